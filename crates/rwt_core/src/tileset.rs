@@ -1,0 +1,326 @@
+//! The recursive progressive Wang tile set: its data, file format, loading and validation.
+//!
+//! Positions are stored as 32-bit fixed point fractions of the tile (`x = X / 2^32`). The
+//! subset property of the paper (section 5.2) then holds *exactly*: for every base point
+//! `k` of tile `t`, the first `N` entries of `t`'s subdivision list name a point `k'` of the
+//! child in cell `(a, b)` with `X_t[k] = floor((a * 2^32 + X_c[k']) / n)` (same for `y`).
+//! A point reached through either level is the same stored number, so no tolerance is
+//! involved anywhere.
+
+use crate::wang::{EdgeColors, complete_set_size};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Version of the file format written by this crate.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// The shipped tile set, built by `rwt tileset build` and embedded in the library.
+const EMBEDDED: &[u8] = include_bytes!("../../../assets/tilesets/default.ron");
+
+/// Scale of the fixed-point tile coordinates.
+pub const FIXED_ONE: f64 = 4_294_967_296.0;
+
+/// One Wang tile.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Tile {
+    /// Edge colours (must equal the tile's index in the complete set).
+    pub edges: EdgeColors,
+    /// Subdivision rule: the `n * n` child tiles, row-major from the south-west cell
+    /// (`cell = b * n + a`, `a` to the east, `b` to the north).
+    pub children: Vec<u16>,
+    /// Points in base-rank order, fixed point `[x, y]`.
+    pub points: Vec<[u32; 2]>,
+    /// Where each point came from (0 interior, 1..=4 the N, E, S, W edge source); used by
+    /// rendering and seam analysis only.
+    pub origins: Vec<u8>,
+    /// The `n^2 N` points of the subdivision in subdivision-rank order, each `cell << 16 |
+    /// child point index`. The first `N` entries are this tile's own points, in base order.
+    pub subdivision: Vec<u32>,
+    /// Seam polylines of the construction (for pictures), tile coordinates.
+    #[serde(default)]
+    pub seams: Vec<Vec<[f32; 2]>>,
+}
+
+/// A complete recursive Wang tile set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TileSet {
+    /// File format version.
+    pub format: u32,
+    /// Number of edge colours `K` (per orientation); the set has `K^4` tiles.
+    pub colors: u8,
+    /// Subdivision factor `n`: a tile splits into `n x n` children.
+    pub subdivision: u8,
+    /// Points per tile `N`.
+    pub points_per_tile: u32,
+    /// Seed the set was built from.
+    pub seed: u64,
+    /// `n`-colour sequence that replaces each horizontal edge colour on subdivision.
+    pub horizontal_sequences: Vec<Vec<u8>>,
+    /// `n`-colour sequence that replaces each vertical edge colour on subdivision.
+    pub vertical_sequences: Vec<Vec<u8>>,
+    /// Tiles, indexed by [`EdgeColors::complete_index`].
+    pub tiles: Vec<Tile>,
+}
+
+/// What is wrong with a tile set file.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum TileSetError {
+    /// The bytes are not a valid RON tile set (truncated, corrupt or not a tile set).
+    #[error("tile set is not valid RON: {0}")]
+    Parse(String),
+    /// Written by a different, incompatible format version.
+    #[error("tile set format {found} is not supported (expected {expected})")]
+    Format {
+        /// Version in the file.
+        found: u32,
+        /// Version this library reads.
+        expected: u32,
+    },
+    /// Header values out of range.
+    #[error("invalid tile set header: {0}")]
+    Header(String),
+    /// A tile's data is inconsistent.
+    #[error("tile {tile}: {problem}")]
+    Tile {
+        /// Tile index.
+        tile: usize,
+        /// What is wrong.
+        problem: String,
+    },
+}
+
+fn tile_err(tile: usize, problem: impl Into<String>) -> TileSetError {
+    TileSetError::Tile {
+        tile,
+        problem: problem.into(),
+    }
+}
+
+impl TileSet {
+    /// The tile set shipped with rwt (`assets/tilesets/default.ron`), parsed and validated
+    /// once per call; keep the result around.
+    pub fn embedded() -> TileSet {
+        // The embedded file is validated by the test suite, so this cannot fail at run time.
+        Self::from_ron_bytes(EMBEDDED).expect("embedded tile set is valid")
+    }
+
+    /// Parses and validates a tile set.
+    pub fn from_ron_bytes(bytes: &[u8]) -> Result<TileSet, TileSetError> {
+        let set = Self::from_ron_bytes_unchecked(bytes)?;
+        set.validate()?;
+        Ok(set)
+    }
+
+    /// Parses without validation (for tools that want to report every problem themselves).
+    pub fn from_ron_bytes_unchecked(bytes: &[u8]) -> Result<TileSet, TileSetError> {
+        let text = std::str::from_utf8(bytes).map_err(|e| TileSetError::Parse(e.to_string()))?;
+        ron::from_str(text).map_err(|e| TileSetError::Parse(e.to_string()))
+    }
+
+    /// Serializes to compact RON.
+    pub fn to_ron(&self) -> String {
+        // Serialization of plain data cannot fail.
+        ron::to_string(self).expect("tile set serializes")
+    }
+
+    /// Number of points in each tile's subdivision (`n^2 N`).
+    pub fn subdivision_len(&self) -> usize {
+        let n = self.subdivision as usize;
+        n * n * self.points_per_tile as usize
+    }
+
+    /// Checks every structural invariant: sizes, colours, subdivision rules that match at the
+    /// borders and inside, rank lists that are permutations, and the exact subset property.
+    pub fn validate(&self) -> Result<(), TileSetError> {
+        if self.format != FORMAT_VERSION {
+            return Err(TileSetError::Format {
+                found: self.format,
+                expected: FORMAT_VERSION,
+            });
+        }
+        let k = self.colors;
+        let n = self.subdivision as usize;
+        let big_n = self.points_per_tile as usize;
+        if !(1..=8).contains(&k) {
+            return Err(TileSetError::Header(format!("colors {k} not in 1..=8")));
+        }
+        if !n.is_power_of_two() || !(2..=16).contains(&n) {
+            return Err(TileSetError::Header(format!(
+                "subdivision {n} must be a power of two in 2..=16"
+            )));
+        }
+        if big_n == 0 || big_n > 65_536 {
+            return Err(TileSetError::Header(format!(
+                "points per tile {big_n} not in 1..=65536"
+            )));
+        }
+        if self.tiles.len() != complete_set_size(k) {
+            return Err(TileSetError::Header(format!(
+                "{} tiles, a complete set of {k} colours has {}",
+                self.tiles.len(),
+                complete_set_size(k)
+            )));
+        }
+        for (name, seqs) in [
+            ("horizontal", &self.horizontal_sequences),
+            ("vertical", &self.vertical_sequences),
+        ] {
+            if seqs.len() != k as usize
+                || seqs
+                    .iter()
+                    .any(|s| s.len() != n || s.iter().any(|&c| c >= k))
+            {
+                return Err(TileSetError::Header(format!(
+                    "{name} sequences must be {k} sequences of {n} colours below {k}"
+                )));
+            }
+            for i in 0..seqs.len() {
+                if seqs[i + 1..].contains(&seqs[i]) {
+                    return Err(TileSetError::Header(format!(
+                        "{name} sequence of colour {i} is not unique"
+                    )));
+                }
+            }
+        }
+        let sub_len = self.subdivision_len();
+        for (t, tile) in self.tiles.iter().enumerate() {
+            if tile.edges.complete_index(k) != t
+                || [
+                    tile.edges.north,
+                    tile.edges.east,
+                    tile.edges.south,
+                    tile.edges.west,
+                ]
+                .iter()
+                .any(|&c| c >= k)
+            {
+                return Err(tile_err(t, "edge colours do not match its index"));
+            }
+            if tile.points.len() != big_n || tile.origins.len() != big_n {
+                return Err(tile_err(
+                    t,
+                    format!("has {} points, expected {big_n}", tile.points.len()),
+                ));
+            }
+            if tile.children.len() != n * n {
+                return Err(tile_err(
+                    t,
+                    format!("subdivision rule has {} children", tile.children.len()),
+                ));
+            }
+            if let Some(&c) = tile
+                .children
+                .iter()
+                .find(|&&c| c as usize >= self.tiles.len())
+            {
+                return Err(tile_err(t, format!("child {c} does not exist")));
+            }
+            if tile.subdivision.len() != sub_len {
+                return Err(tile_err(
+                    t,
+                    format!(
+                        "subdivision lists {} points, expected {sub_len}",
+                        tile.subdivision.len()
+                    ),
+                ));
+            }
+            let mut seen = vec![false; sub_len];
+            for &e in &tile.subdivision {
+                let (cell, idx) = ((e >> 16) as usize, (e & 0xffff) as usize);
+                if cell >= n * n
+                    || idx >= big_n
+                    || std::mem::replace(&mut seen[cell * big_n + idx], true)
+                {
+                    return Err(tile_err(t, "subdivision ranking is not a permutation"));
+                }
+            }
+        }
+        let violations = self.rule_violations();
+        if violations > 0 {
+            return Err(TileSetError::Header(format!(
+                "{violations} edge colour mismatches in subdivision rules"
+            )));
+        }
+        if let Some((t, k)) = self.first_subset_violation() {
+            return Err(tile_err(
+                t,
+                format!("base point {k} is not exactly its subdivision point"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Colour mismatches inside subdivision rules and between rules and the parent's edges.
+    pub fn rule_violations(&self) -> usize {
+        let n = self.subdivision as usize;
+        let mut bad = 0;
+        for tile in &self.tiles {
+            let child = |a: usize, b: usize| &self.tiles[tile.children[b * n + a] as usize].edges;
+            for b in 0..n {
+                for a in 0..n {
+                    let c = child(a, b);
+                    if a + 1 < n && c.east != child(a + 1, b).west {
+                        bad += 1;
+                    }
+                    if b + 1 < n && c.north != child(a, b + 1).south {
+                        bad += 1;
+                    }
+                }
+            }
+            for i in 0..n {
+                let h = |c: u8| self.horizontal_sequences[c as usize][i];
+                let v = |c: u8| self.vertical_sequences[c as usize][i];
+                bad += usize::from(child(i, 0).south != h(tile.edges.south));
+                bad += usize::from(child(i, n - 1).north != h(tile.edges.north));
+                bad += usize::from(child(0, i).west != v(tile.edges.west));
+                bad += usize::from(child(n - 1, i).east != v(tile.edges.east));
+            }
+        }
+        bad
+    }
+
+    /// Position of subdivision entry `e` of tile `t` in `t`'s fixed-point frame (floored).
+    pub fn subdivision_point_fixed(&self, t: usize, e: u32) -> [u32; 2] {
+        let n = self.subdivision as u64;
+        let (cell, idx) = ((e >> 16) as usize, (e & 0xffff) as usize);
+        let (a, b) = ((cell % n as usize) as u64, (cell / n as usize) as u64);
+        let child = self.tiles[t].children[cell] as usize;
+        let [cx, cy] = self.tiles[child].points[idx];
+        [
+            (((a << 32) + cx as u64) / n) as u32,
+            (((b << 32) + cy as u64) / n) as u32,
+        ]
+    }
+
+    /// Largest difference, in fixed-point units, between a base point and the subdivision
+    /// point it is paired with. Zero for every valid set.
+    pub fn max_subset_deviation(&self) -> u64 {
+        let mut worst = 0u64;
+        for (t, tile) in self.tiles.iter().enumerate() {
+            for (k, p) in tile.points.iter().enumerate() {
+                let q = self.subdivision_point_fixed(t, tile.subdivision[k]);
+                for d in 0..2 {
+                    worst = worst.max((p[d] as i64 - q[d] as i64).unsigned_abs());
+                }
+            }
+        }
+        worst
+    }
+
+    fn first_subset_violation(&self) -> Option<(usize, usize)> {
+        for (t, tile) in self.tiles.iter().enumerate() {
+            for (k, p) in tile.points.iter().enumerate() {
+                if self.subdivision_point_fixed(t, tile.subdivision[k]) != *p {
+                    return Some((t, k));
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Converts a fixed-point coordinate to a float in `[0, 1)`.
+#[inline]
+pub fn fixed_to_unit(v: u32) -> f64 {
+    v as f64 / FIXED_ONE
+}
