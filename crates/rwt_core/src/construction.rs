@@ -1,0 +1,422 @@
+//! The tile set construction pipeline (paper sections 4 and 5), deterministic from a seed.
+//!
+//! 1. progressive toroidal source tiles ([`crate::source_tile`]), one per edge colour and
+//!    orientation plus one unique interior per tile;
+//! 2. Wang tiles by merging sources along min-cost Voronoi seams ([`crate::seam`]);
+//! 3. an initial progressive order by interleaving source ranks;
+//! 4. subdivision rules ([`crate::subdivision`]);
+//! 5. relaxation to the exact subset property ([`crate::relaxation`]);
+//! 6. the final base ranking and the subdivision ranking ([`crate::progressive`]), both with
+//!    spacing guaranteed against every possible neighbour tile.
+//!
+//! Independent work (source tiles, merges, relaxation steps) runs on rayon; every random
+//! choice comes from a stream derived from the seed and the item, so the result does not
+//! depend on the number of threads.
+
+use crate::progressive::{Candidate, Neighbours, OFFSETS, order_by_threshold, rank};
+use crate::rng::Rng;
+use crate::seam::{Origin, SourcedPoint, merge};
+use crate::source_tile::DartThrowing;
+use crate::subdivision::{RulesError, find_rules};
+use crate::tileset::{FIXED_ONE, FORMAT_VERSION, Tile, TileSet, TileSetError};
+use crate::wang::{EdgeColors, Side, complete_set_size};
+use glam::DVec2;
+use rayon::prelude::*;
+
+/// Settings of a tile set build.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildConfig {
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Edge colours per orientation `K` (`K^4` tiles).
+    pub colors: u8,
+    /// Points per tile `N`.
+    pub points: u32,
+    /// Subdivision factor `n` (power of two).
+    pub subdivision: u8,
+    /// Spacing constant of the progressive rankings.
+    pub alpha: f64,
+    /// Relaxation passes.
+    pub relax_iterations: usize,
+    /// Minimum distance relaxation keeps between base points, relative to the hexagonal
+    /// spacing of `N` points.
+    pub min_spacing: f64,
+    /// Initial thresholds are `order * lead`: below 1, points enter the ranking a little
+    /// early, which compensates for the ones the spacing rule postpones.
+    pub lead: f64,
+}
+
+impl Default for BuildConfig {
+    /// The configuration of the shipped tile set.
+    fn default() -> Self {
+        Self {
+            seed: 2006,
+            colors: 2,
+            points: 2048,
+            subdivision: 4,
+            alpha: 0.75,
+            relax_iterations: 8,
+            min_spacing: 0.7,
+            lead: 0.85,
+        }
+    }
+}
+
+/// The stages of a build, for progress reporting.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Progressive dart throwing of the source tiles.
+    SourceTiles,
+    /// Seam merging of the Wang tiles.
+    Merging,
+    /// Subdivision rules.
+    Rules,
+    /// Relaxation to the subset property.
+    Relaxation,
+    /// Base and subdivision rankings.
+    Ranking,
+}
+
+impl Stage {
+    /// Human-readable name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::SourceTiles => "source tiles",
+            Stage::Merging => "seam merging",
+            Stage::Rules => "subdivision rules",
+            Stage::Relaxation => "relaxation",
+            Stage::Ranking => "ranking",
+        }
+    }
+}
+
+/// Receives progress of a build (a CLI draws bars; tests ignore it).
+pub trait Progress: Sync {
+    /// A stage starts with `total` steps.
+    fn start(&self, stage: Stage, total: u64);
+    /// `n` steps of the current stage are done.
+    fn advance(&self, n: u64);
+    /// The current stage is done.
+    fn finish(&self);
+}
+
+/// Ignores progress.
+pub struct NoProgress;
+impl Progress for NoProgress {
+    fn start(&self, _: Stage, _: u64) {}
+    fn advance(&self, _: u64) {}
+    fn finish(&self) {}
+}
+
+/// Why a build failed.
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    /// Settings out of range.
+    #[error("invalid build settings: {0}")]
+    Config(String),
+    /// No subdivision rules.
+    #[error(transparent)]
+    Rules(#[from] RulesError),
+    /// The result failed validation (a bug: please report).
+    #[error("built tile set is invalid: {0}")]
+    Invalid(#[from] TileSetError),
+}
+
+/// Extra points thrown in every source so that each merged tile has at least `N`; the
+/// surplus is cut from the end of the progressive order.
+const SOURCE_SURPLUS: f64 = 1.08;
+
+fn origin_code(o: Origin) -> u8 {
+    match o {
+        Origin::Interior => 0,
+        Origin::Edge(Side::North) => 1,
+        Origin::Edge(Side::East) => 2,
+        Origin::Edge(Side::South) => 3,
+        Origin::Edge(Side::West) => 4,
+    }
+}
+
+/// Which tiles may lie at each neighbour offset of each tile, for a complete set with
+/// independent edge hashing: edge neighbours share the colour, diagonal ones are free.
+pub fn complete_set_neighbours(tiles: &[EdgeColors]) -> Neighbours {
+    tiles
+        .iter()
+        .map(|t| {
+            std::array::from_fn(|o| {
+                let (dx, dy) = OFFSETS[o];
+                (0..tiles.len() as u16)
+                    .filter(|&u| {
+                        let u = &tiles[u as usize];
+                        match (dx, dy) {
+                            (1, 0) => u.west == t.east,
+                            (-1, 0) => u.east == t.west,
+                            (0, 1) => u.south == t.north,
+                            (0, -1) => u.north == t.south,
+                            _ => true,
+                        }
+                    })
+                    .collect()
+            })
+        })
+        .collect()
+}
+
+/// Builds a tile set.
+pub fn build(
+    config: &BuildConfig,
+    progress: &dyn Progress,
+) -> Result<(TileSet, BuildReport), BuildError> {
+    let k = config.colors;
+    let n = config.subdivision as usize;
+    let big_n = config.points as usize;
+    if !(1..=4).contains(&k) {
+        return Err(BuildError::Config(format!("colors {k} not in 1..=4")));
+    }
+    if !n.is_power_of_two() || !(2..=8).contains(&n) {
+        return Err(BuildError::Config(format!(
+            "subdivision {n} not a power of two in 2..=8"
+        )));
+    }
+    if !(16..=16_384).contains(&big_n) {
+        return Err(BuildError::Config(format!(
+            "points {big_n} not in 16..=16384"
+        )));
+    }
+    if !(0.3..=0.85).contains(&config.alpha) {
+        return Err(BuildError::Config(format!(
+            "alpha {} not in 0.3..=0.85",
+            config.alpha
+        )));
+    }
+    let seed = config.seed;
+    let tile_count = complete_set_size(k);
+    let edges: Vec<EdgeColors> = (0..tile_count)
+        .map(|i| EdgeColors::from_complete_index(i, k))
+        .collect();
+
+    // 1. Source tiles: K horizontal, K vertical, then one interior per tile.
+    let source_count = 2 * k as usize + tile_count;
+    progress.start(Stage::SourceTiles, source_count as u64);
+    let dart = DartThrowing::new((big_n as f64 * SOURCE_SURPLUS).ceil() as usize);
+    let sources: Vec<Vec<DVec2>> = (0..source_count)
+        .into_par_iter()
+        .map(|s| {
+            let pts = dart.run(&mut Rng::new(seed, 0x50_0000 + s as u64));
+            progress.advance(1);
+            pts
+        })
+        .collect();
+    progress.finish();
+    let tagged = |s: usize, origin: Origin| -> Vec<SourcedPoint> {
+        sources[s]
+            .iter()
+            .enumerate()
+            .map(|(i, &pos)| SourcedPoint {
+                pos,
+                origin,
+                source_rank: i as u32,
+            })
+            .collect()
+    };
+
+    // 2-3. Merge along seams, interleave source ranks, keep the first N.
+    progress.start(Stage::Merging, tile_count as u64);
+    let merged: Vec<(Vec<SourcedPoint>, Vec<Vec<[f32; 2]>>)> = (0..tile_count)
+        .into_par_iter()
+        .map(|t| {
+            let e = edges[t];
+            let mut pts = tagged(2 * k as usize + t, Origin::Interior);
+            let mut seams = Vec::new();
+            for side in Side::ALL {
+                let c = e.side(side) as usize;
+                let src = if side.is_horizontal() {
+                    c
+                } else {
+                    k as usize + c
+                };
+                let (m, seam) = merge(&pts, &tagged(src, Origin::Edge(side)), side);
+                pts = m;
+                seams.push(seam.iter().map(|p| [p.x as f32, p.y as f32]).collect());
+            }
+            let mut rng = Rng::new(seed, 0x1e_0000 + t as u64);
+            let mut keyed: Vec<(u32, u64, SourcedPoint)> = pts
+                .into_iter()
+                .map(|p| (p.source_rank, rng.next_u64(), p))
+                .collect();
+            keyed.sort_by_key(|a| (a.0, a.1));
+            progress.advance(1);
+            (keyed.into_iter().take(big_n).map(|x| x.2).collect(), seams)
+        })
+        .collect();
+    progress.finish();
+    if let Some(short) = merged.iter().position(|m| m.0.len() < big_n) {
+        return Err(BuildError::Config(format!(
+            "tile {short} merged to fewer than {big_n} points; use more points"
+        )));
+    }
+
+    let merged_rho = {
+        let mut r: Vec<f64> = merged
+            .iter()
+            .map(|m| {
+                let pts: Vec<DVec2> = m.0.iter().map(|p| p.pos).collect();
+                crate::analysis::rho(&pts, big_n as f64).unwrap_or(0.0)
+            })
+            .collect();
+        r.sort_by(f64::total_cmp);
+        (r[0], r[r.len() / 2])
+    };
+    // 4. Subdivision rules.
+    progress.start(Stage::Rules, 1);
+    let rules = find_rules(&edges, k, n, seed)?;
+    progress.advance(1);
+    progress.finish();
+
+    // 5. Relaxation.
+    progress.start(Stage::Relaxation, config.relax_iterations as u64);
+    let initial: Vec<Vec<DVec2>> = merged
+        .iter()
+        .map(|m| m.0.iter().map(|p| p.pos).collect())
+        .collect();
+    let neighbours = complete_set_neighbours(&edges);
+    let relaxed = crate::relaxation::relax(
+        initial,
+        &rules.children,
+        &neighbours,
+        n,
+        config.relax_iterations,
+        config.min_spacing,
+        || progress.advance(1),
+    );
+    progress.finish();
+    // 6. Rankings.
+    progress.start(Stage::Ranking, 2);
+    let unit = |p: [u32; 2]| DVec2::new(p[0] as f64, p[1] as f64) / FIXED_ONE;
+    let base_cands: Vec<Vec<Candidate>> = relaxed
+        .positions
+        .iter()
+        .map(|tile| {
+            tile.iter()
+                .enumerate()
+                .map(|(i, &p)| Candidate {
+                    pos: unit(p),
+                    tau0: i as f64 * config.lead,
+                    fixed: false,
+                })
+                .collect()
+        })
+        .collect();
+    let base_tau = rank(&base_cands, &neighbours, config.alpha, big_n as f64);
+    // order[t][new] = old; new_index[t][old] = new.
+    let order: Vec<Vec<usize>> = (0..tile_count)
+        .map(|t| order_by_threshold(&base_cands[t], &base_tau[t]))
+        .collect();
+    let mut new_index = vec![vec![0usize; big_n]; tile_count];
+    for t in 0..tile_count {
+        for (new, &old) in order[t].iter().enumerate() {
+            new_index[t][old] = new;
+        }
+    }
+    let rank_lag: Vec<(usize, f64)> = [16usize, 64, 256, 1024]
+        .into_iter()
+        .filter(|&r| r < big_n)
+        .map(|r| {
+            let lag = (0..tile_count)
+                .map(|t| base_tau[t][order[t][r]] / r as f64)
+                .fold(0.0f64, f64::max);
+            (r, lag)
+        })
+        .collect();
+    progress.advance(1);
+
+    let sub_len = n * n * big_n;
+    let sub_cands: Vec<Vec<Candidate>> = (0..tile_count)
+        .map(|t| {
+            let mut is_base = vec![usize::MAX; sub_len];
+            for (old, &(cell, kk)) in relaxed.partner[t].iter().enumerate() {
+                let child = rules.children[t][cell as usize] as usize;
+                is_base[cell as usize * big_n + new_index[child][kk as usize]] = new_index[t][old];
+            }
+            let mut cands = Vec::with_capacity(sub_len);
+            for cell in 0..n * n {
+                let child = rules.children[t][cell] as usize;
+                let offset = DVec2::new((cell % n) as f64, (cell / n) as f64);
+                for kk in 0..big_n {
+                    let p = unit(relaxed.positions[child][order[child][kk]]);
+                    let base_rank = is_base[cell * big_n + kk];
+                    cands.push(Candidate {
+                        pos: (offset + p) / n as f64,
+                        tau0: if base_rank != usize::MAX {
+                            base_rank as f64
+                        } else {
+                            ((n * n * kk) as f64 * config.lead).max(big_n as f64)
+                        },
+                        fixed: base_rank != usize::MAX,
+                    });
+                }
+            }
+            cands
+        })
+        .collect();
+    let sub_tau = rank(&sub_cands, &neighbours, config.alpha, sub_len as f64);
+    progress.advance(1);
+    progress.finish();
+
+    let tiles: Vec<Tile> = (0..tile_count)
+        .map(|t| {
+            let sub_order = order_by_threshold(&sub_cands[t], &sub_tau[t]);
+            Tile {
+                edges: edges[t],
+                children: rules.children[t].clone(),
+                points: order[t]
+                    .iter()
+                    .map(|&old| relaxed.positions[t][old])
+                    .collect(),
+                origins: order[t]
+                    .iter()
+                    .map(|&old| origin_code(merged[t].0[old].origin))
+                    .collect(),
+                subdivision: sub_order
+                    .iter()
+                    .map(|&j| (((j / big_n) as u32) << 16) | (j % big_n) as u32)
+                    .collect(),
+                seams: merged[t].1.clone(),
+            }
+        })
+        .collect();
+    let set = TileSet {
+        format: FORMAT_VERSION,
+        colors: k,
+        subdivision: n as u8,
+        points_per_tile: big_n as u32,
+        seed,
+        horizontal_sequences: rules.horizontal,
+        vertical_sequences: rules.vertical,
+        tiles,
+    };
+    set.validate()?;
+    let report = BuildReport {
+        merged_rho_min: merged_rho.0,
+        merged_rho_median: merged_rho.1,
+        relaxation_residual: relaxed.residual,
+        relaxation_max_shift: relaxed.max_shift,
+        rank_lag,
+    };
+    Ok((set, report))
+}
+
+/// Measurements taken during a build.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BuildReport {
+    /// Smallest per-tile normalized minimum distance right after seam merging.
+    pub merged_rho_min: f64,
+    /// Median of the same.
+    pub merged_rho_median: f64,
+    /// Largest base-to-partner distance before the exact snap (tile units).
+    pub relaxation_residual: f64,
+    /// Largest distance a point moved in relaxation, in hexagonal spacings of `N` points.
+    pub relaxation_max_shift: f64,
+    /// For some ranks `r`, the largest `tau / r` over tiles: how far the spacing rule
+    /// postponed points (1 = not at all).
+    pub rank_lag: Vec<(usize, f64)>,
+}
