@@ -13,7 +13,9 @@
 //! choice comes from a stream derived from the seed and the item, so the result does not
 //! depend on the number of threads.
 
-use crate::progressive::{Candidate, Neighbours, OFFSETS, order_by_threshold, rank};
+use crate::progressive::{
+    Candidate, Neighbours, OFFSETS, order_by_threshold, rank, repair_prefixes,
+};
 use crate::rng::Rng;
 use crate::seam::{Origin, SourcedPoint, merge};
 use crate::source_tile::DartThrowing;
@@ -34,13 +36,21 @@ pub struct BuildConfig {
     pub points: u32,
     /// Subdivision factor `n` (power of two).
     pub subdivision: u8,
-    /// Spacing constant of the progressive rankings.
+    /// Spacing constant of the progressive rankings: a point of threshold `tau` keeps
+    /// `alpha / sqrt(tau)` from every earlier point (paper: 0.5).
     pub alpha: f64,
+    /// Spacing constant of the final prefix pass: rank `k` keeps `prefix_alpha / sqrt(k + 1)`
+    /// from earlier ranks (0.7 means a normalized minimum distance of 0.65 per prefix).
+    pub prefix_alpha: f64,
     /// Relaxation passes.
     pub relax_iterations: usize,
     /// Minimum distance relaxation keeps between base points, relative to the hexagonal
     /// spacing of `N` points.
     pub min_spacing: f64,
+    /// Width of the seam-free band along every tile edge, as a fraction of the tile. Within
+    /// it every tile with that edge colour holds the same source points; it should be at least
+    /// the spacing of the sparsest prefixes that must match across edges.
+    pub edge_band: f64,
     /// Initial thresholds are `order * lead`: below 1, points enter the ranking a little
     /// early, which compensates for the ones the spacing rule postpones.
     pub lead: f64,
@@ -55,9 +65,11 @@ impl Default for BuildConfig {
             points: 2048,
             subdivision: 4,
             alpha: 0.75,
-            relax_iterations: 8,
+            prefix_alpha: 0.70,
+            relax_iterations: 30,
             min_spacing: 0.7,
-            lead: 0.85,
+            edge_band: 0.2,
+            lead: 0.5,
         }
     }
 }
@@ -123,8 +135,20 @@ pub enum BuildError {
 }
 
 /// Extra points thrown in every source so that each merged tile has at least `N`; the
-/// surplus is cut from the end of the progressive order.
-const SOURCE_SURPLUS: f64 = 1.08;
+/// surplus is cut from the end of the progressive order. Seams make the merged count vary by
+/// a few `sqrt(N)`, hence the second term.
+fn source_surplus(n: usize) -> f64 {
+    1.08 + 2.0 / (n as f64).sqrt()
+}
+
+/// How far ahead in the threshold order the prefix pass looks for a point with room.
+const PREFIX_WINDOW: usize = 64;
+
+/// The same for the subdivision ranking, whose candidates are `n^2` times denser.
+const SUB_PREFIX_WINDOW: usize = 64;
+
+/// A merged Wang tile: its points in progressive order and its seams.
+type MergedTile = (Vec<SourcedPoint>, Vec<Vec<[f32; 2]>>);
 
 fn origin_code(o: Origin) -> u8 {
     match o {
@@ -133,6 +157,70 @@ fn origin_code(o: Origin) -> u8 {
         Origin::Edge(Side::East) => 2,
         Origin::Edge(Side::South) => 3,
         Origin::Edge(Side::West) => 4,
+    }
+}
+
+/// Removes the later of every pair that a seam left closer than the sources allow, then keeps
+/// the first `n` points of the interleaved progressive order. The spacing starts at what
+/// the sources guarantee and relaxes only if too few points would remain.
+fn thin_seams(interleaved: &[SourcedPoint], n: usize) -> Vec<SourcedPoint> {
+    let hex = crate::geometry::hex_spacing(interleaved.len() as f64);
+    for spacing in [0.7, 0.65, 0.6, 0.55, 0.5, 0.0] {
+        let r = spacing * hex;
+        let mut grid = crate::geometry::BucketGrid::new(DVec2::ZERO, DVec2::ONE, r.max(1e-3));
+        let mut kept: Vec<SourcedPoint> = Vec::with_capacity(n);
+        for p in interleaved {
+            let mut clear = true;
+            grid.for_each_near(p.pos, r, |i| {
+                clear &= (kept[i as usize].pos - p.pos).length_squared() >= r * r;
+            });
+            if clear {
+                grid.insert(p.pos, kept.len() as u32);
+                kept.push(*p);
+                if kept.len() == n {
+                    return kept;
+                }
+            }
+        }
+    }
+    interleaved.iter().take(n).copied().collect()
+}
+
+/// Evens out what is left of the seams: pairs closer than `target` hexagonal spacings push
+/// each other apart, for a few rounds. Points within `border` spacings of the tile edge stay
+/// put, so every tile with an edge colour keeps exactly that colour's source pattern there
+/// and neighbouring tiles still continue each other.
+fn smooth_seams(points: &mut [SourcedPoint], target: f64, border: f64, rounds: usize) {
+    let hex = crate::geometry::hex_spacing(points.len() as f64);
+    let r = target * hex;
+    let fixed = border * hex;
+    for _ in 0..rounds {
+        let mut grid = crate::geometry::BucketGrid::new(DVec2::ZERO, DVec2::ONE, r);
+        for (i, p) in points.iter().enumerate() {
+            grid.insert(p.pos, i as u32);
+        }
+        let moves: Vec<DVec2> = points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let m = p.pos.x.min(1.0 - p.pos.x).min(p.pos.y).min(1.0 - p.pos.y);
+                if m < fixed {
+                    return DVec2::ZERO;
+                }
+                let mut push = DVec2::ZERO;
+                grid.for_each_near(p.pos, r, |j| {
+                    let d = p.pos - points[j as usize].pos;
+                    let len = d.length();
+                    if j as usize != i && len < r && len > 0.0 {
+                        push += d / len * (r - len) * 0.5;
+                    }
+                });
+                push
+            })
+            .collect();
+        for (p, m) in points.iter_mut().zip(moves) {
+            p.pos = (p.pos + m).clamp(DVec2::ZERO, DVec2::splat(1.0 - 1e-12));
+        }
     }
 }
 
@@ -182,6 +270,12 @@ pub fn build(
             "points {big_n} not in 16..=16384"
         )));
     }
+    if !(0.0..0.3).contains(&config.edge_band) {
+        return Err(BuildError::Config(format!(
+            "edge band {} not in 0..0.3",
+            config.edge_band
+        )));
+    }
     if !(0.3..=0.85).contains(&config.alpha) {
         return Err(BuildError::Config(format!(
             "alpha {} not in 0.3..=0.85",
@@ -197,7 +291,7 @@ pub fn build(
     // 1. Source tiles: K horizontal, K vertical, then one interior per tile.
     let source_count = 2 * k as usize + tile_count;
     progress.start(Stage::SourceTiles, source_count as u64);
-    let dart = DartThrowing::new((big_n as f64 * SOURCE_SURPLUS).ceil() as usize);
+    let dart = DartThrowing::new((big_n as f64 * source_surplus(big_n)).ceil() as usize);
     let sources: Vec<Vec<DVec2>> = (0..source_count)
         .into_par_iter()
         .map(|s| {
@@ -221,7 +315,8 @@ pub fn build(
 
     // 2-3. Merge along seams, interleave source ranks, keep the first N.
     progress.start(Stage::Merging, tile_count as u64);
-    let merged: Vec<(Vec<SourcedPoint>, Vec<Vec<[f32; 2]>>)> = (0..tile_count)
+    let strip = config.edge_band;
+    let merged: Vec<MergedTile> = (0..tile_count)
         .into_par_iter()
         .map(|t| {
             let e = edges[t];
@@ -234,7 +329,7 @@ pub fn build(
                 } else {
                     k as usize + c
                 };
-                let (m, seam) = merge(&pts, &tagged(src, Origin::Edge(side)), side);
+                let (m, seam) = merge(&pts, &tagged(src, Origin::Edge(side)), side, strip);
                 pts = m;
                 seams.push(seam.iter().map(|p| [p.x as f32, p.y as f32]).collect());
             }
@@ -244,8 +339,11 @@ pub fn build(
                 .map(|p| (p.source_rank, rng.next_u64(), p))
                 .collect();
             keyed.sort_by_key(|a| (a.0, a.1));
+            let interleaved: Vec<SourcedPoint> = keyed.into_iter().map(|x| x.2).collect();
             progress.advance(1);
-            (keyed.into_iter().take(big_n).map(|x| x.2).collect(), seams)
+            let mut kept = thin_seams(&interleaved, big_n);
+            smooth_seams(&mut kept, 0.8, 1.5, 20);
+            (kept, seams)
         })
         .collect();
     progress.finish();
@@ -292,31 +390,29 @@ pub fn build(
     // 6. Rankings.
     progress.start(Stage::Ranking, 2);
     let unit = |p: [u32; 2]| DVec2::new(p[0] as f64, p[1] as f64) / FIXED_ONE;
+    // A point's first threshold comes from its rank in its source, so a shared edge point
+    // starts out the same in every tile that holds it.
+    let source_scale = config.lead * big_n as f64 / dart.points as f64;
     let base_cands: Vec<Vec<Candidate>> = relaxed
         .positions
         .iter()
-        .map(|tile| {
+        .zip(&merged)
+        .map(|(tile, (pts, _))| {
             tile.iter()
-                .enumerate()
-                .map(|(i, &p)| Candidate {
+                .zip(pts)
+                .map(|(&p, src)| Candidate {
                     pos: unit(p),
-                    tau0: i as f64 * config.lead,
+                    tau0: src.source_rank as f64 * source_scale,
                     fixed: false,
                 })
                 .collect()
         })
         .collect();
-    let base_tau = rank(&base_cands, &neighbours, config.alpha, big_n as f64);
+    let base_tau = rank(&base_cands, &neighbours, |_| config.alpha, big_n as f64);
     // order[t][new] = old; new_index[t][old] = new.
-    let order: Vec<Vec<usize>> = (0..tile_count)
+    let mut order: Vec<Vec<usize>> = (0..tile_count)
         .map(|t| order_by_threshold(&base_cands[t], &base_tau[t]))
         .collect();
-    let mut new_index = vec![vec![0usize; big_n]; tile_count];
-    for t in 0..tile_count {
-        for (new, &old) in order[t].iter().enumerate() {
-            new_index[t][old] = new;
-        }
-    }
     let rank_lag: Vec<(usize, f64)> = [16usize, 64, 256, 1024]
         .into_iter()
         .filter(|&r| r < big_n)
@@ -327,6 +423,20 @@ pub fn build(
             (r, lag)
         })
         .collect();
+    let prefix_misses = repair_prefixes(
+        &base_cands,
+        &mut order,
+        &neighbours,
+        config.prefix_alpha,
+        PREFIX_WINDOW,
+        0,
+    );
+    let mut new_index = vec![vec![0usize; big_n]; tile_count];
+    for t in 0..tile_count {
+        for (new, &old) in order[t].iter().enumerate() {
+            new_index[t][old] = new;
+        }
+    }
     progress.advance(1);
 
     let sub_len = n * n * big_n;
@@ -358,13 +468,25 @@ pub fn build(
             cands
         })
         .collect();
-    let sub_tau = rank(&sub_cands, &neighbours, config.alpha, sub_len as f64);
+    let sub_tau = rank(&sub_cands, &neighbours, |_| config.alpha, sub_len as f64);
+    let mut sub_order: Vec<Vec<usize>> = (0..tile_count)
+        .map(|t| order_by_threshold(&sub_cands[t], &sub_tau[t]))
+        .collect();
+    // The base points keep the first N ranks (they are fixed candidates with tau < N).
+    let sub_prefix_misses = repair_prefixes(
+        &sub_cands,
+        &mut sub_order,
+        &neighbours,
+        config.prefix_alpha,
+        SUB_PREFIX_WINDOW,
+        big_n,
+    );
     progress.advance(1);
     progress.finish();
 
     let tiles: Vec<Tile> = (0..tile_count)
         .map(|t| {
-            let sub_order = order_by_threshold(&sub_cands[t], &sub_tau[t]);
+            let sub_order = &sub_order[t];
             Tile {
                 edges: edges[t],
                 children: rules.children[t].clone(),
@@ -400,7 +522,11 @@ pub fn build(
         merged_rho_median: merged_rho.1,
         relaxation_residual: relaxed.residual,
         relaxation_max_shift: relaxed.max_shift,
+        relaxation_crowded: relaxed.crowded,
+        relaxation_crowded_clearance: relaxed.crowded_clearance,
         rank_lag,
+        prefix_misses,
+        sub_prefix_misses,
     };
     Ok((set, report))
 }
@@ -416,7 +542,16 @@ pub struct BuildReport {
     pub relaxation_residual: f64,
     /// Largest distance a point moved in relaxation, in hexagonal spacings of `N` points.
     pub relaxation_max_shift: f64,
+    /// Points relaxation could not give the requested clearance.
+    pub relaxation_crowded: usize,
+    /// Their smallest clearance, in hexagonal spacings.
+    pub relaxation_crowded_clearance: f64,
     /// For some ranks `r`, the largest `tau / r` over tiles: how far the spacing rule
     /// postponed points (1 = not at all).
     pub rank_lag: Vec<(usize, f64)>,
+    /// Ranks (over all tiles) where the final prefix pass found no point with the
+    /// `prefix_alpha` spacing.
+    pub prefix_misses: usize,
+    /// The same for the subdivision ranking (ranks `N..n^2 N`).
+    pub sub_prefix_misses: usize,
 }

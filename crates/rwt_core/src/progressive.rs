@@ -76,10 +76,10 @@ impl Accepted {
 pub fn rank(
     tiles: &[Vec<Candidate>],
     neighbours: &Neighbours,
-    alpha: f64,
+    alpha: impl Fn(f64) -> f64,
     cap: f64,
 ) -> Vec<Vec<f64>> {
-    let cell = alpha / cap.sqrt();
+    let cell = alpha(cap) / cap.sqrt();
     let mut accepted: Vec<Accepted> = tiles
         .iter()
         .map(|_| Accepted {
@@ -106,7 +106,8 @@ pub fn rank(
         let (t, i) = (t as usize, i as usize);
         let tau_now = f64::from_bits(bits);
         let p = tiles[t][i].pos;
-        let r = alpha / tau_now.sqrt();
+        let a = alpha(tau_now);
+        let r = a / tau_now.sqrt();
         let mut d = accepted[t].min_distance(p, r, cell);
         for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
             let near_x = match dx {
@@ -128,11 +129,9 @@ pub fn rank(
             }
         }
         if d < r && tau_now < cap {
-            let wanted = if d > 0.0 {
-                alpha * alpha / (d * d)
-            } else {
-                cap
-            };
+            // Postpone to where this distance is allowed: `alpha` never grows with tau, so
+            // `a^2 / d^2` never overshoots that threshold.
+            let wanted = if d > 0.0 { a * a / (d * d) } else { cap };
             let next = wanted.max(tau_now * (1.0 + 1e-12)).min(cap);
             heap.push(Reverse((next.to_bits(), t as u32, i as u32)));
             continue;
@@ -143,6 +142,85 @@ pub fn rank(
         acc.points.push(p);
     }
     tau
+}
+
+/// The paper's figure 5 in rank space, on top of a threshold order: ranks are fixed one at a
+/// time, in lockstep over all tiles, and rank `k` goes to the first of the next `window`
+/// points (in `order`) that keeps `alpha / sqrt(k + 1)` from the tile's earlier ranks and
+/// from those of every tile that may neighbour it. When none does, the one with the most room
+/// takes it. The first `fixed` ranks of every tile are kept as they are (for a subdivision,
+/// its base points). `order[t]` is rewritten in place; returns how many ranks found no such
+/// point.
+pub fn repair_prefixes(
+    tiles: &[Vec<Candidate>],
+    order: &mut [Vec<usize>],
+    neighbours: &Neighbours,
+    alpha: f64,
+    window: usize,
+    fixed: usize,
+) -> usize {
+    let len = order.iter().map(Vec::len).min().unwrap_or(0);
+    let cell = alpha / (len.max(1) as f64).sqrt();
+    let mut accepted: Vec<Accepted> = tiles
+        .iter()
+        .map(|_| Accepted {
+            grid: BucketGrid::new(DVec2::ZERO, DVec2::ONE, cell),
+            points: Vec::new(),
+        })
+        .collect();
+    for (t, acc) in accepted.iter_mut().enumerate() {
+        for &i in &order[t][..fixed.min(len)] {
+            let p = tiles[t][i].pos;
+            acc.grid.insert(p, acc.points.len() as u32);
+            acc.points.push(p);
+        }
+    }
+    let mut misses = 0;
+    for k in fixed.min(len)..len {
+        let r = alpha / ((k + 1) as f64).sqrt();
+        for t in 0..tiles.len() {
+            let clearance = |p: DVec2| {
+                let mut d = accepted[t].min_distance(p, r, cell);
+                for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
+                    let shifted = p - DVec2::new(dx as f64, dy as f64);
+                    if shifted.x < -r
+                        || shifted.x > 1.0 + r
+                        || shifted.y < -r
+                        || shifted.y > 1.0 + r
+                    {
+                        continue;
+                    }
+                    for &u in &neighbours[t][o] {
+                        d = d.min(accepted[u as usize].min_distance(shifted, d, cell));
+                    }
+                }
+                d
+            };
+            let end = (k + window).min(order[t].len());
+            let mut best = (-1.0f64, k);
+            let mut pick = None;
+            for slot in k..end {
+                let c = clearance(tiles[t][order[t][slot]].pos);
+                if c >= r {
+                    pick = Some(slot);
+                    break;
+                }
+                if c > best.0 {
+                    best = (c, slot);
+                }
+            }
+            if pick.is_none() {
+                misses += 1;
+            }
+            let slot = pick.unwrap_or(best.1);
+            order[t][k..=slot].rotate_right(1);
+            let p = tiles[t][order[t][k]].pos;
+            let acc = &mut accepted[t];
+            acc.grid.insert(p, acc.points.len() as u32);
+            acc.points.push(p);
+        }
+    }
+    misses
 }
 
 /// Turns thresholds into a rank order: indices sorted by `(tau, tau0, index)`.
@@ -176,7 +254,7 @@ mod tests {
         let neighbours: Neighbours = vec![std::array::from_fn(|_| vec![0])];
         let alpha = 0.7;
         let cap = 600.0;
-        let tau = rank(&[cands.clone()], &neighbours, alpha, cap);
+        let tau = rank(std::slice::from_ref(&cands), &neighbours, |_| alpha, cap);
         for a in 0..cands.len() {
             for b in a + 1..cands.len() {
                 let t = tau[0][a].max(tau[0][b]);

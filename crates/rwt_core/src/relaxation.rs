@@ -28,6 +28,10 @@ pub struct Relaxed {
     /// Largest distance a point moved during relaxation and snap, relative to the hexagonal
     /// spacing of `N` points.
     pub max_shift: f64,
+    /// Points that found no subdivision point with the requested clearance in the last pass.
+    pub crowded: usize,
+    /// The smallest clearance among those (hexagonal spacings), `min_spacing` if none.
+    pub crowded_clearance: f64,
 }
 
 fn subdivision_points(points: &[Vec<DVec2>], children: &[u16], n: usize) -> Vec<(DVec2, u16, u16)> {
@@ -40,6 +44,11 @@ fn subdivision_points(points: &[Vec<DVec2>], children: &[u16], n: usize) -> Vec<
     }
     out
 }
+
+/// Subdivision points considered for a base point: the nearest few, then a wider ring when
+/// none of those has room.
+const NEAR_CANDIDATES: usize = 24;
+const FAR_CANDIDATES: usize = 120;
 
 /// Per-tile accepted targets of the current selection pass.
 struct Chosen {
@@ -57,16 +66,45 @@ impl Chosen {
     }
 }
 
+/// Unused subdivision points of one tile near `p`, nearest first (at least `count` unless
+/// the tile runs out).
+fn gather(
+    p: DVec2,
+    count: usize,
+    grid: &BucketGrid,
+    sub: &[(DVec2, u16, u16)],
+    used: &[bool],
+    start: f64,
+    out: &mut Vec<(f64, u32)>,
+) {
+    let mut search = start;
+    loop {
+        out.clear();
+        grid.for_each_near(p, search, |j| {
+            let d = (sub[j as usize].0 - p).length_squared();
+            if !used[j as usize] && d <= search * search {
+                out.push((d, j));
+            }
+        });
+        if out.len() >= count || search > 0.5 {
+            break;
+        }
+        search *= 1.5;
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+}
+
 /// Relaxes `points` (per tile, tile coordinates, in progressive order) against the
 /// subdivision `children` (per tile, `n * n` child indices) and snaps the result exactly.
 ///
 /// Each pass moves every base point onto a subdivision point: the nearest unused one that is
 /// at least `min_spacing` (relative to the hexagonal spacing of `N` points) from the points
 /// already placed in its tile and in every tile that may neighbour it (`neighbours`, as in
-/// [`crate::progressive`]); failing that, the candidate that is farthest from them. Points
-/// are placed in progressive order, all tiles interleaved, so earlier points keep their
-/// place. Subdivision points move with their tiles, so passes repeat until the pairing is
-/// stable; the snap then makes it exact.
+/// [`crate::progressive`]); failing that, the candidate farthest from them. Points are placed
+/// in progressive order, all tiles interleaved, except that points which found no room in the
+/// previous pass go first: they take their place and their neighbours, which had room, adapt
+/// around them, which dissolves jams within a few passes. Subdivision points move with their
+/// tiles, so passes repeat until the pairing is stable; the snap then makes it exact.
 pub fn relax(
     mut points: Vec<Vec<DVec2>>,
     children: &[Vec<u16>],
@@ -84,6 +122,11 @@ pub fn relax(
     let original = points.clone();
     let mut residual = 0.0f64;
     let mut partner: Vec<Vec<(u16, u16)>> = vec![vec![(0, 0); big_n]; tiles];
+    // Passes in a row that left the pairing unchanged: two mean positions have settled.
+    let mut stable_passes = 0;
+    let mut failed: Vec<(usize, usize)> = Vec::new();
+    let mut worst_clearance = f64::INFINITY;
+    let mut candidates: Vec<(f64, u32)> = Vec::new();
     for it in 0..=iterations {
         let subs: Vec<Vec<(DVec2, u16, u16)>> = (0..tiles)
             .into_par_iter()
@@ -99,7 +142,7 @@ pub fn relax(
                 g
             })
             .collect();
-        if it == iterations {
+        if it == iterations || stable_passes >= 2 {
             // Measure how far the pairing is from exact, then stop.
             residual = 0.0;
             for t in 0..tiles {
@@ -111,6 +154,7 @@ pub fn relax(
             }
             break;
         }
+        let previous = partner.clone();
         let mut chosen: Vec<Chosen> = (0..tiles)
             .map(|_| Chosen {
                 grid: BucketGrid::new(DVec2::ZERO, DVec2::ONE, r_min),
@@ -119,44 +163,51 @@ pub fn relax(
             .collect();
         let mut used: Vec<Vec<bool>> = subs.iter().map(|s| vec![false; s.len()]).collect();
         let mut next = points.clone();
-        let mut candidates: Vec<(f64, u32)> = Vec::new();
-        for k in 0..big_n {
-            for t in 0..tiles {
-                let p = points[t][k];
-                let mut search = 1.5 * sub_spacing;
-                loop {
-                    candidates.clear();
-                    sub_grids[t].for_each_near(p, search, |j| {
-                        let d = (subs[t][j as usize].0 - p).length_squared();
-                        if !used[t][j as usize] && d <= search * search {
-                            candidates.push((d, j));
-                        }
-                    });
-                    if candidates.len() >= 12 || search > 0.5 {
-                        break;
-                    }
-                    search *= 1.5;
-                }
-                candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                let clearance = |s: DVec2| -> f64 {
-                    let mut d = chosen[t].min_distance(s, r_min);
-                    for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
-                        let shifted = s - DVec2::new(dx as f64, dy as f64);
-                        if shifted.x < -r_min
-                            || shifted.x > 1.0 + r_min
-                            || shifted.y < -r_min
-                            || shifted.y > 1.0 + r_min
-                        {
-                            continue;
-                        }
+        let mut was_failed = vec![vec![false; big_n]; tiles];
+        for &(t, k) in &failed {
+            was_failed[t][k] = true;
+        }
+        let order: Vec<(usize, usize)> = failed
+            .iter()
+            .copied()
+            .chain(
+                (0..big_n)
+                    .flat_map(|k| (0..tiles).map(move |t| (t, k)))
+                    .filter(|&(t, k)| !was_failed[t][k]),
+            )
+            .collect();
+        let mut failed_now = Vec::new();
+        worst_clearance = f64::INFINITY;
+        for (t, k) in order {
+            let p = points[t][k];
+            let clearance = |s: DVec2| -> f64 {
+                let mut d = chosen[t].min_distance(s, r_min);
+                for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
+                    let shifted = s - DVec2::new(dx as f64, dy as f64);
+                    let outside = shifted.x < -r_min
+                        || shifted.x > 1.0 + r_min
+                        || shifted.y < -r_min
+                        || shifted.y > 1.0 + r_min;
+                    if !outside {
                         for &u in &neighbours[t][o] {
                             d = d.min(chosen[u as usize].min_distance(shifted, d));
                         }
                     }
-                    d
-                };
-                let mut pick = None;
-                let mut best = (-1.0f64, 0u32);
+                }
+                d
+            };
+            let mut pick = None;
+            let mut best = (-1.0f64, 0u32);
+            for count in [NEAR_CANDIDATES, FAR_CANDIDATES] {
+                gather(
+                    p,
+                    count,
+                    &sub_grids[t],
+                    &subs[t],
+                    &used[t],
+                    1.5 * sub_spacing,
+                    &mut candidates,
+                );
                 for &(_, j) in &candidates {
                     let c = clearance(subs[t][j as usize].0);
                     if c >= r_min {
@@ -167,16 +218,29 @@ pub fn relax(
                         best = (c, j);
                     }
                 }
-                let j = pick.unwrap_or(best.1) as usize;
-                used[t][j] = true;
-                let (s, cell, kk) = subs[t][j];
-                partner[t][k] = (cell, kk);
-                next[t][k] = s;
-                let ch = &mut chosen[t];
-                ch.grid.insert(s, ch.points.len() as u32);
-                ch.points.push(s);
+                if pick.is_some() {
+                    break;
+                }
             }
+            if pick.is_none() {
+                failed_now.push((t, k));
+                worst_clearance = worst_clearance.min(best.0 / hex);
+            }
+            let j = pick.unwrap_or(best.1) as usize;
+            used[t][j] = true;
+            let (s, cell, kk) = subs[t][j];
+            partner[t][k] = (cell, kk);
+            next[t][k] = s;
+            let ch = &mut chosen[t];
+            ch.grid.insert(s, ch.points.len() as u32);
+            ch.points.push(s);
         }
+        stable_passes = if partner == previous {
+            stable_passes + 1
+        } else {
+            0
+        };
+        failed = failed_now;
         points = next;
         on_iteration();
     }
@@ -193,6 +257,12 @@ pub fn relax(
         partner,
         residual,
         max_shift,
+        crowded: failed.len(),
+        crowded_clearance: if failed.is_empty() {
+            min_spacing
+        } else {
+            worst_clearance
+        },
     }
 }
 

@@ -39,6 +39,11 @@ pub struct SourcedPoint {
 /// Seam cost exponent `r` (paper: 10).
 pub const SEAM_EXPONENT: i32 = 10;
 
+/// Cost of a seam per point spacing of length. With `r = 10`, edges between well-separated
+/// points cost almost nothing, so without a length cost seams wander to the tile centre and
+/// leave little of the unique interior that keeps tiles from repeating.
+pub const SEAM_LENGTH_COST: f64 = 0.005;
+
 struct Site {
     pos: Point2<f64>,
 }
@@ -52,13 +57,18 @@ impl HasPosition for Site {
 
 /// Merges `incoming` (a full toroidal source tile) into `current` along a seam that joins
 /// the two corners of `side`. Returns the merged points and the seam polyline.
+///
+/// `strip` is the width of the band along every tile edge that seams may not enter except in
+/// the corner squares: each edge's band then holds only its own colour's source points,
+/// identical in every tile with that colour, so the pattern continues exactly across edges.
 pub fn merge(
     current: &[SourcedPoint],
     incoming: &[SourcedPoint],
     side: Side,
+    strip: f64,
 ) -> (Vec<SourcedPoint>, Vec<DVec2>) {
     let union: Vec<SourcedPoint> = current.iter().chain(incoming).copied().collect();
-    let seam = seam_path(&union, side);
+    let seam = seam_path(&union, side, strip);
     let polygon = side_polygon(&seam, side);
     let from_incoming = |p: &SourcedPoint| point_in_polygon(p.pos, &polygon);
     let mut merged: Vec<SourcedPoint> = current
@@ -87,24 +97,9 @@ fn side_corners(side: Side) -> (DVec2, DVec2) {
     }
 }
 
-/// Which side of the unit square a boundary point lies on (None for interior points).
-fn boundary_side(p: DVec2) -> [Option<Side>; 2] {
-    const EPS: f64 = 1e-12;
-    let mut sides = [None, None];
-    let mut n = 0;
-    for (on, s) in [
-        (p.y >= 1.0 - EPS, Side::North),
-        (p.x >= 1.0 - EPS, Side::East),
-        (p.y <= EPS, Side::South),
-        (p.x <= EPS, Side::West),
-    ] {
-        if on && n < 2 {
-            sides[n] = Some(s);
-            n += 1;
-        }
-    }
-    sides
-}
+/// Clipped Voronoi edges: end points, the faces they come from (None for clip points), and
+/// the distance between the two sites they separate.
+type ClippedEdge = (DVec2, DVec2, Option<usize>, Option<usize>, f64);
 
 #[derive(PartialEq)]
 struct State {
@@ -127,11 +122,16 @@ impl PartialOrd for State {
     }
 }
 
-/// Liang-Barsky clip of segment `a -> b` to the unit square.
-fn clip_unit(a: DVec2, b: DVec2) -> Option<(DVec2, DVec2)> {
+/// Liang-Barsky clip of segment `a -> b` to the square `[lo, hi]^2`.
+fn clip(a: DVec2, b: DVec2, lo: f64, hi: f64) -> Option<(DVec2, DVec2)> {
     let d = b - a;
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for (p, q) in [(-d.x, a.x), (d.x, 1.0 - a.x), (-d.y, a.y), (d.y, 1.0 - a.y)] {
+    for (p, q) in [
+        (-d.x, a.x - lo),
+        (d.x, hi - a.x),
+        (-d.y, a.y - lo),
+        (d.y, hi - a.y),
+    ] {
         if p == 0.0 {
             if q < 0.0 {
                 return None;
@@ -148,9 +148,23 @@ fn clip_unit(a: DVec2, b: DVec2) -> Option<(DVec2, DVec2)> {
     (t0 <= t1).then(|| (a + d * t0, a + d * t1))
 }
 
-/// Computes the min-cost seam between the corners of `side` through the clipped Voronoi
-/// diagram of `points` (with a toroidal margin so that cells at the border are bounded).
-pub fn seam_path(points: &[SourcedPoint], side: Side) -> Vec<DVec2> {
+/// Computes the seam between the corners of `side`.
+///
+/// Inside the square `[strip, 1 - strip]^2` the seam is the min-cost path through the
+/// clipped Voronoi diagram of `points` (a toroidal margin keeps border cells bounded).
+/// Outside it, the seam is fixed: from each corner it runs along the diagonal to the inner
+/// square's corner. So the band along every edge belongs to that edge's source alone, and
+/// each corner square is split along its diagonal into two triangles, each owned by the
+/// edge it touches. Around a lattice vertex, every pair of triangles that face each other
+/// across an edge then comes from that edge's source: no two sources meet across a tile
+/// edge anywhere near it, which is what lets neighbouring tiles continue each other.
+pub fn seam_path(points: &[SourcedPoint], side: Side, strip: f64) -> Vec<DVec2> {
+    let (lo, hi) = (strip, 1.0 - strip);
+    let (start_corner, end_corner) = side_corners(side);
+    let inner = |c: DVec2| DVec2::new(c.x.clamp(lo, hi), c.y.clamp(lo, hi));
+    let (start_in, end_in) = (inner(start_corner), inner(end_corner));
+    let fallback = vec![start_corner, start_in, end_in, end_corner];
+
     const MARGIN: f64 = 0.12;
     let mut sites = Vec::with_capacity(points.len() * 2);
     for p in points {
@@ -166,16 +180,15 @@ pub fn seam_path(points: &[SourcedPoint], side: Side) -> Vec<DVec2> {
         }
     }
     let Ok(tri) = DelaunayTriangulation::<Site>::bulk_load(sites) else {
-        // Degenerate input (cannot happen for blue-noise tiles): fall back to the side itself.
-        let (a, b) = side_corners(side);
-        return vec![a, b];
+        return fallback;
     };
 
-    // Graph nodes: Voronoi vertices inside the tile (by face index), clip points, corners.
+    // Graph nodes: Voronoi vertices inside the inner square (by face), clip points on its
+    // border, and the two inner corners the seam must join.
     let mut nodes: Vec<DVec2> = Vec::new();
     let mut face_node: Vec<Option<usize>> = vec![None; tri.num_all_faces()];
     let mut edges: Vec<(usize, usize, f64)> = Vec::new();
-    let mut raw: Vec<(DVec2, DVec2, Option<usize>, Option<usize>, f64)> = Vec::new();
+    let mut raw: Vec<ClippedEdge> = Vec::new();
     let mut d_max = 0.0f64;
     for e in tri.undirected_edges() {
         let de = e.as_directed();
@@ -187,7 +200,7 @@ pub fn seam_path(points: &[SourcedPoint], side: Side) -> Vec<DVec2> {
         let c0 = f0.circumcenter();
         let c1 = f1.circumcenter();
         let (c0, c1) = (DVec2::new(c0.x, c0.y), DVec2::new(c1.x, c1.y));
-        let Some((a, b)) = clip_unit(c0, c1) else {
+        let Some((a, b)) = clip(c0, c1, lo, hi) else {
             continue;
         };
         d_max = d_max.max(d);
@@ -202,12 +215,12 @@ pub fn seam_path(points: &[SourcedPoint], side: Side) -> Vec<DVec2> {
             }
             nodes.push(p);
             face_node[f] = Some(nodes.len() - 1);
-            nodes.len() - 1
         } else {
             nodes.push(p);
-            nodes.len() - 1
         }
+        nodes.len() - 1
     };
+    let spacing = crate::geometry::hex_spacing(points.len() as f64 / 2.0);
     for &(a, b, fa, fb, d) in &raw {
         let na = node_at(a, fa, &mut nodes);
         let nb = node_at(b, fb, &mut nodes);
@@ -216,42 +229,33 @@ pub fn seam_path(points: &[SourcedPoint], side: Side) -> Vec<DVec2> {
         for _ in 0..SEAM_EXPONENT {
             cost *= base;
         }
-        edges.push((na, nb, cost));
+        edges.push((na, nb, cost + SEAM_LENGTH_COST * (b - a).length() / spacing));
     }
-    // Corners, then boundary segments along every side except the merged one.
-    let corners = [
-        DVec2::new(0.0, 0.0),
-        DVec2::new(1.0, 0.0),
-        DVec2::new(1.0, 1.0),
-        DVec2::new(0.0, 1.0),
-    ];
-    let corner_nodes: Vec<usize> = corners
-        .iter()
-        .map(|&c| {
-            nodes.push(c);
-            nodes.len() - 1
-        })
-        .collect();
-    for s in Side::ALL {
-        if s == side {
-            continue;
-        }
-        let mut on_side: Vec<(f64, usize)> = nodes
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| boundary_side(**p).contains(&Some(s)))
-            .map(|(i, p)| (if s.is_horizontal() { p.x } else { p.y }, i))
-            .collect();
-        on_side.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for w in on_side.windows(2) {
-            // Running along the tile border separates nothing: make it the worst edge.
-            edges.push((w[0].1, w[1].1, 1.0));
+    nodes.push(start_in);
+    let start = nodes.len() - 1;
+    nodes.push(end_in);
+    let end = nodes.len() - 1;
+    // Along the inner square's border the seam may only hop from an inner corner to the
+    // first Voronoi edges next to it: running along the border separates nothing.
+    // A few point spacings: two hops must never meet, or the seam would skip the diagram.
+    let reach = 3.0 * crate::geometry::hex_spacing(points.len() as f64 / 2.0);
+    let on_border = |p: DVec2| {
+        const EPS: f64 = 1e-12;
+        (p.x - lo).abs() < EPS
+            || (p.x - hi).abs() < EPS
+            || (p.y - lo).abs() < EPS
+            || (p.y - hi).abs() < EPS
+    };
+    for corner in [start, end] {
+        let c = nodes[corner];
+        for (i, &p) in nodes.iter().enumerate() {
+            let same_line = (p.x - c.x).abs() < 1e-12 || (p.y - c.y).abs() < 1e-12;
+            if i != corner && on_border(p) && same_line && (p - c).length() < reach {
+                edges.push((corner, i, 1.0));
+            }
         }
     }
 
-    let (start_p, end_p) = side_corners(side);
-    let corner_index = |p: DVec2| corner_nodes[corners.iter().position(|&c| c == p).unwrap_or(0)];
-    let (start, end) = (corner_index(start_p), corner_index(end_p));
     let mut adjacency: Vec<Vec<(usize, f64)>> = vec![Vec::new(); nodes.len()];
     for &(a, b, c) in &edges {
         if a != b {
@@ -287,14 +291,15 @@ pub fn seam_path(points: &[SourcedPoint], side: Side) -> Vec<DVec2> {
         }
     }
     if !dist[end].is_finite() {
-        return vec![start_p, end_p];
+        return fallback;
     }
-    let mut path = vec![nodes[end]];
+    let mut path = vec![end_corner, nodes[end]];
     let mut at = end;
     while at != start {
         at = prev[at];
         path.push(nodes[at]);
     }
+    path.push(start_corner);
     path.reverse();
     path
 }
@@ -322,7 +327,7 @@ mod tests {
     fn seam_joins_the_corners_of_the_side() {
         let t = source(1, Origin::Interior);
         let e = source(2, Origin::Edge(Side::East));
-        let (merged, seam) = merge(&t, &e, Side::East);
+        let (merged, seam) = merge(&t, &e, Side::East, 0.08);
         assert_eq!(seam.first(), Some(&DVec2::new(1.0, 0.0)));
         assert_eq!(seam.last(), Some(&DVec2::new(1.0, 1.0)));
         let from_edge: Vec<_> = merged
@@ -334,6 +339,16 @@ mod tests {
         let mean_x = from_edge.iter().map(|p| p.pos.x).sum::<f64>() / from_edge.len() as f64;
         assert!(mean_x > 0.6, "mean x of east points {mean_x}");
         assert!(from_edge.len() < merged.len() / 2);
+        // The east band belongs to the east source alone, the other bands to the tile.
+        for p in &merged {
+            let in_band = |v: f64| v > 0.08 && v < 0.92;
+            if p.pos.x > 0.92 && in_band(p.pos.y) {
+                assert_eq!(p.origin, Origin::Edge(Side::East), "{p:?}");
+            }
+            if p.pos.x < 0.08 && in_band(p.pos.y) {
+                assert_eq!(p.origin, Origin::Interior, "{p:?}");
+            }
+        }
         // About as many points as one source tile.
         let n = merged.len() as f64;
         assert!((n - 400.0).abs() < 40.0, "{n}");

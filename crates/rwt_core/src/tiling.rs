@@ -37,21 +37,10 @@ impl<'a> Tiling<'a> {
         self.seed
     }
 
-    #[inline]
-    fn color(&self, i: i64, j: i64, vertical: u64) -> u8 {
-        let h = hash_words(self.seed, &[i as u64, j as u64, vertical]);
-        (((h >> 32) * self.set.colors as u64) >> 32) as u8
-    }
-
     /// The base (level 0) tile at lattice cell `(i, j)`.
     #[inline]
     pub fn base_tile(&self, i: i64, j: i64) -> u16 {
-        let k = self.set.colors as usize;
-        let north = self.color(i, j.wrapping_add(1), 0) as usize;
-        let east = self.color(i.wrapping_add(1), j, 1) as usize;
-        let south = self.color(i, j, 0) as usize;
-        let west = self.color(i, j, 1) as usize;
-        (((north * k + east) * k + south) * k + west) as u16
+        base_tile(self.seed, self.set.colors, i, j)
     }
 
     /// The tile at cell `(i, j)` of level `level` (cells of side `n^-level` base tiles).
@@ -68,6 +57,24 @@ impl<'a> Tiling<'a> {
         }
         t
     }
+}
+
+#[inline]
+fn edge_color(seed: u64, colors: u8, i: i64, j: i64, vertical: u64) -> u8 {
+    let h = hash_words(seed, &[i as u64, j as u64, vertical]);
+    (((h >> 32) * colors as u64) >> 32) as u8
+}
+
+/// The base tile of a complete set of `colors` colours at lattice cell `(i, j)` for `seed`:
+/// the tile whose four edge colours are the hashes of its four edges.
+#[inline]
+pub fn base_tile(seed: u64, colors: u8, i: i64, j: i64) -> u16 {
+    let k = colors as usize;
+    let north = edge_color(seed, colors, i, j.wrapping_add(1), 0) as usize;
+    let east = edge_color(seed, colors, i.wrapping_add(1), j, 1) as usize;
+    let south = edge_color(seed, colors, i, j, 0) as usize;
+    let west = edge_color(seed, colors, i, j, 1) as usize;
+    (((north * k + east) * k + south) * k + west) as u16
 }
 
 /// Floor division by `2^s` for any `s` (arithmetic shift saturating at 63).

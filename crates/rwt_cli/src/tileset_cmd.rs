@@ -1,0 +1,232 @@
+//! `rwt tileset ...`: build, check and render tile sets.
+
+use crate::draw::Canvas;
+use indicatif::{ProgressBar, ProgressStyle};
+use rwt_core::check::{base_prefix_rho, edge_violations};
+use rwt_core::construction::{BuildConfig, Progress, Stage, build};
+use rwt_core::tileset::{TileSet, fixed_to_unit};
+use std::path::Path;
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// One progress bar per build stage.
+struct Bars {
+    bar: Mutex<Option<ProgressBar>>,
+}
+
+impl Progress for Bars {
+    fn start(&self, stage: Stage, total: u64) {
+        let bar = ProgressBar::new(total).with_style(
+            ProgressStyle::with_template("{prefix:>18} [{bar:32}] {pos}/{len} {elapsed_precise}")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(stage.name());
+        *self.bar.lock().expect("progress lock") = Some(bar);
+    }
+    fn advance(&self, n: u64) {
+        if let Some(b) = self.bar.lock().expect("progress lock").as_ref() {
+            b.inc(n);
+        }
+    }
+    fn finish(&self) {
+        if let Some(b) = self.bar.lock().expect("progress lock").take() {
+            b.finish();
+        }
+    }
+}
+
+/// `rwt tileset build`.
+pub fn build_cmd(out: &Path, config: BuildConfig) -> Result<(), String> {
+    let started = Instant::now();
+    let bars = Bars {
+        bar: Mutex::new(None),
+    };
+    let (set, report) = build(&config, &bars).map_err(|e| e.to_string())?;
+    let text = set.to_ron();
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    std::fs::write(out, &text).map_err(|e| format!("{}: {e}", out.display()))?;
+    println!(
+        "built {} tiles x {} points (subdivision {}x{}) in {:.1} s -> {} ({:.1} MB)",
+        set.tiles.len(),
+        set.points_per_tile,
+        set.subdivision,
+        set.subdivision,
+        started.elapsed().as_secs_f64(),
+        out.display(),
+        text.len() as f64 / 1e6
+    );
+    println!(
+        "  merged rho per tile: min {:.3}, median {:.3}; relaxation residual {:.1e}, max shift {:.2} spacings",
+        report.merged_rho_min,
+        report.merged_rho_median,
+        report.relaxation_residual,
+        report.relaxation_max_shift
+    );
+    println!(
+        "  relaxation: {} points short of the requested clearance (worst {:.3} spacings); prefix pass: {} base and {} subdivision ranks without room",
+        report.relaxation_crowded,
+        report.relaxation_crowded_clearance,
+        report.prefix_misses,
+        report.sub_prefix_misses
+    );
+    for (r, lag) in &report.rank_lag {
+        println!("  rank {r:>5}: threshold / rank at most {lag:.2}");
+    }
+    Ok(())
+}
+
+/// `rwt tileset check`: returns whether the set is valid.
+pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let set = TileSet::from_ron_bytes_unchecked(&bytes).map_err(|e| e.to_string())?;
+    let mut ok = true;
+    println!("tile set        {}", path.display());
+    println!(
+        "tiles           {} ({} colours, complete set)",
+        set.tiles.len(),
+        set.colors
+    );
+    println!("points per tile {}", set.points_per_tile);
+    println!("subdivision     {0}x{0}", set.subdivision);
+    match set.validate() {
+        Ok(()) => {
+            println!("structure       valid (sizes, colours, rules, rank permutations, subset)")
+        }
+        Err(e) => {
+            println!("structure       INVALID: {e}");
+            return Ok(false);
+        }
+    }
+    println!("rank lists      valid permutations; subdivision lists start with the base points");
+    for level in 0..=3 {
+        let window = if level == 3 { 3 } else { 8 };
+        let v = edge_violations(&set, 1, level, window);
+        ok &= v == 0;
+        println!("edge mismatches level {level}: {v}");
+    }
+    let dev = set.max_subset_deviation();
+    ok &= dev == 0;
+    println!("max base-to-subdivision deviation: {dev} (fixed-point units of 2^-32 tile)");
+    println!(
+        "normalized minimum distance of each tile's first k points, with neighbours (8 seeds, 10x10 tiles):"
+    );
+    let n = set.points_per_tile as usize;
+    for k in [16usize, 64, 256, 1024, n] {
+        if k > n {
+            continue;
+        }
+        let rho = base_prefix_rho(&set, k, 8, 10);
+        let pass = min_rho.is_none_or(|m| rho >= m);
+        ok &= pass;
+        println!(
+            "  k = {k:>5}: rho = {rho:.3}{}",
+            if pass { "" } else { "  (below --min-rho)" }
+        );
+    }
+    println!("{}", if ok { "OK" } else { "FAILED" });
+    Ok(ok)
+}
+
+const ORIGIN_COLOURS: [[u8; 3]; 5] = [
+    [30, 30, 30],
+    [214, 39, 40],
+    [31, 119, 180],
+    [44, 160, 44],
+    [255, 127, 14],
+];
+const EDGE_COLOURS: [[u8; 3]; 8] = [
+    [230, 85, 13],
+    [49, 130, 189],
+    [117, 107, 177],
+    [49, 163, 84],
+    [222, 45, 38],
+    [99, 99, 99],
+    [140, 86, 75],
+    [188, 189, 34],
+];
+
+fn edge_bars(c: &mut Canvas, set: &TileSet, t: usize, x: f64, y: f64, s: f64, w: f64) {
+    let e = set.tiles[t].edges;
+    let hc = |k: u8| EDGE_COLOURS[k as usize % 4];
+    let vc = |k: u8| EDGE_COLOURS[4 + k as usize % 4];
+    c.rect(x, y, x + s, y + w, hc(e.north));
+    c.rect(x, y + s - w, x + s, y + s, hc(e.south));
+    c.rect(x, y, x + w, y + s, vc(e.west));
+    c.rect(x + s - w, y, x + s, y + s, vc(e.east));
+}
+
+/// `rwt tileset render`: all tiles with seams, origins and edge colours (figure 4), and one
+/// tile subdivided twice with base and subdivision points (figures 6 and 7).
+pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let set = TileSet::from_ron_bytes(&bytes).map_err(|e| e.to_string())?;
+    let cols = (set.tiles.len() as f64).sqrt().ceil() as usize;
+    let s = 220.0;
+    let gap = 12.0;
+    let grid_w = cols as f64 * (s + gap) + gap;
+    let big = 2.0 * s + gap;
+    let width = grid_w + big + gap;
+    let height = grid_w.max(big + 2.0 * gap);
+    let mut c = Canvas::new(width as u32, height as u32, [255, 255, 255]);
+    for (t, tile) in set.tiles.iter().enumerate() {
+        let x = gap + (t % cols) as f64 * (s + gap);
+        let y = gap + (t / cols) as f64 * (s + gap);
+        c.rect(x, y, x + s, y + s, [245, 245, 245]);
+        edge_bars(&mut c, &set, t, x, y, s, 5.0);
+        for seam in &tile.seams {
+            for w in seam.windows(2) {
+                let p = |q: [f32; 2]| (x + q[0] as f64 * s, y + (1.0 - q[1] as f64) * s);
+                c.line(p(w[0]), p(w[1]), 1.2, [170, 170, 170]);
+            }
+        }
+        for (k, p) in tile.points.iter().enumerate() {
+            let (px, py) = (
+                x + fixed_to_unit(p[0]) * s,
+                y + (1.0 - fixed_to_unit(p[1])) * s,
+            );
+            c.disc(px, py, 1.3, ORIGIN_COLOURS[tile.origins[k] as usize % 5]);
+        }
+    }
+    // One tile, two levels of subdivision.
+    let x0 = grid_w;
+    let y0 = gap;
+    let n = set.subdivision as usize;
+    let cell2 = big / (n * n) as f64;
+    let t0 = 0usize;
+    for (cell, &child) in set.tiles[t0].children.iter().enumerate() {
+        let (a, b) = (cell % n, cell / n);
+        for (cell2_i, &grand) in set.tiles[child as usize].children.iter().enumerate() {
+            let (a2, b2) = (cell2_i % n, cell2_i / n);
+            let gx = x0 + (a * n + a2) as f64 * cell2;
+            let gy = y0 + big - (b * n + b2 + 1) as f64 * cell2;
+            c.rect(gx, gy, gx + cell2, gy + cell2, [250, 250, 250]);
+            edge_bars(&mut c, &set, grand as usize, gx, gy, cell2, 2.0);
+        }
+        let cx = x0 + a as f64 * big / n as f64;
+        let cy = y0 + big - (b + 1) as f64 * big / n as f64;
+        edge_bars(&mut c, &set, child as usize, cx, cy, big / n as f64, 4.0);
+    }
+    edge_bars(&mut c, &set, t0, x0, y0, big, 7.0);
+    // Level 1 points (the subdivision of tile 0), outlined; base points filled on top.
+    let big_n = set.points_per_tile as usize;
+    for (j, &e) in set.tiles[t0].subdivision.iter().enumerate() {
+        let q = set.subdivision_point_fixed(t0, e);
+        let (px, py) = (
+            x0 + fixed_to_unit(q[0]) * big,
+            y0 + (1.0 - fixed_to_unit(q[1])) * big,
+        );
+        if j < big_n {
+            c.disc(px, py, 2.6, [0, 0, 0]);
+        } else {
+            c.disc(px, py, 1.1, [120, 120, 120]);
+        }
+    }
+    c.image
+        .save(out)
+        .map_err(|e| format!("{}: {e}", out.display()))?;
+    println!("wrote {}", out.display());
+    Ok(())
+}

@@ -1,0 +1,480 @@
+//! Random-access blue-noise queries (paper sections 3 and 5.2).
+//!
+//! For a rectangle and a density, every base tile over the rectangle contributes its points
+//! whose rank is below `density x tile area`; where the density's maximum over a tile asks
+//! for more than the tile holds, the tile's subdivision ranking continues the sequence
+//! (ranks `N..n^2 N`), and where it asks for more than that, the children are visited in
+//! turn. Work and output are proportional to the integral of the density; nothing is
+//! allocated per tile (the recursion lives on the stack, results go to a callback).
+//!
+//! Every point is produced exactly once, at the coarsest level where it exists, with a
+//! stable [`PointId`]. A point is included exactly when the density at its position exceeds
+//! its [`Point::threshold`], so raising the density anywhere only adds points, and splitting
+//! a rectangle into pieces (half-open: `[min, max)`) yields exactly the union of the pieces.
+
+use crate::density::{Density, sanitize};
+use crate::rng::{hash_words, unit_f64};
+use crate::tileset::{TileSet, fixed_to_unit};
+use crate::tiling::base_tile;
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+/// Deepest subdivision level visited: `n^(2 * 24)` times the base density, far beyond any
+/// budget. Deeper requests are served at this level's density.
+pub const MAX_LEVEL: u32 = 24;
+
+/// Largest coordinate magnitude, in base tiles, a query may touch (keeps lattice indices of
+/// every level inside `i64`).
+pub const MAX_TILE_COORDINATE: f64 = 1.0e12;
+
+/// A half-open rectangle `[min, max)` in world units.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Rect {
+    /// Inclusive lower corner.
+    pub min: DVec2,
+    /// Exclusive upper corner.
+    pub max: DVec2,
+}
+
+impl Rect {
+    /// A rectangle; it may be empty, but not inverted or non-finite.
+    pub fn new(min: DVec2, max: DVec2) -> Result<Self, QueryError> {
+        if !(min.is_finite() && max.is_finite()) {
+            return Err(QueryError::NonFiniteRect);
+        }
+        if max.x < min.x || max.y < min.y {
+            return Err(QueryError::InvertedRect);
+        }
+        Ok(Self { min, max })
+    }
+
+    /// Whether `p` is inside (half-open).
+    #[inline]
+    pub fn contains(&self, p: DVec2) -> bool {
+        p.x >= self.min.x && p.y >= self.min.y && p.x < self.max.x && p.y < self.max.y
+    }
+
+    /// Area.
+    pub fn area(&self) -> f64 {
+        (self.max.x - self.min.x) * (self.max.y - self.min.y)
+    }
+
+    fn is_empty(&self) -> bool {
+        !(self.max.x > self.min.x && self.max.y > self.min.y)
+    }
+
+    fn intersect(&self, other: &Rect) -> Rect {
+        Rect {
+            min: self.min.max(other.min),
+            max: self.max.min(other.max),
+        }
+    }
+}
+
+/// Why a query was refused. Nothing is generated when a query is refused up front.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum QueryError {
+    /// A corner is NaN or infinite.
+    #[error("query rectangle is not finite")]
+    NonFiniteRect,
+    /// `max < min` on some axis.
+    #[error("query rectangle is inverted (max < min)")]
+    InvertedRect,
+    /// Coordinates beyond [`MAX_TILE_COORDINATE`] base tiles.
+    #[error(
+        "query rectangle reaches {tiles:e} tiles from the origin (limit {MAX_TILE_COORDINATE:e})"
+    )]
+    TooFar {
+        /// Distance in base tiles.
+        tiles: f64,
+    },
+    /// The density asks for more points than the budget allows.
+    #[error("query may produce up to {estimate:.0} points, over the budget of {budget}")]
+    BudgetExceeded {
+        /// Upper bound of the number of points.
+        estimate: f64,
+        /// The budget.
+        budget: usize,
+    },
+}
+
+/// Stable identity of a point: the tile it first appears in and its index there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct PointId {
+    /// Subdivision level (0 = base tiles).
+    pub level: u8,
+    /// Lattice column of the tile at that level.
+    pub x: i64,
+    /// Lattice row of the tile at that level.
+    pub y: i64,
+    /// Index of the point in its tile.
+    pub index: u16,
+}
+
+impl PointId {
+    /// A 64-bit hash of the identity and a salt: the source of every derived attribute.
+    #[inline]
+    pub fn hash(&self, seed: u64, salt: u64) -> u64 {
+        hash_words(
+            seed,
+            &[
+                salt,
+                self.level as u64,
+                self.x as u64,
+                self.y as u64,
+                self.index as u64,
+            ],
+        )
+    }
+
+    /// A number in `[0, 1)` hashed from the identity (same on every platform).
+    #[inline]
+    pub fn unit(&self, seed: u64, salt: u64) -> f64 {
+        unit_f64(self.hash(seed, salt))
+    }
+
+    /// A rotation angle in `[0, 2 pi)`, hashed from the identity.
+    #[inline]
+    pub fn rotation(&self, seed: u64) -> f64 {
+        self.unit(seed, 0x0107) * std::f64::consts::TAU
+    }
+
+    /// A scale factor in `[1 - variation, 1 + variation]`, hashed from the identity.
+    #[inline]
+    pub fn scale(&self, seed: u64, variation: f64) -> f64 {
+        1.0 + variation * (2.0 * self.unit(seed, 0x05ca) - 1.0)
+    }
+}
+
+/// A point of a query.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Point {
+    /// World position.
+    pub position: DVec2,
+    /// Stable identity.
+    pub id: PointId,
+    /// The point is present wherever the density at its position exceeds this (points per
+    /// unit area): use it to fade points in, or to pick a level of detail.
+    pub threshold: f64,
+    /// Class index (see [`Sampler::query_classes`]); 0 for single-density queries.
+    pub class: u16,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct SubEntry {
+    cell: [u8; 2],
+    index: u16,
+    frac: [f64; 2],
+}
+
+#[derive(Clone, Debug)]
+struct RuntimeTile {
+    base: Vec<[f64; 2]>,
+    /// Subdivision entries of rank `N..n^2 N` (the first `N` are the base points).
+    sub: Vec<SubEntry>,
+    children: Vec<u16>,
+}
+
+/// Generates points of a tile set's infinite point set: the run-time side of rwt.
+#[derive(Clone, Debug)]
+pub struct Sampler {
+    tiles: Vec<RuntimeTile>,
+    n: i64,
+    points_per_tile: usize,
+    sub_len: usize,
+    colors: u8,
+    seed: u64,
+    tile_size: f64,
+    budget: usize,
+}
+
+impl Sampler {
+    /// A sampler over `set`'s tiling for `seed`, with base tiles 1 world unit wide and a
+    /// budget of 50 million points per query.
+    pub fn new(set: &TileSet, seed: u64) -> Self {
+        let n = set.subdivision as usize;
+        let big_n = set.points_per_tile as usize;
+        let tiles = set
+            .tiles
+            .iter()
+            .map(|t| RuntimeTile {
+                base: t
+                    .points
+                    .iter()
+                    .map(|p| [fixed_to_unit(p[0]), fixed_to_unit(p[1])])
+                    .collect(),
+                sub: t.subdivision[big_n..]
+                    .iter()
+                    .map(|&e| {
+                        let (cell, index) = ((e >> 16) as usize, (e & 0xffff) as u16);
+                        let child = &set.tiles[t.children[cell] as usize];
+                        let q = child.points[index as usize];
+                        SubEntry {
+                            cell: [(cell % n) as u8, (cell / n) as u8],
+                            index,
+                            frac: [fixed_to_unit(q[0]), fixed_to_unit(q[1])],
+                        }
+                    })
+                    .collect(),
+                children: t.children.clone(),
+            })
+            .collect();
+        Self {
+            tiles,
+            n: n as i64,
+            points_per_tile: big_n,
+            sub_len: set.subdivision_len(),
+            colors: set.colors,
+            seed,
+            tile_size: 1.0,
+            budget: 50_000_000,
+        }
+    }
+
+    /// Base tiles `size` world units wide (finite, positive).
+    pub fn with_tile_size(mut self, size: f64) -> Self {
+        if size.is_finite() && size > 0.0 {
+            self.tile_size = size;
+        }
+        self
+    }
+
+    /// Largest number of points one query may produce.
+    pub fn with_budget(mut self, budget: usize) -> Self {
+        self.budget = budget;
+        self
+    }
+
+    /// Base tile size in world units.
+    pub fn tile_size(&self) -> f64 {
+        self.tile_size
+    }
+
+    /// The tiling seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Points per tile of the underlying set.
+    pub fn points_per_tile(&self) -> usize {
+        self.points_per_tile
+    }
+
+    /// An upper bound of how many points `density` yields in `rect` (refined by splitting
+    /// until it is under the budget or cannot improve).
+    pub fn expected_upper_bound<D: Density + ?Sized>(&self, rect: &Rect, density: &D) -> f64 {
+        fn bound<D: Density + ?Sized>(r: &Rect, d: &D, depth: u32, target: f64) -> f64 {
+            let b = sanitize(d.max_over(r.min, r.max)) * r.area();
+            if b <= target || depth == 0 || b.is_infinite() {
+                return b;
+            }
+            let c = (r.min + r.max) * 0.5;
+            let quads = [
+                Rect { min: r.min, max: c },
+                Rect {
+                    min: DVec2::new(c.x, r.min.y),
+                    max: DVec2::new(r.max.x, c.y),
+                },
+                Rect {
+                    min: DVec2::new(r.min.x, c.y),
+                    max: DVec2::new(c.x, r.max.y),
+                },
+                Rect { min: c, max: r.max },
+            ];
+            quads
+                .iter()
+                .map(|q| bound(q, d, depth - 1, target / 4.0))
+                .sum()
+        }
+        if rect.is_empty() {
+            return 0.0;
+        }
+        bound(rect, density, 7, self.budget as f64)
+    }
+
+    fn check(&self, rect: &Rect) -> Result<(), QueryError> {
+        let far = rect.min.abs().max(rect.max.abs()).max_element() / self.tile_size;
+        if far > MAX_TILE_COORDINATE {
+            return Err(QueryError::TooFar { tiles: far });
+        }
+        Ok(())
+    }
+
+    /// Calls `emit` with every point of `rect` for `density`; returns how many.
+    pub fn query_with<D: Density + ?Sized>(
+        &self,
+        rect: Rect,
+        density: &D,
+        mut emit: impl FnMut(Point),
+    ) -> Result<usize, QueryError> {
+        self.check(&rect)?;
+        let estimate = self.expected_upper_bound(&rect, density);
+        if estimate.is_nan() || estimate > self.budget as f64 {
+            return Err(QueryError::BudgetExceeded {
+                estimate,
+                budget: self.budget,
+            });
+        }
+        let mut count = 0usize;
+        if rect.is_empty() {
+            return Ok(0);
+        }
+        let s = self.tile_size;
+        let (i0, i1) = (
+            (rect.min.x / s).floor() as i64,
+            (rect.max.x / s).ceil() as i64,
+        );
+        let (j0, j1) = (
+            (rect.min.y / s).floor() as i64,
+            (rect.max.y / s).ceil() as i64,
+        );
+        let mut visit = Visit {
+            sampler: self,
+            rect,
+            density,
+            emit: &mut |p: Point| {
+                count += 1;
+                emit(p)
+            },
+        };
+        for j in j0..j1 {
+            for i in i0..i1 {
+                let t = base_tile(self.seed, self.colors, i, j);
+                visit.tile(t, 0, i, j, s);
+            }
+        }
+        Ok(count)
+    }
+
+    /// All points of `rect` for `density`, appended to `out`; returns how many.
+    pub fn query<D: Density + ?Sized>(
+        &self,
+        rect: Rect,
+        density: &D,
+        out: &mut Vec<Point>,
+    ) -> Result<usize, QueryError> {
+        self.query_with(rect, density, |p| out.push(p))
+    }
+
+    /// Several classes sharing one point set (paper section 6.3): points follow the sum of
+    /// the class densities, and a point of threshold `tau` at `p` belongs to the first class
+    /// `i` with `tau < d_0(p) + ... + d_i(p)`. So class 0 alone is exactly the point set of
+    /// `d_0` (blue noise by itself), classes `0..=i` together that of `d_0 + ... + d_i`, and
+    /// every class appears in proportion to its density.
+    pub fn query_classes<D: Density>(
+        &self,
+        rect: Rect,
+        classes: &[D],
+        mut emit: impl FnMut(Point),
+    ) -> Result<usize, QueryError> {
+        let total = SumOf(classes);
+        self.query_with(rect, &total, |mut p| {
+            let mut cumulative = 0.0;
+            p.class = (classes.len().saturating_sub(1)) as u16;
+            for (i, c) in classes.iter().enumerate() {
+                cumulative += sanitize(c.density(p.position));
+                if p.threshold < cumulative {
+                    p.class = i as u16;
+                    break;
+                }
+            }
+            emit(p)
+        })
+    }
+}
+
+/// The sum of a slice of densities.
+struct SumOf<'a, D>(&'a [D]);
+
+impl<D: Density> Density for SumOf<'_, D> {
+    fn density(&self, p: DVec2) -> f64 {
+        self.0.iter().map(|d| sanitize(d.density(p))).sum()
+    }
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        self.0.iter().map(|d| sanitize(d.max_over(min, max))).sum()
+    }
+}
+
+struct Visit<'a, D: ?Sized, F> {
+    sampler: &'a Sampler,
+    rect: Rect,
+    density: &'a D,
+    emit: &'a mut F,
+}
+
+impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
+    fn tile(&mut self, t: u16, level: u32, ix: i64, iy: i64, s: f64) {
+        let tile_rect = Rect {
+            min: DVec2::new(ix as f64 * s, iy as f64 * s),
+            max: DVec2::new((ix + 1) as f64 * s, (iy + 1) as f64 * s),
+        };
+        let clip = tile_rect.intersect(&self.rect);
+        if clip.is_empty() {
+            return;
+        }
+        let area = s * s;
+        let limit = sanitize(self.density.max_over(clip.min, clip.max)) * area;
+        if limit.is_nan() || limit <= 0.0 {
+            return;
+        }
+        let sampler = self.sampler;
+        let tile = &sampler.tiles[t as usize];
+        let big_n = sampler.points_per_tile;
+        if level == 0 {
+            let count = (limit.ceil().min(big_n as f64)) as usize;
+            for (k, f) in tile.base[..count].iter().enumerate() {
+                let p = DVec2::new((ix as f64 + f[0]) * s, (iy as f64 + f[1]) * s);
+                if self.rect.contains(p) && sanitize(self.density.density(p)) * area > k as f64 {
+                    (self.emit)(Point {
+                        position: p,
+                        id: PointId {
+                            level: 0,
+                            x: ix,
+                            y: iy,
+                            index: k as u16,
+                        },
+                        threshold: k as f64 / area,
+                        class: 0,
+                    });
+                }
+            }
+        }
+        if limit <= big_n as f64 || level >= MAX_LEVEL {
+            return;
+        }
+        let n = sampler.n;
+        let (Some(cx0), Some(cy0)) = (ix.checked_mul(n), iy.checked_mul(n)) else {
+            return;
+        };
+        let child_s = s / n as f64;
+        let end = (limit.ceil().min(sampler.sub_len as f64)) as usize - big_n;
+        for (r, e) in tile.sub[..end].iter().enumerate() {
+            let rank = (big_n + r) as f64;
+            let (cx, cy) = (cx0 + e.cell[0] as i64, cy0 + e.cell[1] as i64);
+            let p = DVec2::new(
+                (cx as f64 + e.frac[0]) * child_s,
+                (cy as f64 + e.frac[1]) * child_s,
+            );
+            if self.rect.contains(p) && sanitize(self.density.density(p)) * area > rank {
+                (self.emit)(Point {
+                    position: p,
+                    id: PointId {
+                        level: level as u8 + 1,
+                        x: cx,
+                        y: cy,
+                        index: e.index,
+                    },
+                    threshold: rank / area,
+                    class: 0,
+                });
+            }
+        }
+        if limit <= sampler.sub_len as f64 {
+            return;
+        }
+        for (cell, &child) in tile.children.iter().enumerate() {
+            let (a, b) = (cell as i64 % n, cell as i64 / n);
+            self.tile(child, level + 1, cx0 + a, cy0 + b, child_s);
+        }
+    }
+}
