@@ -16,7 +16,7 @@
 use crate::progressive::{
     Candidate, Neighbours, OFFSETS, order_by_threshold, rank, repair_prefixes,
 };
-use crate::rng::Rng;
+use crate::rng::{Rng, hash_words, unit_f64};
 use crate::seam::{Origin, SourcedPoint, merge};
 use crate::source_tile::DartThrowing;
 use crate::subdivision::{RulesError, find_rules};
@@ -68,7 +68,7 @@ impl Default for BuildConfig {
             prefix_alpha: 0.70,
             relax_iterations: 30,
             min_spacing: 0.7,
-            edge_band: 0.2,
+            edge_band: 0.07,
             lead: 0.5,
         }
     }
@@ -459,7 +459,15 @@ pub fn build(
                         tau0: if base_rank != usize::MAX {
                             base_rank as f64
                         } else {
-                            ((n * n * kk) as f64 * config.lead).max(big_n as f64)
+                            // The paper's figure 8: candidates in random order, spaced by
+                            // the shrinking radius alone.
+                            big_n as f64
+                                * (1.0
+                                    + 1e-3
+                                        * unit_f64(hash_words(
+                                            seed,
+                                            &[0x5ab, t as u64, (cell * big_n + kk) as u64],
+                                        )))
                         },
                         fixed: base_rank != usize::MAX,
                     });
