@@ -1,6 +1,11 @@
 //! `rwt`: the command line of the rwt workspace.
 
+mod analyse_cmd;
+mod bench_cmd;
 mod draw;
+mod points_cmd;
+mod spec;
+mod stipple_cmd;
 mod tileset_cmd;
 
 use clap::{Parser, Subcommand};
@@ -25,6 +30,60 @@ enum Command {
     Tileset {
         #[command(subcommand)]
         action: TilesetAction,
+    },
+    /// Points of a rectangle for a density: `x y class rotation level:x:y:index` per line.
+    Points {
+        /// The rectangle: x0 y0 x1 y1.
+        #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true)]
+        rect: Vec<f64>,
+        /// const:V (points per unit area), image:PATH[:V], dark:PATH[:V] or
+        /// noise:V[:FREQ[:OCTAVES[:SEED]]]; images are stretched over the rectangle.
+        #[arg(long)]
+        density: String,
+        /// Tiling seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Width of a base tile in world units.
+        #[arg(long, default_value_t = 1.0)]
+        tile_size: f64,
+        /// Refuse queries that may produce more points than this.
+        #[arg(long, default_value_t = 50_000_000)]
+        budget: usize,
+        /// Output file (default: standard output).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Normalized minimum distance, spectrum and anisotropy of a point file, beside dart
+    /// throwing, a jittered grid and white noise computed in the same run.
+    Analyse {
+        /// Points, `x y` first on each line.
+        file: PathBuf,
+        /// Draw points, spectrum, radial power and anisotropy to this PNG.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// Stipple an image: dots with blue-noise spacing, denser where darker.
+    Stipple {
+        /// Input image.
+        image: PathBuf,
+        /// Output .svg or .png.
+        #[arg(long)]
+        out: PathBuf,
+        /// Expected number of dots.
+        #[arg(long, default_value_t = 50_000)]
+        points: usize,
+        /// Tiling seed.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output pixels per image pixel.
+        #[arg(long, default_value_t = 2.0)]
+        scale: f64,
+    },
+    /// Throughput and scaling of queries, as ratios measured in one run.
+    Bench {
+        /// Smaller, faster run.
+        #[arg(long)]
+        quick: bool,
     },
 }
 
@@ -92,6 +151,31 @@ fn main() -> ExitCode {
                 tileset_cmd::render_cmd(&file, &out).map(|()| true)
             }
         },
+        Command::Points {
+            rect,
+            density,
+            seed,
+            tile_size,
+            budget,
+            out,
+        } => points_cmd::run(points_cmd::PointsArgs {
+            rect: [rect[0], rect[1], rect[2], rect[3]],
+            density: &density,
+            seed,
+            tile_size,
+            budget,
+            out: out.as_deref(),
+        })
+        .map(|()| true),
+        Command::Analyse { file, plot } => analyse_cmd::run(&file, plot.as_deref()).map(|()| true),
+        Command::Stipple {
+            image,
+            out,
+            points,
+            seed,
+            scale,
+        } => stipple_cmd::run(&image, &out, points, seed, scale).map(|()| true),
+        Command::Bench { quick } => bench_cmd::run(quick).map(|()| true),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

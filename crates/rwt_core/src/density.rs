@@ -100,6 +100,11 @@ pub struct ImageDensity {
     scale: f64,
     width: usize,
     height: usize,
+    /// Texels per world unit on each axis.
+    texels_per_unit: DVec2,
+    /// The image with one extra column and row repeating the last ones, so that bilinear
+    /// interpolation never needs to clamp its second texel (row stride `width + 1`).
+    padded: Vec<f32>,
     /// Level 0 is the image (values in [0, 1]); level `l` holds 2x2 maxima of level `l - 1`.
     levels: Vec<(usize, usize, Vec<f32>)>,
 }
@@ -164,12 +169,21 @@ impl ImageDensity {
             }
             levels.push((nw, nh, next));
         }
+        let img = &levels[0].2;
+        let mut padded = Vec::with_capacity((w + 1) * (h + 1));
+        for y in 0..=h {
+            let row = &img[y.min(h - 1) * w..][..w];
+            padded.extend_from_slice(row);
+            padded.push(row[w - 1]);
+        }
         Ok(Self {
             origin,
             size,
             scale: scale.max(0.0),
             width: w,
             height: h,
+            texels_per_unit: DVec2::new(w as f64, h as f64) / size,
+            padded,
             levels,
         })
     }
@@ -226,31 +240,36 @@ impl ImageDensity {
     }
 
     /// The image value (before `scale`) at a world point.
-    #[inline]
+    // Always inlined: in a query's inner loop this lets the image fields stay in registers.
+    #[inline(always)]
     pub fn value(&self, p: DVec2) -> f64 {
-        let t = self.texel(p);
-        let (w, h) = (self.width as f64, self.height as f64);
-        if !(t.x >= 0.0 && t.y >= 0.0 && t.x < w && t.y < h) {
+        // Texel coordinates with texel centres at integers, y downwards.
+        let fx = (p.x - self.origin.x) * self.texels_per_unit.x - 0.5;
+        let fy = (self.origin.y + self.size.y - p.y) * self.texels_per_unit.y - 0.5;
+        if !(fx >= -0.5
+            && fy >= -0.5
+            && fx < self.width as f64 - 0.5
+            && fy < self.height as f64 - 0.5)
+        {
             return 0.0;
         }
-        let fx = (t.x - 0.5).max(0.0);
-        let fy = (t.y - 0.5).max(0.0);
-        let x0 = (fx as usize).min(self.width - 1);
-        let y0 = (fy as usize).min(self.height - 1);
-        let x1 = (x0 + 1).min(self.width - 1);
-        let y1 = (y0 + 1).min(self.height - 1);
+        let (fx, fy) = (fx.max(0.0), fy.max(0.0));
+        let (x0, y0) = (fx as usize, fy as usize);
         let (ax, ay) = ((fx - x0 as f64) as f32, (fy - y0 as f64) as f32);
-        let img = &self.levels[0].2;
-        let row0 = y0 * self.width;
-        let row1 = y1 * self.width;
-        let top = img[row0 + x0] + (img[row0 + x1] - img[row0 + x0]) * ax;
-        let bottom = img[row1 + x0] + (img[row1 + x1] - img[row1 + x0]) * ax;
-        (top + (bottom - top) * ay) as f64
+        let stride = self.width + 1;
+        let i = y0 * stride + x0;
+        let (top, bottom) = (
+            &self.padded[i..i + 2],
+            &self.padded[i + stride..i + stride + 2],
+        );
+        let t = top[0] + (top[1] - top[0]) * ax;
+        let b = bottom[0] + (bottom[1] - bottom[0]) * ax;
+        (t + (b - t) * ay) as f64
     }
 }
 
 impl Density for ImageDensity {
-    #[inline]
+    #[inline(always)]
     fn density(&self, p: DVec2) -> f64 {
         self.value(p) * self.scale
     }

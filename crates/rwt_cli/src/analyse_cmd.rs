@@ -1,0 +1,240 @@
+//! `rwt analyse`: quality figures of a point set beside references computed in the same run.
+
+use crate::draw::Canvas;
+use glam::DVec2;
+use rwt_core::analysis::{Spectrum, reference, rho};
+use std::path::Path;
+
+/// One row of the comparison table.
+pub struct Row {
+    /// Generator name.
+    pub name: &'static str,
+    /// Normalized minimum distance.
+    pub rho: f64,
+    /// Mean radial power below half the principal frequency.
+    pub low_frequency: f64,
+    /// Mean anisotropy (dB).
+    pub mean_anisotropy: f64,
+    /// Largest anisotropy (dB).
+    pub max_anisotropy: f64,
+    /// The spectrum.
+    pub spectrum: Spectrum,
+}
+
+/// Computes the rows for point windows of side `side` (ours first, then the references).
+pub fn compare(windows: &[(DVec2, Vec<DVec2>)], side: f64, size: usize) -> Vec<Row> {
+    let count = (windows.iter().map(|w| w.1.len()).sum::<usize>() / windows.len().max(1)).max(1);
+    let density = count as f64 / (side * side);
+    let row = |name, wins: &[(DVec2, Vec<DVec2>)]| {
+        let spectrum = Spectrum::averaged(wins, side, size);
+        let r = wins
+            .iter()
+            .filter_map(|(_, p)| rho(p, p.len() as f64 / (side * side)))
+            .fold(f64::INFINITY, f64::min);
+        Row {
+            name,
+            rho: r,
+            low_frequency: spectrum.low_frequency_power(side, density, 0.5),
+            mean_anisotropy: spectrum.mean_anisotropy(2),
+            max_anisotropy: spectrum.max_anisotropy(2),
+            spectrum,
+        }
+    };
+    let make = |f: &dyn Fn(u64) -> Vec<DVec2>| -> Vec<(DVec2, Vec<DVec2>)> {
+        (0..windows.len() as u64)
+            .map(|i| (DVec2::ZERO, f(i)))
+            .collect()
+    };
+    vec![
+        row("this point set", windows),
+        row(
+            "dart throwing",
+            &make(&|i| reference::dart_throwing(DVec2::ZERO, side, count, i)),
+        ),
+        row(
+            "jittered grid",
+            &make(&|i| reference::jittered_grid(DVec2::ZERO, side, count, i)),
+        ),
+        row(
+            "white noise",
+            &make(&|i| reference::white_noise(DVec2::ZERO, side, count, i)),
+        ),
+    ]
+}
+
+/// Prints the table.
+pub fn print_table(rows: &[Row]) {
+    println!(
+        "{:<16} {:>7} {:>12} {:>15} {:>15}",
+        "", "rho", "low-freq pow", "mean aniso dB", "max aniso dB"
+    );
+    for r in rows {
+        println!(
+            "{:<16} {:>7.3} {:>12.3} {:>15.1} {:>15.1}",
+            r.name, r.rho, r.low_frequency, r.mean_anisotropy, r.max_anisotropy
+        );
+    }
+}
+
+fn read_points(path: &Path) -> Result<Vec<DVec2>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let mut it = line.split_whitespace();
+        let (Some(x), Some(y)) = (it.next(), it.next()) else {
+            continue;
+        };
+        let (x, y) = (
+            x.parse::<f64>()
+                .map_err(|_| format!("line {}: bad x {x:?}", n + 1))?,
+            y.parse::<f64>()
+                .map_err(|_| format!("line {}: bad y {y:?}", n + 1))?,
+        );
+        if x.is_finite() && y.is_finite() {
+            out.push(DVec2::new(x, y));
+        }
+    }
+    if out.len() < 16 {
+        return Err(format!(
+            "{}: {} points, need at least 16",
+            path.display(),
+            out.len()
+        ));
+    }
+    Ok(out)
+}
+
+/// `rwt analyse FILE [--plot out.png]`.
+pub fn run(path: &Path, plot: Option<&Path>) -> Result<(), String> {
+    let points = read_points(path)?;
+    let (mut lo, mut hi) = (points[0], points[0]);
+    for &p in &points {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    let side_all = (hi - lo).min_element();
+    if side_all.is_nan() || side_all <= 0.0 {
+        return Err("points span no area".into());
+    }
+    // Up to 4x4 square windows, each with at least ~500 points.
+    let per_axis = ((points.len() as f64 / 500.0).sqrt().floor() as usize).clamp(1, 4);
+    let side = side_all / per_axis as f64;
+    let mut windows = Vec::new();
+    for j in 0..per_axis {
+        for i in 0..per_axis {
+            let o = lo + DVec2::new(i as f64, j as f64) * side;
+            let w: Vec<DVec2> = points
+                .iter()
+                .copied()
+                .filter(|p| p.x >= o.x && p.y >= o.y && p.x < o.x + side && p.y < o.y + side)
+                .collect();
+            windows.push((o, w));
+        }
+    }
+    let total = points.len() as f64 / ((hi.x - lo.x) * (hi.y - lo.y));
+    println!(
+        "{} points, {:.4} x {:.4}, {:.1} per unit area; {} window(s) of side {:.4}",
+        points.len(),
+        hi.x - lo.x,
+        hi.y - lo.y,
+        total,
+        windows.len(),
+        side
+    );
+    let rows = compare(&windows, side, 128);
+    print_table(&rows);
+    if let Some(out) = plot {
+        draw(&windows[0], side, &rows, out)?;
+        println!("wrote {}", out.display());
+    }
+    Ok(())
+}
+
+const COLOURS: [[u8; 3]; 4] = [[20, 20, 20], [31, 119, 180], [44, 160, 44], [214, 39, 40]];
+
+/// Points, power spectrum, radial power and anisotropy (the paper's figure 2 layout).
+pub fn draw(
+    window: &(DVec2, Vec<DVec2>),
+    side: f64,
+    rows: &[Row],
+    out: &Path,
+) -> Result<(), String> {
+    let panel = 320.0;
+    let gap = 16.0;
+    let mut c = Canvas::new(
+        (4.0 * panel + 5.0 * gap) as u32,
+        (panel + 2.0 * gap) as u32,
+        [255, 255, 255],
+    );
+    // Points.
+    let (o, pts) = window;
+    let (x0, y0) = (gap, gap);
+    let r = (0.9 * panel / (pts.len() as f64).sqrt() * 0.25).clamp(0.6, 3.0);
+    for p in pts {
+        let q = (*p - *o) / side;
+        c.disc(x0 + q.x * panel, y0 + (1.0 - q.y) * panel, r, [0, 0, 0]);
+    }
+    // Spectrum, log scale from 0.01 (black) to 10 (white), as in the paper.
+    let s = &rows[0].spectrum;
+    let (x1, y1) = (2.0 * gap + panel, gap);
+    let px = panel / s.size as f64;
+    for v in 0..s.size {
+        for u in 0..s.size {
+            let p = s.power[v * s.size + u].max(1e-3);
+            let t = ((p.log10() + 2.0) / 3.0).clamp(0.0, 1.0);
+            let g = (255.0 * t) as u8;
+            c.rect(
+                x1 + u as f64 * px,
+                y1 + (s.size - 1 - v) as f64 * px,
+                x1 + (u + 1) as f64 * px,
+                y1 + (s.size - v) as f64 * px,
+                [g, g, g],
+            );
+        }
+    }
+    // Radial mean power (0..4) and anisotropy (-20..+10 dB), every row.
+    let curves =
+        |c: &mut Canvas, x: f64, f: &dyn Fn(&Row) -> &Vec<f64>, lo: f64, hi: f64, guide: f64| {
+            c.rect(x, gap, x + panel, gap + panel, [248, 248, 248]);
+            let gy = gap + panel * (1.0 - (guide - lo) / (hi - lo));
+            c.line((x, gy), (x + panel, gy), 1.0, [200, 200, 200]);
+            for (k, row) in rows.iter().enumerate().rev() {
+                let v = f(row);
+                let n = v.len().max(2);
+                let mut prev: Option<(f64, f64)> = None;
+                for (i, &y) in v.iter().enumerate().skip(1) {
+                    if !y.is_finite() {
+                        prev = None;
+                        continue;
+                    }
+                    let p = (
+                        x + panel * i as f64 / (n - 1) as f64,
+                        gap + panel * (1.0 - ((y - lo) / (hi - lo)).clamp(0.0, 1.0)),
+                    );
+                    if let Some(q) = prev {
+                        c.line(q, p, if k == 0 { 2.0 } else { 1.2 }, COLOURS[k % 4]);
+                    }
+                    prev = Some(p);
+                }
+            }
+        };
+    curves(
+        &mut c,
+        3.0 * gap + 2.0 * panel,
+        &|r: &Row| &r.spectrum.radial_mean,
+        0.0,
+        4.0,
+        1.0,
+    );
+    curves(
+        &mut c,
+        4.0 * gap + 3.0 * panel,
+        &|r: &Row| &r.spectrum.anisotropy_db,
+        -20.0,
+        10.0,
+        0.0,
+    );
+    c.image
+        .save(out)
+        .map_err(|e| format!("{}: {e}", out.display()))
+}

@@ -1,0 +1,200 @@
+//! `rwt bench`: query throughput and scaling, as ratios measured in one run (one thread).
+
+use fast_poisson::Poisson2D;
+use glam::DVec2;
+use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity};
+use rwt_core::query::{Point, PointId, Rect, Sampler};
+use rwt_core::rng::{Rng, hash_words, unit_f64};
+use rwt_core::tileset::TileSet;
+use std::hint::black_box;
+use std::time::Instant;
+
+/// Median wall time of `runs` runs of `f`, in seconds.
+fn median_time(runs: usize, mut f: impl FnMut()) -> f64 {
+    let mut t: Vec<f64> = (0..runs)
+        .map(|_| {
+            let s = Instant::now();
+            f();
+            s.elapsed().as_secs_f64()
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
+/// A smooth painted-looking map: blobs and strokes, values in [0, 1].
+pub fn synthetic_map(size: u32) -> Vec<f32> {
+    let mut rng = Rng::new(5, 5);
+    let blobs: Vec<(f64, f64, f64)> = (0..24)
+        .map(|_| (rng.next_f64(), rng.next_f64(), 0.03 + 0.12 * rng.next_f64()))
+        .collect();
+    (0..size * size)
+        .map(|i| {
+            let (x, y) = (
+                (i % size) as f64 / size as f64,
+                (i / size) as f64 / size as f64,
+            );
+            let mut v: f64 = 0.15;
+            for &(bx, by, r) in &blobs {
+                let d2 = ((x - bx).powi(2) + (y - by).powi(2)) / (r * r);
+                v += (-d2).exp();
+            }
+            v.min(1.0) as f32
+        })
+        .collect()
+}
+
+/// Times one density (monomorphized, as a user's own density type would be).
+fn measure<D: Density>(
+    sampler: &Sampler,
+    rect: Rect,
+    runs: usize,
+    out: &mut Vec<Point>,
+    name: &str,
+    d: &D,
+) -> (String, usize, f64) {
+    out.clear();
+    let count = sampler.query(rect, d, out).unwrap_or(0);
+    let t = median_time(runs, || {
+        out.clear();
+        black_box(sampler.query(rect, d, out).ok());
+    });
+    (name.to_string(), count, t)
+}
+
+/// `rwt bench`.
+pub fn run(quick: bool) -> Result<(), String> {
+    let set = TileSet::embedded();
+    let runs = if quick { 3 } else { 7 };
+    let target = if quick { 400_000.0 } else { 2_000_000.0 };
+    // A 32 x 32 tile world at about 1.5 N per tile, which uses levels 0 and 1.
+    let tiles = 32.0;
+    let rect = Rect::new(DVec2::ZERO, DVec2::splat(tiles)).map_err(|e| e.to_string())?;
+    let d_uniform = target / (tiles * tiles);
+    let sampler = Sampler::new(&set, 1).with_budget(100_000_000);
+    let mut out: Vec<Point> = Vec::with_capacity(target as usize * 2);
+    let map = synthetic_map(1024);
+    let mean_map = map.iter().map(|&v| v as f64).sum::<f64>() / map.len() as f64;
+    let image = {
+        let scale = d_uniform / mean_map;
+        ImageDensity::from_values(1024, 1024, &map, DVec2::ZERO, DVec2::splat(tiles), scale)
+            .map_err(|e| e.to_string())?
+    };
+    let noise = NoiseDensity::new(3, 0.15, 4, 0.5, 0.5, 2.0 * d_uniform);
+    let rows = vec![
+        measure(
+            &sampler,
+            rect,
+            runs,
+            &mut out,
+            "uniform",
+            &Constant(d_uniform),
+        ),
+        measure(&sampler, rect, runs, &mut out, "image (1024^2 map)", &image),
+        measure(
+            &sampler,
+            rect,
+            runs,
+            &mut out,
+            "noise (4-octave fBm)",
+            &noise,
+        ),
+    ];
+    // White-noise floor: hashed random points written to the same output type.
+    let floor_count = rows[0].1;
+    let floor = median_time(runs, || {
+        out.clear();
+        for i in 0..floor_count as u64 {
+            let h = hash_words(1, &[i]);
+            let p = DVec2::new(unit_f64(h), unit_f64(h.rotate_left(32))) * tiles;
+            out.push(Point {
+                position: p,
+                id: PointId {
+                    level: 0,
+                    x: 0,
+                    y: 0,
+                    index: i as u16,
+                },
+                threshold: 0.0,
+                class: 0,
+            });
+        }
+        black_box(&out);
+    });
+    let floor_rate = floor_count as f64 / floor;
+    println!(
+        "one thread, {} runs each (median), {}x{} base tiles of {} points",
+        runs, tiles, tiles, set.points_per_tile
+    );
+    println!(
+        "{:<24} {:>10} {:>12} {:>14} {:>12}",
+        "density", "points", "ms", "M points/s", "floor / this"
+    );
+    for (name, count, t) in &rows {
+        let rate = *count as f64 / t;
+        println!(
+            "{name:<24} {count:>10} {:>12.2} {:>14.1} {:>12.2}",
+            t * 1e3,
+            rate / 1e6,
+            floor_rate / rate
+        );
+    }
+    println!(
+        "{:<24} {floor_count:>10} {:>12.2} {:>14.1} {:>12}",
+        "white-noise floor",
+        floor * 1e3,
+        floor_rate / 1e6,
+        "1.00"
+    );
+
+    // Bridson (fast_poisson) at about the same number of points.
+    let n_target = rows[0].1 as f64;
+    let radius = (0.69 * tiles * tiles / n_target).sqrt();
+    let mut bridson_count = 0;
+    let bridson = median_time(runs.min(3), || {
+        let pts = Poisson2D::new()
+            .with_dimensions([tiles, tiles], radius)
+            .with_seed(1)
+            .generate();
+        bridson_count = pts.len();
+        black_box(pts);
+    });
+    let ours_rate = rows[0].1 as f64 / rows[0].2;
+    let bridson_rate = bridson_count as f64 / bridson;
+    println!(
+        "fast_poisson (Bridson)   {bridson_count:>10} {:>12.2} {:>14.1}   this is {:.0}x faster (uniform)",
+        bridson * 1e3,
+        bridson_rate / 1e6,
+        ours_rate / bridson_rate
+    );
+
+    // Cost against area and density.
+    let time_of = |r: Rect, d: f64| {
+        let mut o: Vec<Point> = Vec::with_capacity((d * r.area() * 1.1) as usize);
+        median_time(runs, || {
+            o.clear();
+            black_box(sampler.query(r, &Constant(d), &mut o).ok());
+        })
+    };
+    let half = Rect::new(DVec2::ZERO, DVec2::new(tiles / 2.0, tiles)).map_err(|e| e.to_string())?;
+    let t_half = time_of(half, d_uniform);
+    let t_full = time_of(rect, d_uniform);
+    let t_double = time_of(half, 2.0 * d_uniform);
+    let t_zero = median_time(runs, || {
+        black_box(sampler.query(rect, &Constant(0.0), &mut Vec::new()).ok());
+    });
+    println!(
+        "cost x area:    doubling the area takes {:.2}x the time",
+        t_full / t_half
+    );
+    println!(
+        "cost x density: doubling the density takes {:.2}x the time",
+        t_double / t_half
+    );
+    println!(
+        "all-zero density over the whole world: {:.3} ms ({:.4} of the uniform query)",
+        t_zero * 1e3,
+        t_zero / rows[0].2
+    );
+    Ok(())
+}
