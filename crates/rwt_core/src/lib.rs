@@ -25,7 +25,41 @@
 //! assert_eq!(set.tiles[a as usize].edges.east, set.tiles[b as usize].edges.west);
 //! ```
 //!
-//! Loading a tile set validates it and reports problems as [`tileset::TileSetError`]:
+//! ## Queries
+//!
+//! A [`query::Sampler`] produces the points of any rectangle for any [`density::Density`]
+//! (points per unit area). Each point has a stable [`query::PointId`], and the point set only
+//! grows when the density grows, so chunked, streamed or zoomed views never see a point move:
+//!
+//! ```
+//! use glam::DVec2;
+//! use rwt_core::density::{Constant, NoiseDensity};
+//! use rwt_core::query::{Rect, Sampler};
+//! use rwt_core::tileset::TileSet;
+//!
+//! let set = TileSet::embedded();
+//! let sampler = Sampler::new(&set, 7).with_tile_size(4.0); // base tiles 4 units wide
+//! let rect = Rect::new(DVec2::ZERO, DVec2::new(8.0, 8.0)).unwrap();
+//! let mut sparse = Vec::new();
+//! sampler.query(rect, &Constant(20.0), &mut sparse).unwrap();
+//! assert!((sparse.len() as f64 - 20.0 * 64.0).abs() < 40.0);
+//!
+//! // Raising the density only adds points; the old ones keep their place.
+//! let mut dense = Vec::new();
+//! sampler.query(rect, &Constant(50.0), &mut dense).unwrap();
+//! assert!(sparse.iter().all(|p| dense.iter().any(|q| q.id == p.id && q.position == p.position)));
+//!
+//! // Classes share one point set; rotations are hashed from the identity.
+//! let classes = [Constant(10.0), Constant(30.0)];
+//! let mut n = [0; 2];
+//! sampler.query_classes(rect, &classes, |p| n[p.class as usize] += 1).unwrap();
+//! assert!(n[1] > 2 * n[0]);
+//! let yaw = dense[0].id.rotation(7);
+//! assert!((0.0..std::f64::consts::TAU).contains(&yaw));
+//! # let _ = NoiseDensity::new(1, 0.1, 3, 0.5, 0.5, 10.0);
+//! ```
+//!
+//! Bad input is a typed error, never a panic; loading a tile set validates it:
 //!
 //! ```
 //! use rwt_core::tileset::{TileSet, TileSetError};

@@ -260,16 +260,41 @@ impl Sampler {
         self.points_per_tile
     }
 
-    /// An upper bound of how many points `density` yields in `rect` (refined by splitting
-    /// until it is under the budget or cannot improve).
+    /// An upper bound of how many points `density` yields in `rect`, refined best-first
+    /// (the cell with the largest bound is split in four) until it fits the budget or 4096
+    /// bounds have been evaluated. A small dense spot in a huge empty region is bounded
+    /// tightly in a few hundred steps.
     pub fn expected_upper_bound<D: Density + ?Sized>(&self, rect: &Rect, density: &D) -> f64 {
-        fn bound<D: Density + ?Sized>(r: &Rect, d: &D, depth: u32, target: f64) -> f64 {
-            let b = sanitize(d.max_over(r.min, r.max)) * r.area();
-            if b <= target || depth == 0 || b.is_infinite() {
-                return b;
+        #[derive(PartialEq)]
+        struct Cell(f64, Rect);
+        impl Eq for Cell {}
+        impl PartialOrd for Cell {
+            fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+                Some(self.cmp(other))
             }
+        }
+        impl Ord for Cell {
+            fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+                self.0.total_cmp(&other.0)
+            }
+        }
+        if rect.is_empty() {
+            return 0.0;
+        }
+        let bound = |r: &Rect| {
+            let b = sanitize(density.max_over(r.min, r.max)) * r.area();
+            if b.is_nan() { f64::INFINITY } else { b }
+        };
+        let target = self.budget as f64;
+        let first = bound(rect);
+        let mut total = first;
+        let mut heap = std::collections::BinaryHeap::from([Cell(first, *rect)]);
+        let mut evaluations = 1;
+        while total > target && evaluations < 4096 && total.is_finite() {
+            let Some(Cell(b, r)) = heap.pop() else { break };
             let c = (r.min + r.max) * 0.5;
-            let quads = [
+            total -= b;
+            for q in [
                 Rect { min: r.min, max: c },
                 Rect {
                     min: DVec2::new(c.x, r.min.y),
@@ -280,16 +305,16 @@ impl Sampler {
                     max: DVec2::new(c.x, r.max.y),
                 },
                 Rect { min: c, max: r.max },
-            ];
-            quads
-                .iter()
-                .map(|q| bound(q, d, depth - 1, target / 4.0))
-                .sum()
+            ] {
+                let qb = bound(&q);
+                total += qb;
+                evaluations += 1;
+                if qb > 0.0 {
+                    heap.push(Cell(qb, q));
+                }
+            }
         }
-        if rect.is_empty() {
-            return 0.0;
-        }
-        bound(rect, density, 7, self.budget as f64)
+        total.max(0.0)
     }
 
     fn check(&self, rect: &Rect) -> Result<(), QueryError> {
@@ -337,12 +362,7 @@ impl Sampler {
                 emit(p)
             },
         };
-        for j in j0..j1 {
-            for i in i0..i1 {
-                let t = base_tile(self.seed, self.colors, i, j);
-                visit.tile(t, 0, i, j, s);
-            }
-        }
+        visit.blocks(i0, i1, j0, j1, s);
         Ok(count)
     }
 
@@ -403,6 +423,43 @@ struct Visit<'a, D: ?Sized, F> {
 }
 
 impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
+    /// Visits the base tiles `[i0, i1) x [j0, j1)`, halving the block while it is large and
+    /// skipping blocks where the density is zero: an empty region costs one bound however
+    /// many tiles it spans.
+    fn blocks(&mut self, i0: i64, i1: i64, j0: i64, j1: i64, s: f64) {
+        const LEAF: i64 = 8;
+        if i1 <= i0 || j1 <= j0 {
+            return;
+        }
+        // Sides compared separately: their product can overflow for huge rectangles.
+        if i1 - i0 > LEAF || j1 - j0 > LEAF {
+            let block = Rect {
+                min: DVec2::new(i0 as f64 * s, j0 as f64 * s),
+                max: DVec2::new(i1 as f64 * s, j1 as f64 * s),
+            }
+            .intersect(&self.rect);
+            let bound = sanitize(self.density.max_over(block.min, block.max));
+            if block.is_empty() || bound.is_nan() || bound <= 0.0 {
+                return;
+            }
+            let (im, jm) = (i0 + (i1 - i0) / 2, j0 + (j1 - j0) / 2);
+            if i1 - i0 >= j1 - j0 {
+                self.blocks(i0, im, j0, j1, s);
+                self.blocks(im, i1, j0, j1, s);
+            } else {
+                self.blocks(i0, i1, j0, jm, s);
+                self.blocks(i0, i1, jm, j1, s);
+            }
+            return;
+        }
+        for j in j0..j1 {
+            for i in i0..i1 {
+                let t = base_tile(self.sampler.seed, self.sampler.colors, i, j);
+                self.tile(t, 0, i, j, s);
+            }
+        }
+    }
+
     fn tile(&mut self, t: u16, level: u32, ix: i64, iy: i64, s: f64) {
         let tile_rect = Rect {
             min: DVec2::new(ix as f64 * s, iy as f64 * s),
@@ -443,7 +500,9 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
             return;
         }
         let n = sampler.n;
-        let (Some(cx0), Some(cy0)) = (ix.checked_mul(n), iy.checked_mul(n)) else {
+        // Child lattice indices, with room for the cell offset: never overflow, just stop.
+        let child = |v: i64| v.checked_mul(n).filter(|c| c.checked_add(n).is_some());
+        let (Some(cx0), Some(cy0)) = (child(ix), child(iy)) else {
             return;
         };
         let child_s = s / n as f64;

@@ -266,6 +266,27 @@ fn bad_input_gets_typed_errors() {
         .unwrap();
     // Density 500 on the half of area 2 that is not NaN.
     assert!(n > 950 && n < 1_050, "{n}");
+    // A huge rectangle of zero density returns at once (it is never walked tile by tile).
+    let huge = Rect::new(DVec2::splat(-1.0e11), DVec2::splat(1.0e11)).unwrap();
+    let started = std::time::Instant::now();
+    assert_eq!(s.query(huge, &Constant(0.0), &mut Vec::new()), Ok(0));
+    let spot = from_fn(|p: DVec2| if p.length() < 1.0 { 50.0 } else { 0.0 }, 50.0);
+    let spot = rwt_core::density::FnDensity::new(
+        |p: DVec2| spot.density(p),
+        |a: DVec2, b: DVec2| {
+            if a.x < 1.0 && a.y < 1.0 && b.x > -1.0 && b.y > -1.0 {
+                50.0
+            } else {
+                0.0
+            }
+        },
+    );
+    let n = s.query(huge, &spot, &mut Vec::new()).unwrap();
+    assert!(
+        (100..220).contains(&n),
+        "{n} points in the unit disc at density 50"
+    );
+    assert!(started.elapsed().as_secs_f64() < 5.0);
     // An empty rectangle is fine.
     assert_eq!(
         s.query(square(3.0, 0.0), &Constant(100.0), &mut Vec::new()),
@@ -316,4 +337,41 @@ fn a_thin_painted_stroke_is_never_missed() {
     let x = 64.0 * 100.5 / 256.0;
     assert!(out.len() > 1_000, "{} points on the stroke", out.len());
     assert!(out.iter().all(|p| (p.position.x - x).abs() < 0.5));
+}
+
+#[test]
+fn warped_uniform_reference_follows_the_density_but_less_evenly() {
+    // Figure 3 of the paper: warping a uniform set to a density is noisier than generating
+    // the density directly. Compare both on a left-to-right ramp.
+    let side = 4.0;
+    let ramp = |p: DVec2| 400.0 * (p.x / side).clamp(0.0, 1.0);
+    let warped = reference::warped_uniform(DVec2::ZERO, side, 3_200, ramp, 64, 1);
+    let mut ours = Vec::new();
+    sampler(6)
+        .query(square(0.0, side), &from_fn(ramp, 400.0), &mut ours)
+        .unwrap();
+    let right_half =
+        |v: &[DVec2]| v.iter().filter(|p| p.x >= side / 2.0).count() as f64 / v.len() as f64;
+    let ours = positions(&ours);
+    // Both follow the ramp: three quarters of the mass lies in the right half.
+    assert!(
+        (right_half(&warped) - 0.75).abs() < 0.03,
+        "{}",
+        right_half(&warped)
+    );
+    assert!(
+        (right_half(&ours) - 0.75).abs() < 0.03,
+        "{}",
+        right_half(&ours)
+    );
+    // In the dense part, direct generation keeps points better apart than warping.
+    let dense = |v: &[DVec2]| v.iter().copied().filter(|p| p.x > 3.0).collect::<Vec<_>>();
+    let (w, o) = (dense(&warped), dense(&ours));
+    let local = |v: &[DVec2]| rho(v, v.len() as f64 / 4.0).unwrap();
+    assert!(
+        local(&o) > local(&w) + 0.1,
+        "direct {:.3} vs warped {:.3}",
+        local(&o),
+        local(&w)
+    );
 }
