@@ -158,8 +158,9 @@ fn edge_bars(c: &mut Canvas, set: &TileSet, t: usize, x: f64, y: f64, s: f64, w:
     c.rect(x + s - w, y, x + s, y + s, vc(e.east));
 }
 
-/// `rwt tileset render`: all tiles with seams, origins and edge colours (figure 4), and one
-/// tile subdivided twice with base and subdivision points (figures 6 and 7).
+/// `rwt tileset render`: all tiles with seams, origins and edge colours (figure 4); one tile
+/// subdivided twice with the edge colours of every level (figure 6); and a corner of that
+/// tile where its points sit exactly on points of its subdivision (figure 7).
 pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let set = TileSet::from_ron_bytes(&bytes).map_err(|e| e.to_string())?;
@@ -167,9 +168,9 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
     let s = 220.0;
     let gap = 12.0;
     let grid_w = cols as f64 * (s + gap) + gap;
-    let big = 2.0 * s + gap;
-    let width = grid_w + big + gap;
-    let height = grid_w.max(big + 2.0 * gap);
+    let side = (grid_w - 3.0 * gap) / 2.0;
+    let width = grid_w + side + gap;
+    let height = grid_w;
     let mut c = Canvas::new(width as u32, height as u32, [255, 255, 255]);
     for (t, tile) in set.tiles.iter().enumerate() {
         let x = gap + (t % cols) as f64 * (s + gap);
@@ -190,38 +191,56 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
             c.disc(px, py, 1.3, ORIGIN_COLOURS[tile.origins[k] as usize % 5]);
         }
     }
-    // One tile, two levels of subdivision.
-    let x0 = grid_w;
-    let y0 = gap;
+    // Figure 6: tile 0 and two levels of its subdivision, edge colours only.
     let n = set.subdivision as usize;
-    let cell2 = big / (n * n) as f64;
+    let (x0, y0) = (grid_w, gap);
     let t0 = 0usize;
+    let level2 = side / (n * n) as f64;
     for (cell, &child) in set.tiles[t0].children.iter().enumerate() {
         let (a, b) = (cell % n, cell / n);
-        for (cell2_i, &grand) in set.tiles[child as usize].children.iter().enumerate() {
-            let (a2, b2) = (cell2_i % n, cell2_i / n);
-            let gx = x0 + (a * n + a2) as f64 * cell2;
-            let gy = y0 + big - (b * n + b2 + 1) as f64 * cell2;
-            c.rect(gx, gy, gx + cell2, gy + cell2, [250, 250, 250]);
-            edge_bars(&mut c, &set, grand as usize, gx, gy, cell2, 2.0);
+        for (cell2, &grand) in set.tiles[child as usize].children.iter().enumerate() {
+            let (a2, b2) = (cell2 % n, cell2 / n);
+            let gx = x0 + (a * n + a2) as f64 * level2;
+            let gy = y0 + side - (b * n + b2 + 1) as f64 * level2;
+            edge_bars(
+                &mut c,
+                &set,
+                grand as usize,
+                gx + 1.0,
+                gy + 1.0,
+                level2 - 2.0,
+                2.0,
+            );
         }
-        let cx = x0 + a as f64 * big / n as f64;
-        let cy = y0 + big - (b + 1) as f64 * big / n as f64;
-        edge_bars(&mut c, &set, child as usize, cx, cy, big / n as f64, 4.0);
     }
-    edge_bars(&mut c, &set, t0, x0, y0, big, 7.0);
-    // Level 1 points (the subdivision of tile 0), outlined; base points filled on top.
+    for (cell, &child) in set.tiles[t0].children.iter().enumerate() {
+        let (a, b) = (cell % n, cell / n);
+        let cx = x0 + a as f64 * side / n as f64;
+        let cy = y0 + side - (b + 1) as f64 * side / n as f64;
+        edge_bars(&mut c, &set, child as usize, cx, cy, side / n as f64, 4.0);
+    }
+    edge_bars(&mut c, &set, t0, x0, y0, side, 7.0);
+    // Figure 7: the south-west quarter of tile 0, its points (filled) on its subdivision's
+    // points (rings).
+    let (x1, y1) = (grid_w, 2.0 * gap + side);
+    let zoom = side * 4.0;
+    c.rect(x1, y1, x1 + side, y1 + side, [250, 250, 250]);
     let big_n = set.points_per_tile as usize;
+    let to_px = |q: [u32; 2]| {
+        (
+            x1 + fixed_to_unit(q[0]) * zoom,
+            y1 + side - fixed_to_unit(q[1]) * zoom,
+        )
+    };
+    let inside = |(px, py): (f64, f64)| px >= x1 && px < x1 + side && py >= y1 && py < y1 + side;
     for (j, &e) in set.tiles[t0].subdivision.iter().enumerate() {
-        let q = set.subdivision_point_fixed(t0, e);
-        let (px, py) = (
-            x0 + fixed_to_unit(q[0]) * big,
-            y0 + (1.0 - fixed_to_unit(q[1])) * big,
-        );
-        if j < big_n {
-            c.disc(px, py, 2.6, [0, 0, 0]);
-        } else {
-            c.disc(px, py, 1.1, [120, 120, 120]);
+        let q = to_px(set.subdivision_point_fixed(t0, e));
+        if inside(q) {
+            c.disc(q.0, q.1, 3.2, [150, 150, 150]);
+            c.disc(q.0, q.1, 2.0, [250, 250, 250]);
+            if j < big_n {
+                c.disc(q.0, q.1, 1.6, [0, 0, 0]);
+            }
         }
     }
     c.image
