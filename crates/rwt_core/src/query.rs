@@ -160,18 +160,24 @@ pub struct Point {
     pub class: u16,
 }
 
+/// A point of a tile's cell list: its rank in the list it comes from, its index in the tile
+/// it belongs to, and its position in that tile.
 #[derive(Clone, Copy, Debug)]
-struct SubEntry {
-    cell: [u8; 2],
+struct CellPoint {
+    rank: u32,
     index: u16,
     frac: [f64; 2],
 }
 
+/// A tile prepared for queries: its points grouped by the `n x n` cells of its subdivision,
+/// each group in rank order, so that a query bounds the density per cell and only touches
+/// the cells it needs.
 #[derive(Clone, Debug)]
 struct RuntimeTile {
-    base: Vec<[f64; 2]>,
-    /// Subdivision entries of rank `N..n^2 N` (the first `N` are the base points).
-    sub: Vec<SubEntry>,
+    /// Base points by the cell they lie in (`rank` = base rank, `frac` in this tile).
+    base_cells: Vec<Vec<CellPoint>>,
+    /// Subdivision points of rank `N..n^2 N` by child cell (`index` and `frac` in the child).
+    sub_cells: Vec<Vec<CellPoint>>,
     children: Vec<u16>,
 }
 
@@ -197,26 +203,33 @@ impl Sampler {
         let tiles = set
             .tiles
             .iter()
-            .map(|t| RuntimeTile {
-                base: t
-                    .points
-                    .iter()
-                    .map(|p| [fixed_to_unit(p[0]), fixed_to_unit(p[1])])
-                    .collect(),
-                sub: t.subdivision[big_n..]
-                    .iter()
-                    .map(|&e| {
-                        let (cell, index) = ((e >> 16) as usize, (e & 0xffff) as u16);
-                        let child = &set.tiles[t.children[cell] as usize];
-                        let q = child.points[index as usize];
-                        SubEntry {
-                            cell: [(cell % n) as u8, (cell / n) as u8],
-                            index,
-                            frac: [fixed_to_unit(q[0]), fixed_to_unit(q[1])],
-                        }
-                    })
-                    .collect(),
-                children: t.children.clone(),
+            .map(|t| {
+                let mut base_cells = vec![Vec::new(); n * n];
+                for (k, p) in t.points.iter().enumerate() {
+                    let frac = [fixed_to_unit(p[0]), fixed_to_unit(p[1])];
+                    let cell = ((frac[1] * n as f64) as usize).min(n - 1) * n
+                        + ((frac[0] * n as f64) as usize).min(n - 1);
+                    base_cells[cell].push(CellPoint {
+                        rank: k as u32,
+                        index: k as u16,
+                        frac,
+                    });
+                }
+                let mut sub_cells = vec![Vec::new(); n * n];
+                for (r, &e) in t.subdivision.iter().enumerate().skip(big_n) {
+                    let (cell, index) = ((e >> 16) as usize, (e & 0xffff) as u16);
+                    let q = set.tiles[t.children[cell] as usize].points[index as usize];
+                    sub_cells[cell].push(CellPoint {
+                        rank: r as u32,
+                        index,
+                        frac: [fixed_to_unit(q[0]), fixed_to_unit(q[1])],
+                    });
+                }
+                RuntimeTile {
+                    base_cells,
+                    sub_cells,
+                    children: t.children.clone(),
+                }
             })
             .collect();
         Self {
@@ -455,12 +468,14 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
         for j in j0..j1 {
             for i in i0..i1 {
                 let t = base_tile(self.sampler.seed, self.sampler.colors, i, j);
-                self.tile(t, 0, i, j, s);
+                self.tile(t, 0, i, j, s, None);
             }
         }
     }
 
-    fn tile(&mut self, t: u16, level: u32, ix: i64, iy: i64, s: f64) {
+    /// Visits tile `t` of level `level` at lattice `(ix, iy)`, side `s`. `known` is the
+    /// density bound over its part of the query times its area, when the parent has it.
+    fn tile(&mut self, t: u16, level: u32, ix: i64, iy: i64, s: f64, known: Option<f64>) {
         let tile_rect = Rect {
             min: DVec2::new(ix as f64 * s, iy as f64 * s),
             max: DVec2::new((ix + 1) as f64 * s, (iy + 1) as f64 * s),
@@ -470,70 +485,110 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
             return;
         }
         let area = s * s;
-        let limit = sanitize(self.density.max_over(clip.min, clip.max)) * area;
+        let limit =
+            known.unwrap_or_else(|| sanitize(self.density.max_over(clip.min, clip.max)) * area);
         if limit.is_nan() || limit <= 0.0 {
             return;
         }
         let sampler = self.sampler;
         let tile = &sampler.tiles[t as usize];
-        let big_n = sampler.points_per_tile;
+        let big_n = sampler.points_per_tile as f64;
+        let n = sampler.n;
+        let cells = (n * n) as usize;
+        let child_s = s / n as f64;
+        // Per-cell bounds pay off once the tile asks for more than a few points per cell, or
+        // when it is only partly inside the query; otherwise the tile's bound serves all.
+        let mut cell_limit = [limit; 64];
+        if limit > 4.0 * cells as f64 || clip != tile_rect {
+            for (cell, slot) in cell_limit[..cells].iter_mut().enumerate() {
+                let (a, b) = ((cell as i64 % n) as f64, (cell as i64 / n) as f64);
+                let cell_rect = Rect {
+                    min: tile_rect.min + DVec2::new(a, b) * child_s,
+                    max: tile_rect.min + DVec2::new(a + 1.0, b + 1.0) * child_s,
+                }
+                .intersect(&self.rect);
+                *slot = if cell_rect.is_empty() {
+                    0.0
+                } else {
+                    (sanitize(self.density.max_over(cell_rect.min, cell_rect.max)) * area)
+                        .min(limit)
+                };
+            }
+        }
         if level == 0 {
-            let count = (limit.ceil().min(big_n as f64)) as usize;
-            for (k, f) in tile.base[..count].iter().enumerate() {
-                let p = DVec2::new((ix as f64 + f[0]) * s, (iy as f64 + f[1]) * s);
-                if self.rect.contains(p) && sanitize(self.density.density(p)) * area > k as f64 {
-                    (self.emit)(Point {
-                        position: p,
-                        id: PointId {
-                            level: 0,
-                            x: ix,
-                            y: iy,
-                            index: k as u16,
-                        },
-                        threshold: k as f64 / area,
-                        class: 0,
-                    });
+            for (cell, points) in tile.base_cells.iter().enumerate() {
+                let lim = cell_limit[cell];
+                for cp in points.iter().take_while(|cp| (cp.rank as f64) < lim) {
+                    let p = DVec2::new((ix as f64 + cp.frac[0]) * s, (iy as f64 + cp.frac[1]) * s);
+                    if self.rect.contains(p)
+                        && sanitize(self.density.density(p)) * area > cp.rank as f64
+                    {
+                        (self.emit)(Point {
+                            position: p,
+                            id: PointId {
+                                level: 0,
+                                x: ix,
+                                y: iy,
+                                index: cp.index,
+                            },
+                            threshold: cp.rank as f64 / area,
+                            class: 0,
+                        });
+                    }
                 }
             }
         }
-        if limit <= big_n as f64 || level >= MAX_LEVEL {
+        if limit <= big_n || level >= MAX_LEVEL {
             return;
         }
-        let n = sampler.n;
         // Child lattice indices, with room for the cell offset: never overflow, just stop.
         let child = |v: i64| v.checked_mul(n).filter(|c| c.checked_add(n).is_some());
         let (Some(cx0), Some(cy0)) = (child(ix), child(iy)) else {
             return;
         };
-        let child_s = s / n as f64;
-        let end = (limit.ceil().min(sampler.sub_len as f64)) as usize - big_n;
-        for (r, e) in tile.sub[..end].iter().enumerate() {
-            let rank = (big_n + r) as f64;
-            let (cx, cy) = (cx0 + e.cell[0] as i64, cy0 + e.cell[1] as i64);
-            let p = DVec2::new(
-                (cx as f64 + e.frac[0]) * child_s,
-                (cy as f64 + e.frac[1]) * child_s,
-            );
-            if self.rect.contains(p) && sanitize(self.density.density(p)) * area > rank {
-                (self.emit)(Point {
-                    position: p,
-                    id: PointId {
-                        level: level as u8 + 1,
-                        x: cx,
-                        y: cy,
-                        index: e.index,
-                    },
-                    threshold: rank / area,
-                    class: 0,
-                });
+        let full = sampler.sub_len as f64;
+        for (cell, points) in tile.sub_cells.iter().enumerate() {
+            let lim = cell_limit[cell];
+            if lim <= big_n {
+                continue;
+            }
+            let (cx, cy) = (cx0 + cell as i64 % n, cy0 + cell as i64 / n);
+            for cp in points.iter().take_while(|cp| (cp.rank as f64) < lim) {
+                let p = DVec2::new(
+                    (cx as f64 + cp.frac[0]) * child_s,
+                    (cy as f64 + cp.frac[1]) * child_s,
+                );
+                if self.rect.contains(p)
+                    && sanitize(self.density.density(p)) * area > cp.rank as f64
+                {
+                    (self.emit)(Point {
+                        position: p,
+                        id: PointId {
+                            level: level as u8 + 1,
+                            x: cx,
+                            y: cy,
+                            index: cp.index,
+                        },
+                        threshold: cp.rank as f64 / area,
+                        class: 0,
+                    });
+                }
             }
         }
-        if limit <= sampler.sub_len as f64 {
-            return;
-        }
-        for (cell, &child) in tile.children.iter().enumerate() {
-            let (a, b) = (cell as i64 % n, cell as i64 / n);
-            self.tile(child, level + 1, cx0 + a, cy0 + b, child_s);
+        for (cell, &child_tile) in tile.children.iter().enumerate() {
+            let lim = cell_limit[cell];
+            if lim > full {
+                let (cx, cy) = (cx0 + cell as i64 % n, cy0 + cell as i64 / n);
+                // The cell's bound in the child's own area units.
+                self.tile(
+                    child_tile,
+                    level + 1,
+                    cx,
+                    cy,
+                    child_s,
+                    Some(lim / (n * n) as f64),
+                );
+            }
         }
     }
 }

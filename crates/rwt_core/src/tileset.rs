@@ -144,9 +144,9 @@ impl TileSet {
         if !(1..=8).contains(&k) {
             return Err(TileSetError::Header(format!("colors {k} not in 1..=8")));
         }
-        if !n.is_power_of_two() || !(2..=16).contains(&n) {
+        if !n.is_power_of_two() || !(2..=8).contains(&n) {
             return Err(TileSetError::Header(format!(
-                "subdivision {n} must be a power of two in 2..=16"
+                "subdivision {n} must be a power of two in 2..=8"
             )));
         }
         if big_n == 0 || big_n > 65_536 {
