@@ -77,6 +77,7 @@ pub mod relaxation;
 pub mod rng;
 pub mod seam;
 pub mod source_tile;
+pub mod streaming;
 pub mod subdivision;
 pub mod tileset;
 pub mod tiling;

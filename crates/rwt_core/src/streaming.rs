@@ -1,0 +1,361 @@
+//! Chunk streaming around viewers, engine-agnostic: which chunks to load and unload, and
+//! which instances a re-query adds or removes. The Bevy plugin turns cameras into
+//! [`Viewer`]s and the answers into entities; all decisions live here, where they are
+//! tested without an engine.
+//!
+//! Chunks are squares of `chunk_size` world units on the ground plane (x, z in a 3-D world
+//! map to this plane's x, y). A chunk owns the points whose position falls inside it,
+//! half-open, so neighbouring chunks never share a point.
+
+use crate::query::{Point, PointId, Rect};
+use glam::DVec2;
+use std::collections::{HashMap, HashSet};
+
+/// Integer coordinates of a chunk: it covers `[x, x + 1) * size` by `[y, y + 1) * size`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ChunkCoord {
+    /// Column.
+    pub x: i64,
+    /// Row.
+    pub y: i64,
+}
+
+impl ChunkCoord {
+    /// The chunk's rectangle.
+    pub fn rect(&self, size: f64) -> Rect {
+        Rect {
+            min: DVec2::new(self.x as f64 * size, self.y as f64 * size),
+            max: DVec2::new((self.x + 1) as f64 * size, (self.y + 1) as f64 * size),
+        }
+    }
+
+    /// Distance from `p` to the nearest point of the chunk (0 inside).
+    pub fn distance(&self, size: f64, p: DVec2) -> f64 {
+        let r = self.rect(size);
+        p.clamp(r.min, r.max).distance(p)
+    }
+}
+
+/// What a viewer sees of the ground: a position and, optionally, the ground-plane footprint
+/// of its view frustum (a convex polygon). Chunks are loaded within the load distance and,
+/// when a footprint is given, only where they overlap it (or lie close to the viewer, so
+/// turning around never shows an empty ground).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Viewer {
+    /// Position on the ground plane.
+    pub position: DVec2,
+    /// Convex ground footprint of the view, counter-clockwise, or empty for all directions.
+    pub footprint: Vec<DVec2>,
+}
+
+impl Viewer {
+    /// A viewer that sees in every direction.
+    pub fn omni(position: DVec2) -> Self {
+        Self {
+            position,
+            footprint: Vec::new(),
+        }
+    }
+}
+
+/// Distances that decide what is loaded. `unload_distance > load_distance` gives hysteresis:
+/// a viewer moving back and forth across the load boundary does not reload chunks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StreamingConfig {
+    /// Chunk side in world units.
+    pub chunk_size: f64,
+    /// Chunks closer than this to a viewer (and in its footprint) are loaded.
+    pub load_distance: f64,
+    /// Loaded chunks farther than this from every viewer are unloaded.
+    pub unload_distance: f64,
+    /// Chunks this close are loaded whatever the footprint.
+    pub near_distance: f64,
+}
+
+impl Default for StreamingConfig {
+    fn default() -> Self {
+        Self {
+            chunk_size: 32.0,
+            load_distance: 256.0,
+            unload_distance: 320.0,
+            near_distance: 48.0,
+        }
+    }
+}
+
+/// Chunks to start loading and to unload after an update.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ChunkChanges {
+    /// Newly wanted chunks, nearest to a viewer first.
+    pub load: Vec<ChunkCoord>,
+    /// Chunks no viewer needs any more.
+    pub unload: Vec<ChunkCoord>,
+}
+
+/// Tracks the loaded chunks of one layer.
+#[derive(Clone, Debug, Default)]
+pub struct ChunkSet {
+    loaded: HashSet<ChunkCoord>,
+}
+
+fn overlaps_convex(rect: &Rect, polygon: &[DVec2]) -> bool {
+    if polygon.len() < 3 {
+        return true;
+    }
+    // Separating axis test: the rectangle's axes and the polygon's edge normals.
+    let corners = [
+        rect.min,
+        DVec2::new(rect.max.x, rect.min.y),
+        rect.max,
+        DVec2::new(rect.min.x, rect.max.y),
+    ];
+    let (mut lo, mut hi) = (polygon[0], polygon[0]);
+    for &p in polygon {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    if hi.x < rect.min.x || lo.x > rect.max.x || hi.y < rect.min.y || lo.y > rect.max.y {
+        return false;
+    }
+    for i in 0..polygon.len() {
+        let a = polygon[i];
+        let b = polygon[(i + 1) % polygon.len()];
+        let normal = DVec2::new(b.y - a.y, a.x - b.x);
+        let limit = normal.dot(a);
+        // Outward normal for a counter-clockwise polygon: all corners outside means apart.
+        if corners.iter().all(|c| normal.dot(*c) > limit) {
+            return false;
+        }
+    }
+    true
+}
+
+impl ChunkSet {
+    /// Chunks currently loaded.
+    pub fn loaded(&self) -> &HashSet<ChunkCoord> {
+        &self.loaded
+    }
+
+    /// Updates the loaded set for `viewers`; returns what changed. Loads are sorted by
+    /// distance to the nearest viewer so the nearest ground fills first.
+    pub fn update(&mut self, config: &StreamingConfig, viewers: &[Viewer]) -> ChunkChanges {
+        let size = config.chunk_size;
+        let mut wanted: HashMap<ChunkCoord, f64> = HashMap::new();
+        if size.is_finite() && size > 0.0 {
+            for v in viewers {
+                if !v.position.is_finite() {
+                    continue;
+                }
+                let reach = config.load_distance.max(0.0);
+                let (x0, x1) = (
+                    ((v.position.x - reach) / size).floor() as i64,
+                    ((v.position.x + reach) / size).floor() as i64,
+                );
+                let (y0, y1) = (
+                    ((v.position.y - reach) / size).floor() as i64,
+                    ((v.position.y + reach) / size).floor() as i64,
+                );
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        let c = ChunkCoord { x, y };
+                        let d = c.distance(size, v.position);
+                        if d > reach {
+                            continue;
+                        }
+                        if d > config.near_distance && !overlaps_convex(&c.rect(size), &v.footprint)
+                        {
+                            continue;
+                        }
+                        let slot = wanted.entry(c).or_insert(f64::INFINITY);
+                        *slot = slot.min(d);
+                    }
+                }
+            }
+        }
+        let mut load: Vec<(f64, ChunkCoord)> = wanted
+            .iter()
+            .filter(|(c, _)| !self.loaded.contains(c))
+            .map(|(c, d)| (*d, *c))
+            .collect();
+        load.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let keep = |c: &ChunkCoord| {
+            wanted.contains_key(c)
+                || viewers.iter().any(|v| {
+                    v.position.is_finite() && c.distance(size, v.position) <= config.unload_distance
+                })
+        };
+        let mut unload: Vec<ChunkCoord> =
+            self.loaded.iter().filter(|c| !keep(c)).copied().collect();
+        unload.sort();
+        for c in &unload {
+            self.loaded.remove(c);
+        }
+        for (_, c) in &load {
+            self.loaded.insert(*c);
+        }
+        ChunkChanges {
+            load: load.into_iter().map(|(_, c)| c).collect(),
+            unload,
+        }
+    }
+}
+
+/// Instances a re-query adds and removes, by identity: existing instances never move.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InstanceDiff {
+    /// Points that are new.
+    pub added: Vec<Point>,
+    /// Identities that are gone.
+    pub removed: Vec<PointId>,
+}
+
+/// Compares the identities a chunk shows with a fresh query result.
+pub fn diff_instances<'a>(
+    current: impl IntoIterator<Item = &'a PointId>,
+    fresh: &[Point],
+) -> InstanceDiff {
+    let current: HashSet<PointId> = current.into_iter().copied().collect();
+    let fresh_ids: HashSet<PointId> = fresh.iter().map(|p| p.id).collect();
+    let mut removed: Vec<PointId> = current.difference(&fresh_ids).copied().collect();
+    removed.sort();
+    InstanceDiff {
+        added: fresh
+            .iter()
+            .filter(|p| !current.contains(&p.id))
+            .copied()
+            .collect(),
+        removed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::density::{Constant, DistanceFalloff};
+    use crate::query::Sampler;
+    use crate::tileset::TileSet;
+
+    fn config() -> StreamingConfig {
+        StreamingConfig {
+            chunk_size: 10.0,
+            load_distance: 30.0,
+            unload_distance: 40.0,
+            near_distance: 12.0,
+        }
+    }
+
+    #[test]
+    fn loads_around_the_viewer_and_unloads_with_hysteresis() {
+        let mut set = ChunkSet::default();
+        let c = config();
+        let first = set.update(&c, &[Viewer::omni(DVec2::ZERO)]);
+        assert!(first.unload.is_empty());
+        assert!(
+            first.load.len() > 20 && first.load.len() < 50,
+            "{}",
+            first.load.len()
+        );
+        assert!(
+            first.load[0].distance(10.0, DVec2::ZERO) == 0.0,
+            "nearest first"
+        );
+        // A small step loads a few chunks and unloads none (hysteresis).
+        let step = set.update(&c, &[Viewer::omni(DVec2::new(6.0, 0.0))]);
+        assert!(step.unload.is_empty());
+        // Stepping back loads nothing new and still unloads nothing.
+        let back = set.update(&c, &[Viewer::omni(DVec2::ZERO)]);
+        assert!(back.load.is_empty() && back.unload.is_empty());
+        // Far away: everything old goes.
+        let far = set.update(&c, &[Viewer::omni(DVec2::new(500.0, 0.0))]);
+        assert_eq!(far.unload.len(), first.load.len() + step.load.len());
+        assert!(
+            set.loaded()
+                .iter()
+                .all(|ch| ch.distance(10.0, DVec2::new(500.0, 0.0)) <= 30.0)
+        );
+    }
+
+    #[test]
+    fn footprint_limits_loading_except_near_the_viewer() {
+        let c = config();
+        // Looking towards +x: a wedge.
+        let wedge = vec![DVec2::ZERO, DVec2::new(30.0, -10.0), DVec2::new(30.0, 10.0)];
+        let mut set = ChunkSet::default();
+        let changes = set.update(
+            &c,
+            &[Viewer {
+                position: DVec2::ZERO,
+                footprint: wedge,
+            }],
+        );
+        assert!(
+            changes.load.iter().all(|ch| ch.x >= -2),
+            "{:?}",
+            changes.load
+        );
+        assert!(changes.load.iter().any(|ch| ch.x == 2));
+        assert!(
+            changes.load.iter().any(|ch| ch.x == -1),
+            "near chunks load behind the viewer"
+        );
+        assert!(!changes.load.iter().any(|ch| ch.x == -3));
+    }
+
+    #[test]
+    fn several_viewers_and_bad_positions() {
+        let c = config();
+        let mut set = ChunkSet::default();
+        let changes = set.update(
+            &c,
+            &[
+                Viewer::omni(DVec2::ZERO),
+                Viewer::omni(DVec2::new(200.0, 0.0)),
+                Viewer::omni(DVec2::NAN),
+            ],
+        );
+        assert!(changes.load.iter().any(|ch| ch.x == 20));
+        assert!(changes.load.iter().any(|ch| ch.x == 0));
+        let bad = StreamingConfig {
+            chunk_size: 0.0,
+            ..c
+        };
+        assert!(
+            ChunkSet::default()
+                .update(&bad, &[Viewer::omni(DVec2::ZERO)])
+                .load
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn approaching_adds_instances_and_moves_none() {
+        // Level of detail by density: far, the chunk holds few instances; nearer, more, and
+        // the diff only adds.
+        let set = TileSet::embedded();
+        let sampler = Sampler::new(&set, 3).with_tile_size(4.0);
+        let chunk = ChunkCoord { x: 2, y: 0 };
+        let rect = chunk.rect(10.0);
+        let lod = |viewer: DVec2| DistanceFalloff {
+            inner: Constant(20.0),
+            centre: viewer,
+            near: 5.0,
+            far: 60.0,
+        };
+        let mut far = Vec::new();
+        sampler
+            .query(rect, &lod(DVec2::new(-30.0, 0.0)), &mut far)
+            .unwrap();
+        let mut near = Vec::new();
+        sampler
+            .query(rect, &lod(DVec2::new(10.0, 0.0)), &mut near)
+            .unwrap();
+        let d = diff_instances(far.iter().map(|p| &p.id), &near);
+        assert!(d.removed.is_empty());
+        assert_eq!(d.added.len(), near.len() - far.len());
+        assert!(far.len() > 50 && near.len() > far.len() + 500);
+        // Going back removes exactly the added ones.
+        let back = diff_instances(near.iter().map(|p| &p.id), &far);
+        assert!(back.added.is_empty());
+        assert_eq!(back.removed.len(), d.added.len());
+    }
+}
