@@ -243,19 +243,17 @@ impl ImageDensity {
     // Always inlined: in a query's inner loop this lets the image fields stay in registers.
     #[inline(always)]
     pub fn value(&self, p: DVec2) -> f64 {
-        // Texel coordinates with texel centres at integers, y downwards.
-        let fx = (p.x - self.origin.x) * self.texels_per_unit.x - 0.5;
-        let fy = (self.origin.y + self.size.y - p.y) * self.texels_per_unit.y - 0.5;
-        if !(fx >= -0.5
-            && fy >= -0.5
-            && fx < self.width as f64 - 0.5
-            && fy < self.height as f64 - 0.5)
-        {
+        // Texel coordinates with texel centres at integers, y downwards; f32 after one f64
+        // subtraction, which keeps far-away worlds exact to well under a texel.
+        let fx = ((p.x - self.origin.x) * self.texels_per_unit.x) as f32 - 0.5;
+        let fy = ((self.origin.y + self.size.y - p.y) * self.texels_per_unit.y) as f32 - 0.5;
+        let (w, h) = (self.width as f32, self.height as f32);
+        if !(fx >= -0.5 && fy >= -0.5 && fx < w - 0.5 && fy < h - 0.5) {
             return 0.0;
         }
         let (fx, fy) = (fx.max(0.0), fy.max(0.0));
         let (x0, y0) = (fx as usize, fy as usize);
-        let (ax, ay) = ((fx - x0 as f64) as f32, (fy - y0 as f64) as f32);
+        let (ax, ay) = (fx - x0 as f32, fy - y0 as f32);
         let stride = self.width + 1;
         let i = y0 * stride + x0;
         let (top, bottom) = (
