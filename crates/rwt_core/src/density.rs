@@ -38,6 +38,15 @@ impl<D: Density + ?Sized> Density for Box<D> {
     }
 }
 
+impl<D: Density + ?Sized> Density for std::sync::Arc<D> {
+    fn density(&self, p: DVec2) -> f64 {
+        (**self).density(p)
+    }
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        (**self).max_over(min, max)
+    }
+}
+
 /// The same density everywhere.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Constant(pub f64);

@@ -1,0 +1,233 @@
+//! Scatter layers: what to place, where, how densely, and how it looks.
+
+use bevy::prelude::*;
+use rwt_core::density::{Constant, Density, NoiseDensity};
+use rwt_core::streaming::StreamingConfig;
+use std::sync::Arc;
+
+/// A density of a layer or class, in instances per square world unit on the ground (x, z).
+#[derive(Clone)]
+pub enum LayerDensity {
+    /// The same everywhere.
+    Constant(f64),
+    /// Fractal noise: `scale * max(0, base + amplitude * fbm(p * frequency))`.
+    Noise {
+        /// Noise seed.
+        seed: u32,
+        /// Cycles per world unit.
+        frequency: f64,
+        /// Octaves (1..=16).
+        octaves: usize,
+        /// Offset of the noise value.
+        base: f64,
+        /// Gain of the noise value.
+        amplitude: f64,
+        /// Instances per square unit at value 1.
+        scale: f64,
+    },
+    /// A painted map: the image's luminance (0..1) over the ground rectangle `min..min + size`
+    /// (x, z), times `scale`. Repainting the image re-queries the chunks it covers.
+    Image {
+        /// The map.
+        image: Handle<Image>,
+        /// Ground position of the image's bottom-left corner (x, z).
+        min: Vec2,
+        /// Ground size of the image (x, z).
+        size: Vec2,
+        /// Instances per square unit where the image is white.
+        scale: f64,
+    },
+    /// Any density of `rwt_core`.
+    Custom(Arc<dyn Density + Send + Sync>),
+}
+
+impl std::fmt::Debug for LayerDensity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LayerDensity::Constant(v) => write!(f, "Constant({v})"),
+            LayerDensity::Noise {
+                scale, frequency, ..
+            } => write!(f, "Noise {{ scale: {scale}, frequency: {frequency}, .. }}"),
+            LayerDensity::Image { image, scale, .. } => {
+                write!(f, "Image {{ {image:?}, scale: {scale}, .. }}")
+            }
+            LayerDensity::Custom(_) => write!(f, "Custom(..)"),
+        }
+    }
+}
+
+impl LayerDensity {
+    /// The image this density reads, if any.
+    pub fn image(&self) -> Option<&Handle<Image>> {
+        match self {
+            LayerDensity::Image { image, .. } => Some(image),
+            _ => None,
+        }
+    }
+
+    /// A thread-safe snapshot for generation tasks; `None` while a painted map is loading.
+    pub fn resolve(&self, images: &Assets<Image>) -> Option<Arc<dyn Density + Send + Sync>> {
+        Some(match self {
+            LayerDensity::Constant(v) => Arc::new(Constant(*v)),
+            LayerDensity::Noise {
+                seed,
+                frequency,
+                octaves,
+                base,
+                amplitude,
+                scale,
+            } => Arc::new(NoiseDensity::new(
+                *seed, *frequency, *octaves, *base, *amplitude, *scale,
+            )),
+            LayerDensity::Image {
+                image,
+                min,
+                size,
+                scale,
+            } => {
+                let img = images.get(image)?;
+                Arc::new(crate::image_density::from_bevy_image(
+                    img, *min, *size, *scale,
+                )?)
+            }
+            LayerDensity::Custom(d) => d.clone(),
+        })
+    }
+}
+
+/// One kind of instance in a layer: its own density (the layer's classes share one blue-noise
+/// point set, paper section 6.3) and how it looks.
+#[derive(Clone, Debug)]
+pub struct ScatterClass {
+    /// Where and how densely this class grows.
+    pub density: LayerDensity,
+    /// Mesh shared by every instance (Bevy batches them).
+    pub mesh: Handle<Mesh>,
+    /// Material shared by every instance.
+    pub material: Handle<StandardMaterial>,
+    /// Base scale of the instances.
+    pub scale: f32,
+    /// Random scale variation, hashed per instance: scale in `scale * (1 +- variation)`.
+    pub scale_variation: f32,
+}
+
+impl ScatterClass {
+    /// A class with unit scale and 20 % variation.
+    pub fn new(
+        density: LayerDensity,
+        mesh: Handle<Mesh>,
+        material: Handle<StandardMaterial>,
+    ) -> Self {
+        Self {
+            density,
+            mesh,
+            material,
+            scale: 1.0,
+            scale_variation: 0.2,
+        }
+    }
+}
+
+/// Ground height under an instance.
+#[derive(Clone)]
+pub enum HeightSource {
+    /// Flat ground at this height.
+    Constant(f32),
+    /// A function of the ground position (x, z).
+    Function(Arc<dyn Fn(Vec2) -> f32 + Send + Sync>),
+}
+
+impl std::fmt::Debug for HeightSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            HeightSource::Constant(h) => write!(f, "Constant({h})"),
+            HeightSource::Function(_) => write!(f, "Function(..)"),
+        }
+    }
+}
+
+impl HeightSource {
+    /// Height at a ground position.
+    pub fn at(&self, p: Vec2) -> f32 {
+        match self {
+            HeightSource::Constant(h) => *h,
+            HeightSource::Function(f) => f(p),
+        }
+    }
+}
+
+/// A scatter layer: instances of its classes, streamed around every [`crate::RwtViewer`].
+/// Removing the component (or despawning its entity) despawns all its instances.
+#[derive(Component, Clone, Debug)]
+#[require(Transform, Visibility)]
+pub struct ScatterLayer {
+    /// Classes sharing the layer's point set.
+    pub classes: Vec<ScatterClass>,
+    /// Width of a base Wang tile in world units. Aim for at least ~100 instances per tile
+    /// where the layer is dense.
+    pub tile_size: f64,
+    /// Tiling seed: different seeds give unrelated layouts.
+    pub seed: u64,
+    /// Chunk size and load / unload distances.
+    pub streaming: StreamingConfig,
+    /// Level of detail by density: full density up to `near`, fading to none at `far` from
+    /// the nearest viewer. Approaching adds instances between the existing ones.
+    pub falloff: Option<(f64, f64)>,
+    /// Ground height.
+    pub height: HeightSource,
+}
+
+impl ScatterLayer {
+    /// A layer with one class, tiles of 8 units, default streaming and flat ground.
+    pub fn new(classes: Vec<ScatterClass>) -> Self {
+        Self {
+            classes,
+            tile_size: 8.0,
+            seed: 0,
+            streaming: StreamingConfig::default(),
+            falloff: None,
+            height: HeightSource::Constant(0.0),
+        }
+    }
+
+    /// Sets the tile size.
+    pub fn with_tile_size(mut self, size: f64) -> Self {
+        self.tile_size = size;
+        self
+    }
+
+    /// Sets the seed.
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Sets the streaming distances.
+    pub fn with_streaming(mut self, streaming: StreamingConfig) -> Self {
+        self.streaming = streaming;
+        self
+    }
+
+    /// Sets the density fall-off with distance.
+    pub fn with_falloff(mut self, near: f64, far: f64) -> Self {
+        self.falloff = Some((near, far));
+        self
+    }
+
+    /// Sets the ground height.
+    pub fn with_height(mut self, height: HeightSource) -> Self {
+        self.height = height;
+        self
+    }
+}
+
+/// Marks an instance spawned by a layer.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ScatterInstance {
+    /// The layer entity.
+    pub layer: Entity,
+    /// Stable identity of the point the instance stands on.
+    pub id: rwt_core::query::PointId,
+    /// Class index in the layer.
+    pub class: u16,
+}

@@ -1,0 +1,284 @@
+//! Headless tests of streaming: `MinimalPlugins` plus assets, no renderer.
+
+use super::*;
+use crate::layer::{LayerDensity, ScatterClass};
+use crate::{RwtPlugin, RwtStats};
+use bevy::asset::AssetPlugin;
+use rwt_core::streaming::StreamingConfig;
+use std::collections::HashMap;
+use std::time::Duration;
+
+fn create_app() -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        RwtPlugin::default().with_spawn_budget(50_000),
+    ));
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// Runs frames until nothing is pending or queued (or `max` frames).
+fn tick_app(app: &mut App, max: usize) {
+    for _ in 0..max {
+        app.update();
+        let s = app.world().resource::<RwtStats>();
+        if s.pending_tasks == 0 && s.queued_spawns == 0 {
+            app.update();
+            let s = app.world().resource::<RwtStats>();
+            if s.pending_tasks == 0 && s.queued_spawns == 0 {
+                return;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    panic!("streaming did not settle in {max} frames");
+}
+
+fn streaming() -> StreamingConfig {
+    StreamingConfig {
+        chunk_size: 16.0,
+        load_distance: 48.0,
+        unload_distance: 64.0,
+        near_distance: 20.0,
+    }
+}
+
+fn layer(density: LayerDensity) -> ScatterLayer {
+    let class = ScatterClass::new(density, Handle::default(), Handle::default());
+    ScatterLayer::new(vec![class])
+        .with_tile_size(8.0)
+        .with_seed(3)
+        .with_streaming(streaming())
+}
+
+fn spawn_viewer(app: &mut App, at: Vec3) -> Entity {
+    app.world_mut()
+        .spawn((
+            RwtViewer { half_angle: None },
+            Transform::from_translation(at),
+            GlobalTransform::from_translation(at),
+        ))
+        .id()
+}
+
+fn move_viewer(app: &mut App, viewer: Entity, at: Vec3) {
+    let mut e = app.world_mut().entity_mut(viewer);
+    *e.get_mut::<Transform>().unwrap() = Transform::from_translation(at);
+    *e.get_mut::<GlobalTransform>().unwrap() = GlobalTransform::from_translation(at);
+}
+
+fn instances(app: &mut App) -> HashMap<rwt_core::query::PointId, Vec3> {
+    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut out = HashMap::new();
+    for (i, t) in q.iter(app.world()) {
+        assert!(
+            out.insert(i.id, t.translation).is_none(),
+            "two live instances share {:?}",
+            i.id
+        );
+    }
+    out
+}
+
+#[test]
+fn streams_around_a_viewer_without_duplicates() {
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    app.world_mut().spawn(layer(LayerDensity::Constant(0.5)));
+    tick_app(&mut app, 2_000);
+    let live = instances(&mut app);
+    let stats = app.world().resource::<RwtStats>().clone();
+    assert_eq!(live.len(), stats.live_instances);
+    // About 0.5 per square unit over the loaded chunks.
+    let area = stats.loaded_chunks as f64 * 16.0 * 16.0;
+    assert!(
+        (live.len() as f64 - 0.5 * area).abs() < 0.05 * 0.5 * area,
+        "{} vs {}",
+        live.len(),
+        0.5 * area
+    );
+    // Every instance lies in a loaded chunk near the viewer, on the ground.
+    assert!(
+        live.values()
+            .all(|p| p.y == 0.0 && Vec2::new(p.x, p.z).length() < 48.0 + 23.0)
+    );
+}
+
+#[test]
+fn a_round_trip_returns_to_the_same_instances_and_stays_bounded() {
+    let mut app = create_app();
+    let viewer = spawn_viewer(&mut app, Vec3::ZERO);
+    app.world_mut().spawn(layer(LayerDensity::Constant(0.3)));
+    tick_app(&mut app, 2_000);
+    let start = instances(&mut app);
+    let mut most = 0;
+    for i in 0..=40 {
+        let x = i as f32 * 10.0;
+        move_viewer(&mut app, viewer, Vec3::new(x, 0.0, x * 0.5));
+        tick_app(&mut app, 2_000);
+        most = most.max(instances(&mut app).len());
+    }
+    for i in (0..=40).rev() {
+        let x = i as f32 * 10.0;
+        move_viewer(&mut app, viewer, Vec3::new(x, 0.0, x * 0.5));
+        tick_app(&mut app, 2_000);
+    }
+    let end = instances(&mut app);
+    // Back at the start, everything within the load distance is exactly as it was; chunks
+    // kept by hysteresis (between load and unload distance) may remain from the trip.
+    assert!(
+        start.iter().all(|(id, p)| end.get(id) == Some(p)),
+        "instances moved or vanished"
+    );
+    let extra: Vec<_> = end
+        .iter()
+        .filter(|(id, _)| !start.contains_key(id))
+        .collect();
+    let within = |p: &Vec3, d: f32| Vec2::new(p.x, p.z).length() < d;
+    assert!(
+        extra
+            .iter()
+            .all(|(_, p)| !within(p, 48.0 - 23.0) && within(p, 64.0 + 23.0)),
+        "{extra:?}"
+    );
+    // Bounded: never more than the unload disc can hold.
+    let cap = 0.3 * std::f64::consts::PI * (64.0f64 + 23.0).powi(2);
+    assert!((most as f64) < cap, "{most} live instances");
+}
+
+#[test]
+fn two_runs_give_the_same_world() {
+    let run = || {
+        let mut app = create_app();
+        let viewer = spawn_viewer(&mut app, Vec3::ZERO);
+        app.world_mut().spawn(layer(LayerDensity::Noise {
+            seed: 2,
+            frequency: 0.05,
+            octaves: 3,
+            base: 0.5,
+            amplitude: 0.5,
+            scale: 0.8,
+        }));
+        for i in 0..10 {
+            move_viewer(&mut app, viewer, Vec3::new(i as f32 * 7.0, 0.0, 0.0));
+            tick_app(&mut app, 2_000);
+        }
+        let mut v: Vec<_> = instances(&mut app)
+            .into_iter()
+            .map(|(id, p)| (id, p.x.to_bits(), p.z.to_bits()))
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(run(), run());
+}
+
+#[test]
+fn approaching_adds_instances_and_moves_none() {
+    let mut app = create_app();
+    let viewer = spawn_viewer(&mut app, Vec3::new(-150.0, 0.0, 0.0));
+    let mut l = layer(LayerDensity::Constant(0.6)).with_falloff(10.0, 120.0);
+    l.streaming.load_distance = 160.0;
+    l.streaming.unload_distance = 200.0;
+    app.world_mut().spawn(l);
+    tick_app(&mut app, 4_000);
+    let far = instances(&mut app);
+    let near_origin = |m: &HashMap<_, Vec3>| {
+        m.values()
+            .filter(|p| Vec2::new(p.x, p.z).length() < 8.0)
+            .count()
+    };
+    move_viewer(&mut app, viewer, Vec3::new(-20.0, 0.0, 0.0));
+    tick_app(&mut app, 4_000);
+    let near = instances(&mut app);
+    assert!(
+        near_origin(&near) > near_origin(&far) + 10,
+        "{} -> {}",
+        near_origin(&far),
+        near_origin(&near)
+    );
+    for (id, p) in &far {
+        if Vec2::new(p.x, p.z).length() < 30.0 {
+            assert_eq!(
+                near.get(id),
+                Some(p),
+                "an instance near the origin moved or vanished"
+            );
+        }
+    }
+}
+
+#[test]
+fn removing_a_layer_despawns_everything() {
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let l = app
+        .world_mut()
+        .spawn(layer(LayerDensity::Constant(0.4)))
+        .id();
+    tick_app(&mut app, 2_000);
+    assert!(!instances(&mut app).is_empty());
+    app.world_mut().entity_mut(l).remove::<ScatterLayer>();
+    app.update();
+    app.update();
+    assert!(instances(&mut app).is_empty());
+}
+
+#[test]
+fn painting_changes_only_the_painted_region() {
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let size = 64u32;
+    let image = Image::new_fill(
+        Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        &[128, 128, 128, 255],
+        TextureFormat::Rgba8Unorm,
+        Default::default(),
+    );
+    let handle = app.world_mut().resource_mut::<Assets<Image>>().add(image);
+    let density = LayerDensity::Image {
+        image: handle.clone(),
+        min: Vec2::splat(-64.0),
+        size: Vec2::splat(128.0),
+        scale: 1.0,
+    };
+    app.world_mut().spawn(layer(density));
+    tick_app(&mut app, 2_000);
+    let before = instances(&mut app);
+    // Paint a white square over texels 40..48 (world x, z in 16..32 and -32..-16).
+    {
+        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+        let mut img = images.get_mut(&handle).unwrap();
+        for y in 40..48u32 {
+            for x in 40..48u32 {
+                img.set_color_at(x, y, Color::WHITE).unwrap();
+            }
+        }
+    }
+    tick_app(&mut app, 2_000);
+    let after = instances(&mut app);
+    let added: Vec<_> = after
+        .iter()
+        .filter(|(id, _)| !before.contains_key(id))
+        .collect();
+    let removed = before.keys().filter(|id| !after.contains_key(id)).count();
+    assert!(added.len() > 20, "painting added {} instances", added.len());
+    assert_eq!(removed, 0);
+    // Texels 40..48 of 64 over 128 units from -64: x in 16..32; rows 40..48 from the top
+    // (max z = 64): z in -32..-16. Bilinear blending widens that by half a texel.
+    assert!(
+        added
+            .iter()
+            .all(|(_, p)| p.x > 15.0 && p.x < 33.0 && p.z > -33.0 && p.z < -15.0),
+        "{added:?}"
+    );
+}
