@@ -10,21 +10,8 @@ use std::sync::Arc;
 pub enum LayerDensity {
     /// The same everywhere.
     Constant(f64),
-    /// Fractal noise: `scale * max(0, base + amplitude * fbm(p * frequency))`.
-    Noise {
-        /// Noise seed.
-        seed: u32,
-        /// Cycles per world unit.
-        frequency: f64,
-        /// Octaves (1..=16).
-        octaves: usize,
-        /// Offset of the noise value.
-        base: f64,
-        /// Gain of the noise value.
-        amplitude: f64,
-        /// Instances per square unit at value 1.
-        scale: f64,
-    },
+    /// Fractal noise (`rwt_core`'s fBm density).
+    Noise(NoiseDensity),
     /// A painted map: the image's luminance (0..1) over the ground rectangle `min..min + size`
     /// (x, z), times `scale`. Repainting the image re-queries the chunks it covers.
     Image {
@@ -45,9 +32,7 @@ impl std::fmt::Debug for LayerDensity {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             LayerDensity::Constant(v) => write!(f, "Constant({v})"),
-            LayerDensity::Noise {
-                scale, frequency, ..
-            } => write!(f, "Noise {{ scale: {scale}, frequency: {frequency}, .. }}"),
+            LayerDensity::Noise(n) => write!(f, "{n:?}"),
             LayerDensity::Image { image, scale, .. } => {
                 write!(f, "Image {{ {image:?}, scale: {scale}, .. }}")
             }
@@ -69,16 +54,7 @@ impl LayerDensity {
     pub fn resolve(&self, images: &Assets<Image>) -> Option<Arc<dyn Density + Send + Sync>> {
         Some(match self {
             LayerDensity::Constant(v) => Arc::new(Constant(*v)),
-            LayerDensity::Noise {
-                seed,
-                frequency,
-                octaves,
-                base,
-                amplitude,
-                scale,
-            } => Arc::new(NoiseDensity::new(
-                *seed, *frequency, *octaves, *base, *amplitude, *scale,
-            )),
+            LayerDensity::Noise(n) => Arc::new(n.clone()),
             LayerDensity::Image {
                 image,
                 min,

@@ -64,14 +64,22 @@ pub fn compare(windows: &[(DVec2, Vec<DVec2>)], side: f64, size: usize) -> Vec<R
 
 /// Prints the table.
 pub fn print_table(rows: &[Row]) {
-    println!(
+    say!(
         "{:<16} {:>7} {:>12} {:>15} {:>15}",
-        "", "rho", "low-freq pow", "mean aniso dB", "max aniso dB"
+        "",
+        "rho",
+        "low-freq pow",
+        "mean aniso dB",
+        "max aniso dB"
     );
     for r in rows {
-        println!(
+        say!(
             "{:<16} {:>7.3} {:>12.3} {:>15.1} {:>15.1}",
-            r.name, r.rho, r.low_frequency, r.mean_anisotropy, r.max_anisotropy
+            r.name,
+            r.rho,
+            r.low_frequency,
+            r.mean_anisotropy,
+            r.max_anisotropy
         );
     }
 }
@@ -132,7 +140,7 @@ pub fn run(path: &Path, plot: Option<&Path>) -> Result<(), String> {
         }
     }
     let total = points.len() as f64 / ((hi.x - lo.x) * (hi.y - lo.y));
-    println!(
+    say!(
         "{} points, {:.4} x {:.4}, {:.1} per unit area; {} window(s) of side {:.4}",
         points.len(),
         hi.x - lo.x,
@@ -145,7 +153,7 @@ pub fn run(path: &Path, plot: Option<&Path>) -> Result<(), String> {
     print_table(&rows);
     if let Some(out) = plot {
         draw(&windows[0], side, &rows, out)?;
-        println!("wrote {}", out.display());
+        say!("wrote {}", out.display());
     }
     Ok(())
 }

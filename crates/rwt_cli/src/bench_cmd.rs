@@ -122,24 +122,31 @@ pub fn run(quick: bool) -> Result<(), String> {
         black_box(&out);
     });
     let floor_rate = floor_count as f64 / floor;
-    println!(
+    say!(
         "one thread, {} runs each (median), {}x{} base tiles of {} points",
-        runs, tiles, tiles, set.points_per_tile
+        runs,
+        tiles,
+        tiles,
+        set.points_per_tile
     );
-    println!(
+    say!(
         "{:<24} {:>10} {:>12} {:>14} {:>12}",
-        "density", "points", "ms", "M points/s", "floor / this"
+        "density",
+        "points",
+        "ms",
+        "M points/s",
+        "floor / this"
     );
     for (name, count, t) in &rows {
         let rate = *count as f64 / t;
-        println!(
+        say!(
             "{name:<24} {count:>10} {:>12.2} {:>14.1} {:>12.2}",
             t * 1e3,
             rate / 1e6,
             floor_rate / rate
         );
     }
-    println!(
+    say!(
         "{:<24} {floor_count:>10} {:>12.2} {:>14.1} {:>12}",
         "white-noise floor",
         floor * 1e3,
@@ -164,7 +171,7 @@ pub fn run(quick: bool) -> Result<(), String> {
     let (_, ours_count, ours_time) = measure(&sampler, rect, runs, &mut out, "", &same);
     let ours_rate = ours_count as f64 / ours_time;
     let bridson_rate = bridson_count as f64 / bridson;
-    println!(
+    say!(
         "fast_poisson (Bridson)   {bridson_count:>10} {:>12.2} {:>14.3}   this, {ours_count} points: {:.2} ms, {:.0}x faster",
         bridson * 1e3,
         bridson_rate / 1e6,
@@ -190,15 +197,15 @@ pub fn run(quick: bool) -> Result<(), String> {
     let t_zero = median_time(runs, || {
         black_box(sampler.query(rect, &Constant(0.0), &mut Vec::new()).ok());
     });
-    println!(
+    say!(
         "cost x area:    doubling the area takes {:.2}x the time",
         t_full / t_half
     );
-    println!(
+    say!(
         "cost x density: doubling the density (3 N to 6 N per tile) takes {:.2}x the time",
         t_double / t_single
     );
-    println!(
+    say!(
         "all-zero density over the whole world: {:.3} ms ({:.4} of the uniform query)",
         t_zero * 1e3,
         t_zero / rows[0].2

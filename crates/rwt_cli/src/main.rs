@@ -1,5 +1,13 @@
 //! `rwt`: the command line of the rwt workspace.
 
+/// `println!` that ignores a closed standard output (`rwt ... | head`) instead of panicking.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod analyse_cmd;
 mod bench_cmd;
 mod draw;

@@ -40,7 +40,7 @@ pub fn run(image: &Path, out: &Path, points: usize, seed: u64, scale: f64) -> Re
         .query(rect, &d, &mut pts)
         .map_err(|e| e.to_string())?;
     let secs = started.elapsed().as_secs_f64();
-    println!(
+    say!(
         "{} points in {:.1} ms ({:.1} million points per second)",
         pts.len(),
         secs * 1e3,
@@ -83,6 +83,6 @@ pub fn run(image: &Path, out: &Path, points: usize, seed: u64, scale: f64) -> Re
             .save(out)
             .map_err(|e| format!("{}: {e}", out.display()))?;
     }
-    println!("wrote {}", out.display());
+    say!("wrote {}", out.display());
     Ok(())
 }

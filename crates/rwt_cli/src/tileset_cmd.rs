@@ -48,7 +48,7 @@ pub fn build_cmd(out: &Path, config: BuildConfig) -> Result<(), String> {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     }
     std::fs::write(out, &text).map_err(|e| format!("{}: {e}", out.display()))?;
-    println!(
+    say!(
         "built {} tiles x {} points (subdivision {}x{}) in {:.1} s -> {} ({:.1} MB)",
         set.tiles.len(),
         set.points_per_tile,
@@ -58,14 +58,14 @@ pub fn build_cmd(out: &Path, config: BuildConfig) -> Result<(), String> {
         out.display(),
         text.len() as f64 / 1e6
     );
-    println!(
+    say!(
         "  merged rho per tile: min {:.3}, median {:.3}; relaxation residual {:.1e}, max shift {:.2} spacings",
         report.merged_rho_min,
         report.merged_rho_median,
         report.relaxation_residual,
         report.relaxation_max_shift
     );
-    println!(
+    say!(
         "  relaxation: {} points short of the requested clearance (worst {:.3} spacings); prefix pass: {} base and {} subdivision ranks without room",
         report.relaxation_crowded,
         report.relaxation_crowded_clearance,
@@ -73,7 +73,7 @@ pub fn build_cmd(out: &Path, config: BuildConfig) -> Result<(), String> {
         report.sub_prefix_misses
     );
     for (r, lag) in &report.rank_lag {
-        println!("  rank {r:>5}: threshold / rank at most {lag:.2}");
+        say!("  rank {r:>5}: threshold / rank at most {lag:.2}");
     }
     Ok(())
 }
@@ -83,34 +83,34 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let set = TileSet::from_ron_bytes_unchecked(&bytes).map_err(|e| e.to_string())?;
     let mut ok = true;
-    println!("tile set        {}", path.display());
-    println!(
+    say!("tile set        {}", path.display());
+    say!(
         "tiles           {} ({} colours, complete set)",
         set.tiles.len(),
         set.colors
     );
-    println!("points per tile {}", set.points_per_tile);
-    println!("subdivision     {0}x{0}", set.subdivision);
+    say!("points per tile {}", set.points_per_tile);
+    say!("subdivision     {0}x{0}", set.subdivision);
     match set.validate() {
         Ok(()) => {
-            println!("structure       valid (sizes, colours, rules, rank permutations, subset)")
+            say!("structure       valid (sizes, colours, rules, rank permutations, subset)")
         }
         Err(e) => {
-            println!("structure       INVALID: {e}");
+            say!("structure       INVALID: {e}");
             return Ok(false);
         }
     }
-    println!("rank lists      valid permutations; subdivision lists start with the base points");
+    say!("rank lists      valid permutations; subdivision lists start with the base points");
     for level in 0..=3 {
         let window = if level == 3 { 3 } else { 8 };
         let v = edge_violations(&set, 1, level, window);
         ok &= v == 0;
-        println!("edge mismatches level {level}: {v}");
+        say!("edge mismatches level {level}: {v}");
     }
     let dev = set.max_subset_deviation();
     ok &= dev == 0;
-    println!("max base-to-subdivision deviation: {dev} (fixed-point units of 2^-32 tile)");
-    println!(
+    say!("max base-to-subdivision deviation: {dev} (fixed-point units of 2^-32 tile)");
+    say!(
         "normalized minimum distance of each tile's first k points, with neighbours (8 seeds, 10x10 tiles):"
     );
     let n = set.points_per_tile as usize;
@@ -121,12 +121,12 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
         let rho = base_prefix_rho(&set, k, 8, 10);
         let pass = min_rho.is_none_or(|m| rho >= m);
         ok &= pass;
-        println!(
+        say!(
             "  k = {k:>5}: rho = {rho:.3}{}",
             if pass { "" } else { "  (below --min-rho)" }
         );
     }
-    println!("{}", if ok { "OK" } else { "FAILED" });
+    say!("{}", if ok { "OK" } else { "FAILED" });
     Ok(ok)
 }
 
@@ -246,6 +246,6 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
     c.image
         .save(out)
         .map_err(|e| format!("{}: {e}", out.display()))?;
-    println!("wrote {}", out.display());
+    say!("wrote {}", out.display());
     Ok(())
 }

@@ -69,6 +69,53 @@ impl Accepted {
     }
 }
 
+/// Points placed so far in every tile of a set, for spacing checks that include every tile
+/// that may lie next to a tile. Shared by the rankings and by relaxation.
+pub struct Placed {
+    tiles: Vec<Accepted>,
+    cell: f64,
+}
+
+impl Placed {
+    /// No points yet, in `tiles` tiles, indexed with cells of about `cell` (the smallest
+    /// spacing that will be checked).
+    pub fn new(tiles: usize, cell: f64) -> Self {
+        Self {
+            tiles: (0..tiles)
+                .map(|_| Accepted {
+                    grid: BucketGrid::new(DVec2::ZERO, DVec2::ONE, cell),
+                    points: Vec::new(),
+                })
+                .collect(),
+            cell,
+        }
+    }
+
+    /// Places `p` in tile `t`.
+    pub fn insert(&mut self, t: usize, p: DVec2) {
+        let acc = &mut self.tiles[t];
+        acc.grid.insert(p, acc.points.len() as u32);
+        acc.points.push(p);
+    }
+
+    /// Distance from `p` (in tile `t`'s frame) to the nearest point placed in `t` or in any
+    /// tile that may lie at any of the 8 offsets, capped at `r`.
+    pub fn clearance(&self, neighbours: &Neighbours, t: usize, p: DVec2, r: f64) -> f64 {
+        let mut d = self.tiles[t].min_distance(p, r, self.cell);
+        for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
+            let shifted = p - DVec2::new(dx as f64, dy as f64);
+            // Only offsets whose tile the disc reaches.
+            if shifted.x < -d || shifted.x > 1.0 + d || shifted.y < -d || shifted.y > 1.0 + d {
+                continue;
+            }
+            for &u in &neighbours[t][o] {
+                d = d.min(self.tiles[u as usize].min_distance(shifted, d, self.cell));
+            }
+        }
+        d
+    }
+}
+
 /// Assigns thresholds to every candidate of every tile; returns `tau` per candidate.
 ///
 /// `alpha` is the spacing constant (the paper uses 0.5; 0.75 keeps the normalized minimum
@@ -79,23 +126,14 @@ pub fn rank(
     alpha: impl Fn(f64) -> f64,
     cap: f64,
 ) -> Vec<Vec<f64>> {
-    let cell = alpha(cap) / cap.sqrt();
-    let mut accepted: Vec<Accepted> = tiles
-        .iter()
-        .map(|_| Accepted {
-            grid: BucketGrid::new(DVec2::ZERO, DVec2::ONE, cell),
-            points: Vec::new(),
-        })
-        .collect();
+    let mut placed = Placed::new(tiles.len(), alpha(cap) / cap.sqrt());
     let mut tau: Vec<Vec<f64>> = tiles.iter().map(|c| vec![f64::NAN; c.len()]).collect();
     let mut heap = BinaryHeap::new();
     for (t, cands) in tiles.iter().enumerate() {
         for (i, c) in cands.iter().enumerate() {
             if c.fixed {
                 tau[t][i] = c.tau0;
-                let acc = &mut accepted[t];
-                acc.grid.insert(c.pos, acc.points.len() as u32);
-                acc.points.push(c.pos);
+                placed.insert(t, c.pos);
             } else {
                 let tau0 = c.tau0.clamp(1e-9, cap);
                 heap.push(Reverse((tau0.to_bits(), t as u32, i as u32)));
@@ -108,26 +146,7 @@ pub fn rank(
         let p = tiles[t][i].pos;
         let a = alpha(tau_now);
         let r = a / tau_now.sqrt();
-        let mut d = accepted[t].min_distance(p, r, cell);
-        for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
-            let near_x = match dx {
-                1 => p.x + r > 1.0,
-                -1 => p.x - r < 0.0,
-                _ => true,
-            };
-            let near_y = match dy {
-                1 => p.y + r > 1.0,
-                -1 => p.y - r < 0.0,
-                _ => true,
-            };
-            if !(near_x && near_y) {
-                continue;
-            }
-            let shifted = p - DVec2::new(dx as f64, dy as f64);
-            for &u in &neighbours[t][o] {
-                d = d.min(accepted[u as usize].min_distance(shifted, r.min(d), cell));
-            }
-        }
+        let d = placed.clearance(neighbours, t, p, r);
         if d < r && tau_now < cap {
             // Postpone to where this distance is allowed: `alpha` never grows with tau, so
             // `a^2 / d^2` never overshoots that threshold.
@@ -137,9 +156,7 @@ pub fn rank(
             continue;
         }
         tau[t][i] = tau_now;
-        let acc = &mut accepted[t];
-        acc.grid.insert(p, acc.points.len() as u32);
-        acc.points.push(p);
+        placed.insert(t, p);
     }
     tau
 }
@@ -160,42 +177,17 @@ pub fn repair_prefixes(
     fixed: usize,
 ) -> usize {
     let len = order.iter().map(Vec::len).min().unwrap_or(0);
-    let cell = alpha / (len.max(1) as f64).sqrt();
-    let mut accepted: Vec<Accepted> = tiles
-        .iter()
-        .map(|_| Accepted {
-            grid: BucketGrid::new(DVec2::ZERO, DVec2::ONE, cell),
-            points: Vec::new(),
-        })
-        .collect();
-    for (t, acc) in accepted.iter_mut().enumerate() {
-        for &i in &order[t][..fixed.min(len)] {
-            let p = tiles[t][i].pos;
-            acc.grid.insert(p, acc.points.len() as u32);
-            acc.points.push(p);
+    let mut placed = Placed::new(tiles.len(), alpha / (len.max(1) as f64).sqrt());
+    for (t, o) in order.iter().enumerate() {
+        for &i in &o[..fixed.min(len)] {
+            placed.insert(t, tiles[t][i].pos);
         }
     }
     let mut misses = 0;
     for k in fixed.min(len)..len {
         let r = alpha / ((k + 1) as f64).sqrt();
         for t in 0..tiles.len() {
-            let clearance = |p: DVec2| {
-                let mut d = accepted[t].min_distance(p, r, cell);
-                for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
-                    let shifted = p - DVec2::new(dx as f64, dy as f64);
-                    if shifted.x < -r
-                        || shifted.x > 1.0 + r
-                        || shifted.y < -r
-                        || shifted.y > 1.0 + r
-                    {
-                        continue;
-                    }
-                    for &u in &neighbours[t][o] {
-                        d = d.min(accepted[u as usize].min_distance(shifted, d, cell));
-                    }
-                }
-                d
-            };
+            let clearance = |p: DVec2| placed.clearance(neighbours, t, p, r);
             let end = (k + window).min(order[t].len());
             let mut best = (-1.0f64, k);
             let mut pick = None;
@@ -214,10 +206,7 @@ pub fn repair_prefixes(
             }
             let slot = pick.unwrap_or(best.1);
             order[t][k..=slot].rotate_right(1);
-            let p = tiles[t][order[t][k]].pos;
-            let acc = &mut accepted[t];
-            acc.grid.insert(p, acc.points.len() as u32);
-            acc.points.push(p);
+            placed.insert(t, tiles[t][order[t][k]].pos);
         }
     }
     misses

@@ -12,7 +12,7 @@
 //! point follows from its successor. The result satisfies the subset property bit for bit.
 
 use crate::geometry::BucketGrid;
-use crate::progressive::{Neighbours, OFFSETS};
+use crate::progressive::{Neighbours, Placed};
 use glam::DVec2;
 use rayon::prelude::*;
 
@@ -49,22 +49,6 @@ fn subdivision_points(points: &[Vec<DVec2>], children: &[u16], n: usize) -> Vec<
 /// none of those has room.
 const NEAR_CANDIDATES: usize = 24;
 const FAR_CANDIDATES: usize = 120;
-
-/// Per-tile accepted targets of the current selection pass.
-struct Chosen {
-    grid: BucketGrid,
-    points: Vec<DVec2>,
-}
-
-impl Chosen {
-    fn min_distance(&self, p: DVec2, r: f64) -> f64 {
-        let mut best2 = r * r;
-        self.grid.for_each_near(p, r, |i| {
-            best2 = best2.min((self.points[i as usize] - p).length_squared());
-        });
-        best2.sqrt()
-    }
-}
 
 /// Unused subdivision points of one tile near `p`, nearest first (at least `count` unless
 /// the tile runs out).
@@ -155,12 +139,7 @@ pub fn relax(
             break;
         }
         let previous = partner.clone();
-        let mut chosen: Vec<Chosen> = (0..tiles)
-            .map(|_| Chosen {
-                grid: BucketGrid::new(DVec2::ZERO, DVec2::ONE, r_min),
-                points: Vec::with_capacity(big_n),
-            })
-            .collect();
+        let mut chosen = Placed::new(tiles, r_min);
         let mut used: Vec<Vec<bool>> = subs.iter().map(|s| vec![false; s.len()]).collect();
         let mut next = points.clone();
         let mut was_failed = vec![vec![false; big_n]; tiles];
@@ -180,22 +159,7 @@ pub fn relax(
         worst_clearance = f64::INFINITY;
         for (t, k) in order {
             let p = points[t][k];
-            let clearance = |s: DVec2| -> f64 {
-                let mut d = chosen[t].min_distance(s, r_min);
-                for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
-                    let shifted = s - DVec2::new(dx as f64, dy as f64);
-                    let outside = shifted.x < -r_min
-                        || shifted.x > 1.0 + r_min
-                        || shifted.y < -r_min
-                        || shifted.y > 1.0 + r_min;
-                    if !outside {
-                        for &u in &neighbours[t][o] {
-                            d = d.min(chosen[u as usize].min_distance(shifted, d));
-                        }
-                    }
-                }
-                d
-            };
+            let clearance = |s: DVec2| chosen.clearance(neighbours, t, s, r_min);
             let mut pick = None;
             let mut best = (-1.0f64, 0u32);
             for count in [NEAR_CANDIDATES, FAR_CANDIDATES] {
@@ -231,9 +195,7 @@ pub fn relax(
             let (s, cell, kk) = subs[t][j];
             partner[t][k] = (cell, kk);
             next[t][k] = s;
-            let ch = &mut chosen[t];
-            ch.grid.insert(s, ch.points.len() as u32);
-            ch.points.push(s);
+            chosen.insert(t, s);
         }
         stable_passes = if partner == previous {
             stable_passes + 1

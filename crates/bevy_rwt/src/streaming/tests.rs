@@ -154,14 +154,9 @@ fn two_runs_give_the_same_world() {
     let run = || {
         let mut app = create_app();
         let viewer = spawn_viewer(&mut app, Vec3::ZERO);
-        app.world_mut().spawn(layer(LayerDensity::Noise {
-            seed: 2,
-            frequency: 0.05,
-            octaves: 3,
-            base: 0.5,
-            amplitude: 0.5,
-            scale: 0.8,
-        }));
+        app.world_mut().spawn(layer(LayerDensity::Noise(
+            rwt_core::density::NoiseDensity::new(2, 0.05, 3, 0.5, 0.5, 0.8),
+        )));
         for i in 0..10 {
             move_viewer(&mut app, viewer, Vec3::new(i as f32 * 7.0, 0.0, 0.0));
             tick_app(&mut app, 2_000);
