@@ -37,6 +37,10 @@ type ChunkTask = Task<Option<Vec<Point>>>;
 #[derive(Default)]
 struct ChunkState {
     instances: HashMap<PointId, Entity>,
+    /// Points generated but not yet spawned (waiting for the spawn budget).
+    queued: Vec<Point>,
+    /// Whether the chunk is in the spawn order.
+    in_order: bool,
     /// Level-of-detail band the content was generated for.
     lod: i64,
     task: Option<(ChunkTask, i64)>,
@@ -51,7 +55,8 @@ pub struct LayerState {
     densities: Option<Densities>,
     chunks: ChunkSet,
     states: HashMap<ChunkCoord, ChunkState>,
-    spawn: VecDeque<(ChunkCoord, Point)>,
+    /// Chunks with queued points, in the order they finished (unloaded ones are skipped).
+    spawn_order: VecDeque<ChunkCoord>,
     despawn: VecDeque<Entity>,
 }
 
@@ -77,6 +82,11 @@ impl LayerState {
     /// Loaded chunks.
     pub fn loaded(&self) -> usize {
         self.chunks.loaded().len()
+    }
+
+    /// Instances waiting for the spawn budget.
+    pub fn queued(&self) -> usize {
+        self.states.values().map(|c| c.queued.len()).sum()
     }
 
     /// Every instance entity of the layer (for despawning it).
@@ -206,7 +216,7 @@ pub fn plan_chunks(
             if let Some(c) = state.states.remove(&chunk) {
                 state.despawn.extend(c.instances.values().copied());
             }
-            state.spawn.retain(|(ch, _)| *ch != chunk);
+            // Its queued points go with it; its place in the spawn order is skipped later.
             unloaded.write(ChunkUnloaded {
                 layer: entity,
                 chunk,
@@ -277,20 +287,30 @@ pub fn collect_results(
             let Some(points) = result else { continue };
             let c = state.states.get_mut(&chunk).expect("finished chunks exist");
             c.lod = band;
-            let diff = diff_instances(c.instances.keys(), &points);
-            for id in &diff.removed {
-                if let Some(e) = c.instances.remove(id) {
-                    state.despawn.push_back(e);
+            // Compare with what the chunk shows or is about to show.
+            let shown: Vec<PointId> = c
+                .instances
+                .keys()
+                .chain(c.queued.iter().map(|p| &p.id))
+                .copied()
+                .collect();
+            let diff = diff_instances(shown.iter(), &points);
+            if !diff.removed.is_empty() {
+                let removed: std::collections::HashSet<PointId> =
+                    diff.removed.iter().copied().collect();
+                c.queued.retain(|p| !removed.contains(&p.id));
+                for id in &diff.removed {
+                    if let Some(e) = c.instances.remove(id) {
+                        state.despawn.push_back(e);
+                    }
                 }
             }
-            // Instances not yet spawned for this chunk and no longer wanted are dropped.
-            state
-                .spawn
-                .retain(|(ch, p)| *ch != chunk || !diff.removed.contains(&p.id));
             let count = points.len();
-            state
-                .spawn
-                .extend(diff.added.into_iter().map(|p| (chunk, p)));
+            c.queued.extend(diff.added);
+            if !c.queued.is_empty() && !c.in_order {
+                c.in_order = true;
+                state.spawn_order.push_back(chunk);
+            }
             loaded.write(ChunkLoaded {
                 layer: entity,
                 chunk,
@@ -299,7 +319,6 @@ pub fn collect_results(
         }
     }
 }
-
 /// Spawns and despawns queued instances within the per-frame budget.
 pub fn apply_budget(
     mut commands: Commands,
@@ -318,40 +337,46 @@ pub fn apply_budget(
             despawn_budget -= 1;
         }
         while spawn_budget > 0 {
-            let Some((chunk, p)) = state.spawn.pop_front() else {
+            let Some(&chunk) = state.spawn_order.front() else {
                 break;
             };
             let Some(c) = state.states.get_mut(&chunk) else {
+                // Unloaded while waiting.
+                state.spawn_order.pop_front();
                 continue;
             };
-            if c.instances.contains_key(&p.id) {
-                continue;
+            while spawn_budget > 0 {
+                let Some(p) = c.queued.pop() else { break };
+                let class =
+                    &layer.classes[(p.class as usize).min(layer.classes.len().saturating_sub(1))];
+                let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+                let scale =
+                    class.scale * p.id.scale(layer.seed, class.scale_variation as f64) as f32;
+                let transform = Transform::from_xyz(ground.x, layer.height.at(ground), ground.y)
+                    .with_rotation(Quat::from_rotation_y(p.id.rotation(layer.seed) as f32))
+                    .with_scale(Vec3::splat(scale));
+                let e = commands
+                    .spawn((
+                        ScatterInstance {
+                            layer: entity,
+                            id: p.id,
+                            class: p.class,
+                        },
+                        Mesh3d(class.mesh.clone()),
+                        MeshMaterial3d(class.material.clone()),
+                        transform,
+                    ))
+                    .id();
+                c.instances.insert(p.id, e);
+                spawn_budget -= 1;
             }
-            let class =
-                &layer.classes[(p.class as usize).min(layer.classes.len().saturating_sub(1))];
-            let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
-            let scale = class.scale * p.id.scale(layer.seed, class.scale_variation as f64) as f32;
-            let transform = Transform::from_xyz(ground.x, layer.height.at(ground), ground.y)
-                .with_rotation(Quat::from_rotation_y(p.id.rotation(layer.seed) as f32))
-                .with_scale(Vec3::splat(scale));
-            let e = commands
-                .spawn((
-                    ScatterInstance {
-                        layer: entity,
-                        id: p.id,
-                        class: p.class,
-                    },
-                    Mesh3d(class.mesh.clone()),
-                    MeshMaterial3d(class.material.clone()),
-                    transform,
-                ))
-                .id();
-            c.instances.insert(p.id, e);
-            spawn_budget -= 1;
+            if c.queued.is_empty() {
+                c.in_order = false;
+                state.spawn_order.pop_front();
+            }
         }
     }
 }
-
 /// Re-queries the chunks a repainted map covers; only changed instances are touched.
 pub fn repaint(
     mut events: MessageReader<AssetEvent<Image>>,
@@ -424,5 +449,5 @@ pub fn update_stats(layers: Query<&LayerState>, mut stats: ResMut<RwtStats>) {
     stats.live_instances = layers.iter().map(LayerState::live).sum();
     stats.loaded_chunks = layers.iter().map(LayerState::loaded).sum();
     stats.pending_tasks = layers.iter().map(LayerState::pending).sum();
-    stats.queued_spawns = layers.iter().map(|s| s.spawn.len()).sum();
+    stats.queued_spawns = layers.iter().map(LayerState::queued).sum();
 }

@@ -1,0 +1,118 @@
+//! Headless fly-through over a world of about a million live instances:
+//! `cargo bench -p bevy_rwt`. Prints the median and maximum time of a whole frame (the
+//! plugin's systems and the spawning and despawning they command) and instance churn.
+
+use bevy::prelude::*;
+use bevy_rwt::prelude::*;
+use std::time::Instant;
+
+fn main() {
+    for speed in [2.0f32, 8.0] {
+        run(speed);
+    }
+}
+
+fn run(speed: f32) {
+    println!(
+        "== flying at {speed} units per frame ({} units/s at 60 fps)",
+        speed * 60.0
+    );
+
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        bevy::asset::AssetPlugin::default(),
+        RwtPlugin::default().with_max_tasks(32),
+    ));
+    app.finish();
+    app.cleanup();
+    let viewer = app
+        .world_mut()
+        .spawn((
+            RwtViewer { half_angle: None },
+            Transform::default(),
+            GlobalTransform::default(),
+        ))
+        .id();
+    let grass = ScatterClass::new(
+        LayerDensity::Constant(0.5),
+        Handle::default(),
+        Handle::default(),
+    );
+    let streaming = StreamingConfig {
+        chunk_size: 32.0,
+        load_distance: 800.0,
+        unload_distance: 880.0,
+        near_distance: 64.0,
+    };
+    app.world_mut().spawn(
+        ScatterLayer::new(vec![grass])
+            .with_tile_size(16.0)
+            .with_streaming(streaming),
+    );
+
+    // Fill the world around the start.
+    let started = Instant::now();
+    let mut frames = 0;
+    loop {
+        app.update();
+        frames += 1;
+        let s = app.world().resource::<RwtStats>();
+        if s.pending_tasks == 0 && s.queued_spawns == 0 && s.live_instances > 0 {
+            break;
+        }
+        if frames > 100_000 {
+            panic!("the world did not fill");
+        }
+    }
+    let live = app.world().resource::<RwtStats>().live_instances;
+    println!(
+        "filled {live} instances in {frames} frames, {:.2} s",
+        started.elapsed().as_secs_f64()
+    );
+
+    // Fly for 600 frames.
+    let mut times = Vec::with_capacity(600);
+    let (mut most, mut least) = (0, usize::MAX);
+    let (mut spawned, mut despawned) = (0usize, 0usize);
+    let mut previous: std::collections::HashSet<Entity> = std::collections::HashSet::new();
+    let mut q = app
+        .world_mut()
+        .query_filtered::<Entity, With<ScatterInstance>>();
+    previous.extend(q.iter(app.world()));
+    let fly = Instant::now();
+    for f in 0..600 {
+        let x = f as f32 * speed;
+        let at = Vec3::new(x, 2.0, (x * 0.01).sin() * 200.0);
+        let mut e = app.world_mut().entity_mut(viewer);
+        *e.get_mut::<Transform>().unwrap() = Transform::from_translation(at);
+        *e.get_mut::<GlobalTransform>().unwrap() = GlobalTransform::from_translation(at);
+        let t = Instant::now();
+        app.update();
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        let now: std::collections::HashSet<Entity> = q.iter(app.world()).collect();
+        spawned += now.difference(&previous).count();
+        despawned += previous.difference(&now).count();
+        most = most.max(now.len());
+        least = least.min(now.len());
+        previous = now;
+    }
+    let seconds = fly.elapsed().as_secs_f64();
+    times.sort_by(f64::total_cmp);
+    let stats = app.world().resource::<RwtStats>().clone();
+    println!(
+        "fly-through: 600 frames, live instances between {least} and {most} (now {})",
+        stats.live_instances
+    );
+    println!(
+        "frame time: median {:.2} ms, 95th percentile {:.2} ms, max {:.2} ms",
+        times[times.len() / 2],
+        times[times.len() * 95 / 100],
+        times[times.len() - 1]
+    );
+    println!(
+        "churn: {spawned} spawned, {despawned} despawned ({:.0} and {:.0} per second of frames)",
+        spawned as f64 / seconds,
+        despawned as f64 / seconds
+    );
+}
