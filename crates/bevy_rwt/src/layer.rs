@@ -111,25 +111,66 @@ pub enum HeightSource {
     Constant(f32),
     /// A function of the ground position (x, z).
     Function(Arc<dyn Fn(Vec2) -> f32 + Send + Sync>),
+    /// A heightmap: the image's luminance (0..1, bilinear) over `min..min + size` (x, z),
+    /// times `scale`; 0 outside.
+    Image {
+        /// The heightmap.
+        image: Handle<Image>,
+        /// Ground position of the image's bottom-left corner (x, z).
+        min: Vec2,
+        /// Ground size of the image (x, z).
+        size: Vec2,
+        /// Height where the image is white.
+        scale: f32,
+    },
 }
+
+/// A thread-safe height function, as generation tasks use it.
+pub type HeightFn = Arc<dyn Fn(Vec2) -> f32 + Send + Sync>;
 
 impl std::fmt::Debug for HeightSource {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             HeightSource::Constant(h) => write!(f, "Constant({h})"),
             HeightSource::Function(_) => write!(f, "Function(..)"),
+            HeightSource::Image { image, scale, .. } => {
+                write!(f, "Image {{ {image:?}, scale: {scale}, .. }}")
+            }
         }
     }
 }
 
 impl HeightSource {
-    /// Height at a ground position.
-    pub fn at(&self, p: Vec2) -> f32 {
-        match self {
-            HeightSource::Constant(h) => *h,
-            HeightSource::Function(f) => f(p),
-        }
+    /// A thread-safe snapshot; `None` while a heightmap is loading.
+    pub fn resolve(&self, images: &Assets<Image>) -> Option<HeightFn> {
+        Some(match self {
+            HeightSource::Constant(h) => {
+                let h = *h;
+                Arc::new(move |_| h)
+            }
+            HeightSource::Function(f) => f.clone(),
+            HeightSource::Image {
+                image,
+                min,
+                size,
+                scale,
+            } => {
+                let map =
+                    crate::image_density::from_bevy_image(images.get(image)?, *min, *size, 1.0)?;
+                let scale = *scale;
+                Arc::new(move |p: Vec2| {
+                    map.value(glam::DVec2::new(p.x as f64, p.y as f64)) as f32 * scale
+                })
+            }
+        })
     }
+}
+
+/// Slope (rise over run) of `height` at `p`, by central differences over `step`.
+pub fn slope(height: &HeightFn, p: Vec2, step: f32) -> f32 {
+    let dx = height(p + Vec2::X * step) - height(p - Vec2::X * step);
+    let dz = height(p + Vec2::Y * step) - height(p - Vec2::Y * step);
+    Vec2::new(dx, dz).length() / (2.0 * step)
 }
 
 /// A scatter layer: instances of its classes, streamed around every [`crate::RwtViewer`].
@@ -151,6 +192,10 @@ pub struct ScatterLayer {
     pub falloff: Option<(f64, f64)>,
     /// Ground height.
     pub height: HeightSource,
+    /// Instances only where the ground height is within this range.
+    pub height_range: Option<(f32, f32)>,
+    /// Instances only where the ground slope (rise over run) is at most this.
+    pub max_slope: Option<f32>,
 }
 
 impl ScatterLayer {
@@ -163,6 +208,8 @@ impl ScatterLayer {
             streaming: StreamingConfig::default(),
             falloff: None,
             height: HeightSource::Constant(0.0),
+            height_range: None,
+            max_slope: None,
         }
     }
 
@@ -193,6 +240,18 @@ impl ScatterLayer {
     /// Sets the ground height.
     pub fn with_height(mut self, height: HeightSource) -> Self {
         self.height = height;
+        self
+    }
+
+    /// Keeps instances where the ground height is in `min..=max`.
+    pub fn with_height_range(mut self, min: f32, max: f32) -> Self {
+        self.height_range = Some((min, max));
+        self
+    }
+
+    /// Keeps instances where the ground slope is at most `max` (rise over run).
+    pub fn with_max_slope(mut self, max: f32) -> Self {
+        self.max_slope = Some(max);
         self
     }
 }

@@ -9,7 +9,7 @@ mod tests;
 
 pub use plugin::StreamingPlugin;
 
-use crate::layer::{ScatterInstance, ScatterLayer};
+use crate::layer::{HeightFn, ScatterInstance, ScatterLayer, slope};
 use crate::{ChunkLoaded, ChunkUnloaded, RwtSettings, RwtStats, RwtViewer};
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
@@ -53,6 +53,7 @@ struct ChunkState {
 pub struct LayerState {
     sampler: Option<Arc<Sampler>>,
     densities: Option<Densities>,
+    height: Option<HeightFn>,
     chunks: ChunkSet,
     states: HashMap<ChunkCoord, ChunkState>,
     /// Chunks with queued points, in the order they finished (unloaded ones are skipped).
@@ -162,21 +163,30 @@ fn band_factor(layer: &ScatterLayer, band: i64) -> f64 {
     }
 }
 
-/// Starts a generation task for a chunk.
+/// Starts a generation task for a chunk: the query, then the height and slope filters.
 fn start_task(
     layer: &ScatterLayer,
     sampler: Arc<Sampler>,
     densities: Densities,
+    height: HeightFn,
     chunk: ChunkCoord,
     band: i64,
 ) -> ChunkTask {
     let rect = chunk.rect(layer.streaming.chunk_size);
     let factor = band_factor(layer, band);
+    let (range, max_slope) = (layer.height_range, layer.max_slope);
     AsyncComputeTaskPool::get().spawn(async move {
         let scaled: Vec<_> = densities.iter().map(|d| Scale(d.clone(), factor)).collect();
         let mut out = Vec::new();
         sampler
-            .query_classes(rect, &scaled, |p| out.push(p))
+            .query_classes(rect, &scaled, |p| {
+                let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+                let in_range = range.is_none_or(|(lo, hi)| (lo..=hi).contains(&height(ground)));
+                let flat_enough = max_slope.is_none_or(|m| slope(&height, ground, 0.25) <= m);
+                if in_range && flat_enough {
+                    out.push(p);
+                }
+            })
             .ok()
             .map(|_| out)
     })
@@ -211,6 +221,13 @@ pub fn plan_chunks(
                 None => continue,
             }
         }
+        if state.height.is_none() {
+            match layer.height.resolve(&images) {
+                Some(h) => state.height = Some(h),
+                // A heightmap is still loading: try again next frame.
+                None => continue,
+            }
+        }
         let changes = state.chunks.update(&layer.streaming, &viewers.0);
         for chunk in changes.unload {
             if let Some(c) = state.states.remove(&chunk) {
@@ -238,6 +255,7 @@ pub fn plan_chunks(
             .saturating_sub(state.in_flight());
         let sampler = state.sampler.clone().expect("sampler set above");
         let densities = state.densities.clone().expect("densities set above");
+        let height = state.height.clone().expect("height set above");
         let mut order: Vec<(f64, ChunkCoord)> = state
             .states
             .iter()
@@ -258,7 +276,14 @@ pub fn plan_chunks(
             let c = state.states.get_mut(&chunk).expect("listed above");
             c.stale = false;
             c.task = Some((
-                start_task(layer, sampler.clone(), densities.clone(), chunk, band),
+                start_task(
+                    layer,
+                    sampler.clone(),
+                    densities.clone(),
+                    height.clone(),
+                    chunk,
+                    band,
+                ),
                 band,
             ));
         }
@@ -340,6 +365,9 @@ pub fn apply_budget(
             let Some(&chunk) = state.spawn_order.front() else {
                 break;
             };
+            let Some(height) = state.height.clone() else {
+                break;
+            };
             let Some(c) = state.states.get_mut(&chunk) else {
                 // Unloaded while waiting.
                 state.spawn_order.pop_front();
@@ -352,7 +380,7 @@ pub fn apply_budget(
                 let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
                 let scale =
                     class.scale * p.id.scale(layer.seed, class.scale_variation as f64) as f32;
-                let transform = Transform::from_xyz(ground.x, layer.height.at(ground), ground.y)
+                let transform = Transform::from_xyz(ground.x, height(ground), ground.y)
                     .with_rotation(Quat::from_rotation_y(p.id.rotation(layer.seed) as f32))
                     .with_scale(Vec3::splat(scale));
                 let e = commands

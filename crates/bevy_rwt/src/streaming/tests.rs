@@ -277,3 +277,77 @@ fn painting_changes_only_the_painted_region() {
         "{added:?}"
     );
 }
+
+#[test]
+fn removing_the_viewer_unloads_everything() {
+    let mut app = create_app();
+    let viewer = spawn_viewer(&mut app, Vec3::ZERO);
+    app.world_mut().spawn(layer(LayerDensity::Constant(0.4)));
+    tick_app(&mut app, 2_000);
+    assert!(!instances(&mut app).is_empty());
+    app.world_mut().despawn(viewer);
+    tick_app(&mut app, 2_000);
+    assert!(instances(&mut app).is_empty());
+    let stats = app.world().resource::<RwtStats>();
+    assert_eq!((stats.live_instances, stats.loaded_chunks), (0, 0));
+}
+
+#[test]
+fn height_range_and_slope_filters() {
+    use crate::layer::HeightSource;
+    use std::sync::Arc;
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    // Flat at 0 for x < 0; a ramp of slope 2 for x >= 0 (too steep); a plateau at 4 from x = 2.
+    let ground = |p: Vec2| if p.x < 0.0 { 0.0 } else { (2.0 * p.x).min(4.0) };
+    let steep_free = layer(LayerDensity::Constant(0.5))
+        .with_height(HeightSource::Function(Arc::new(ground)))
+        .with_max_slope(1.0)
+        .with_height_range(-1.0, 3.0);
+    app.world_mut().spawn(steep_free);
+    tick_app(&mut app, 2_000);
+    let live = instances(&mut app);
+    assert!(live.len() > 500);
+    // Left of the ramp only (the plateau at height 4 is out of range, the ramp too steep).
+    assert!(
+        live.values().all(|p| p.x < 0.3 && p.y == 0.0),
+        "{:?}",
+        live.values().find(|p| p.x >= 0.3)
+    );
+}
+
+#[test]
+fn a_heightmap_image_lifts_instances() {
+    use crate::layer::HeightSource;
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let white = Image::new_fill(
+        Extent3d {
+            width: 4,
+            height: 4,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        &[255, 255, 255, 255],
+        TextureFormat::Rgba8Unorm,
+        Default::default(),
+    );
+    let handle = app.world_mut().resource_mut::<Assets<Image>>().add(white);
+    let height = HeightSource::Image {
+        image: handle,
+        min: Vec2::splat(-100.0),
+        size: Vec2::splat(200.0),
+        scale: 7.5,
+    };
+    app.world_mut()
+        .spawn(layer(LayerDensity::Constant(0.3)).with_height(height));
+    tick_app(&mut app, 2_000);
+    let live = instances(&mut app);
+    assert!(!live.is_empty());
+    assert!(
+        live.values().all(|p| (p.y - 7.5).abs() < 1e-4),
+        "{:?}",
+        live.values().next()
+    );
+}
