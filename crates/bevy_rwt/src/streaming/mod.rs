@@ -467,9 +467,19 @@ pub fn on_layer_removed(
     }
 }
 
-/// Gives every new layer its streaming state.
-pub fn on_layer_added(add: On<Add, ScatterLayer>, mut commands: Commands) {
-    commands.entity(add.entity).insert(LayerState::default());
+/// Gives every new or replaced layer a fresh streaming state: a replaced layer (new settings,
+/// a reloaded description) despawns what the old one placed and streams anew.
+pub fn on_layer_inserted(
+    insert: On<Insert, ScatterLayer>,
+    states: Query<&LayerState>,
+    mut commands: Commands,
+) {
+    if let Ok(old) = states.get(insert.entity) {
+        for e in old.entities().chain(old.despawn.iter().copied()) {
+            commands.entity(e).try_despawn();
+        }
+    }
+    commands.entity(insert.entity).insert(LayerState::default());
 }
 
 /// Updates [`RwtStats`].

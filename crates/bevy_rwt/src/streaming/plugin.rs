@@ -15,7 +15,7 @@ impl Plugin for StreamingPlugin {
         let set = Arc::new(TileSet::embedded());
         app.insert_resource(RwtTileSet(set))
             .init_resource::<Viewers>()
-            .add_observer(on_layer_added)
+            .add_observer(on_layer_inserted)
             .add_observer(on_layer_removed)
             .add_systems(
                 self.schedule,

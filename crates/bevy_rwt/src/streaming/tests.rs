@@ -351,3 +351,28 @@ fn a_heightmap_image_lifts_instances() {
         live.values().next()
     );
 }
+
+#[test]
+fn replacing_a_layer_restreams_it() {
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let l = app
+        .world_mut()
+        .spawn(layer(LayerDensity::Constant(0.2)))
+        .id();
+    tick_app(&mut app, 2_000);
+    let sparse = instances(&mut app).len();
+    app.world_mut()
+        .entity_mut(l)
+        .insert(layer(LayerDensity::Constant(0.6)));
+    tick_app(&mut app, 2_000);
+    let dense = instances(&mut app);
+    let ratio = dense.len() as f64 / sparse as f64;
+    assert!((ratio - 3.0).abs() < 0.2, "{sparse} -> {}", dense.len());
+    let stats = app.world().resource::<RwtStats>();
+    assert_eq!(
+        stats.live_instances,
+        dense.len(),
+        "no leftovers of the old layer"
+    );
+}
