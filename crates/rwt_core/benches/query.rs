@@ -71,23 +71,7 @@ fn white_noise_floor(b: Bencher) {
     let mut out: Vec<Point> = Vec::with_capacity(POINTS as usize);
     b.bench_local(|| {
         out.clear();
-        for i in 0..POINTS as u64 {
-            let h = rwt_core::rng::mix64(i);
-            out.push(Point {
-                position: DVec2::new(
-                    rwt_core::rng::unit_f64(h),
-                    rwt_core::rng::unit_f64(h.rotate_left(32)),
-                ) * TILES,
-                id: rwt_core::query::PointId {
-                    level: 0,
-                    x: 0,
-                    y: 0,
-                    index: i as u16,
-                },
-                threshold: 0.0,
-                class: 0,
-            });
-        }
+        rwt_core::analysis::reference::white_noise_floor(POINTS as usize, TILES, &mut out);
         black_box(&out);
     });
 }

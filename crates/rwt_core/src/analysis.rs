@@ -214,6 +214,28 @@ pub mod reference {
     use crate::source_tile::DartThrowing;
     use glam::DVec2;
 
+    /// The throughput floor of a query: `count` hashed white-noise points written to `out`
+    /// as query results, in the square `[0, side)^2`. Benchmarks compare queries with this.
+    pub fn white_noise_floor(count: usize, side: f64, out: &mut Vec<crate::query::Point>) {
+        for i in 0..count as u64 {
+            let h = crate::rng::mix64(i);
+            out.push(crate::query::Point {
+                position: DVec2::new(
+                    crate::rng::unit_f64(h),
+                    crate::rng::unit_f64(h.rotate_left(32)),
+                ) * side,
+                id: crate::query::PointId {
+                    level: 0,
+                    x: 0,
+                    y: 0,
+                    index: i as u16,
+                },
+                threshold: 0.0,
+                class: 0,
+            });
+        }
+    }
+
     /// Uniform random points (white noise).
     pub fn white_noise(origin: DVec2, side: f64, count: usize, seed: u64) -> Vec<DVec2> {
         let mut rng = Rng::new(seed, 0x3417e);

@@ -37,6 +37,22 @@ fn tick_app(app: &mut App, max: usize) {
     panic!("streaming did not settle in {max} frames");
 }
 
+/// A `size x size` image of one colour.
+fn solid_image(size: u32, rgba: [u8; 4]) -> Image {
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+    Image::new_fill(
+        Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        &rgba,
+        TextureFormat::Rgba8Unorm,
+        Default::default(),
+    )
+}
+
 fn streaming() -> StreamingConfig {
     StreamingConfig {
         chunk_size: 16.0,
@@ -224,21 +240,10 @@ fn removing_a_layer_despawns_everything() {
 
 #[test]
 fn painting_changes_only_the_painted_region() {
-    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
     let mut app = create_app();
     spawn_viewer(&mut app, Vec3::ZERO);
     let size = 64u32;
-    let image = Image::new_fill(
-        Extent3d {
-            width: size,
-            height: size,
-            depth_or_array_layers: 1,
-        },
-        TextureDimension::D2,
-        &[128, 128, 128, 255],
-        TextureFormat::Rgba8Unorm,
-        Default::default(),
-    );
+    let image = solid_image(size, [128, 128, 128, 255]);
     let handle = app.world_mut().resource_mut::<Assets<Image>>().add(image);
     let density = LayerDensity::Image {
         image: handle.clone(),
@@ -319,20 +324,9 @@ fn height_range_and_slope_filters() {
 #[test]
 fn a_heightmap_image_lifts_instances() {
     use crate::layer::HeightSource;
-    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
     let mut app = create_app();
     spawn_viewer(&mut app, Vec3::ZERO);
-    let white = Image::new_fill(
-        Extent3d {
-            width: 4,
-            height: 4,
-            depth_or_array_layers: 1,
-        },
-        TextureDimension::D2,
-        &[255, 255, 255, 255],
-        TextureFormat::Rgba8Unorm,
-        Default::default(),
-    );
+    let white = solid_image(4, [255, 255, 255, 255]);
     let handle = app.world_mut().resource_mut::<Assets<Image>>().add(white);
     let height = HeightSource::Image {
         image: handle,
