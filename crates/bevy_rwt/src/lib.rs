@@ -30,6 +30,7 @@
 
 pub mod image_density;
 pub mod layer;
+pub mod layer_asset;
 pub mod streaming;
 
 use bevy::diagnostic::{Diagnostic, Diagnostics, RegisterDiagnostic};
@@ -42,6 +43,7 @@ use std::time::Instant;
 
 /// Everything a game needs.
 pub mod prelude {
+    pub use crate::layer_asset::{ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{
         ChunkLoaded, ChunkUnloaded, HeightSource, LayerDensity, RwtPlugin, RwtSettings, RwtStats,
         RwtSystems, RwtViewer, ScatterClass, ScatterInstance, ScatterLayer,

@@ -20,7 +20,8 @@ impl Plugin for StreamingPlugin {
             .add_systems(
                 self.schedule,
                 (
-                    collect_viewers.in_set(RwtSystems::Viewers),
+                    (crate::layer_asset::apply_layer_assets, collect_viewers)
+                        .in_set(RwtSystems::Viewers),
                     (repaint, plan_chunks).chain().in_set(RwtSystems::Plan),
                     collect_results.in_set(RwtSystems::Collect),
                     apply_budget.in_set(RwtSystems::Apply),
@@ -35,5 +36,7 @@ impl Plugin for StreamingPlugin {
         if !app.world().contains_resource::<Assets<Image>>() {
             app.init_asset::<Image>();
         }
+        app.init_asset::<crate::layer_asset::ScatterLayerAsset>()
+            .register_asset_loader(crate::layer_asset::ScatterLayerLoader);
     }
 }

@@ -370,3 +370,66 @@ fn replacing_a_layer_restreams_it() {
         "no leftovers of the old layer"
     );
 }
+
+#[test]
+fn a_layer_file_loads_and_reloads() {
+    use crate::layer_asset::{ScatterLayerAsset, ScatterLayerSource};
+    let dir = std::env::temp_dir().join(format!("bevy_rwt_layer_test_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("meadow.layer.ron"),
+        r#"(tile_size: 8.0, seed: 3, chunk_size: 16.0, load_distance: 48.0, unload_distance: 64.0,
+            classes: [(density: Constant(0.25), mesh: Cone(radius: 0.5, height: 2.0), material: Color(0.1, 0.5, 0.1))])"#,
+    )
+    .unwrap();
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin {
+            file_path: dir.to_string_lossy().into_owned(),
+            ..Default::default()
+        },
+        RwtPlugin::default().with_spawn_budget(50_000),
+    ))
+    .init_asset::<Mesh>()
+    .init_asset::<StandardMaterial>();
+    app.finish();
+    app.cleanup();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let handle: Handle<ScatterLayerAsset> = app
+        .world()
+        .resource::<AssetServer>()
+        .load("meadow.layer.ron");
+    let entity = app
+        .world_mut()
+        .spawn(ScatterLayerSource(handle.clone()))
+        .id();
+    for _ in 0..2_000 {
+        app.update();
+        if app.world().get::<ScatterLayer>(entity).is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    assert!(
+        app.world().get::<ScatterLayer>(entity).is_some(),
+        "the layer file never loaded"
+    );
+    tick_app(&mut app, 2_000);
+    let first = instances(&mut app).len();
+    assert!(first > 100);
+    // What a file watcher does on save: the asset changes, the layer restreams.
+    {
+        let mut assets = app.world_mut().resource_mut::<Assets<ScatterLayerAsset>>();
+        let mut asset = assets.get_mut(&handle).unwrap();
+        asset.0.classes[0].density = LayerDensity::Constant(0.75);
+    }
+    for _ in 0..5 {
+        app.update();
+    }
+    tick_app(&mut app, 2_000);
+    let second = instances(&mut app).len();
+    let ratio = second as f64 / first as f64;
+    assert!((ratio - 3.0).abs() < 0.25, "{first} -> {second}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
