@@ -29,7 +29,7 @@ fn run(speed: f32) {
     let viewer = app
         .world_mut()
         .spawn((
-            RwtViewer { half_angle: None },
+            RwtViewer::all_around(),
             Transform::default(),
             GlobalTransform::default(),
         ))

@@ -46,25 +46,51 @@ pub mod prelude {
     pub use crate::layer_asset::{ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{
         ChunkLoaded, ChunkUnloaded, HeightSource, LayerDensity, RwtPlugin, RwtSettings, RwtStats,
-        RwtSystems, RwtViewer, ScatterClass, ScatterInstance, ScatterLayer,
+        RwtSystems, RwtViewer, ScatterClass, ScatterInstance, ScatterLayer, ViewCone,
     };
     pub use rwt_core::streaming::StreamingConfig;
 }
 
-/// Marks an entity (usually a camera) around which layers are streamed.
+/// Which directions a viewer streams in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewCone {
+    /// Every direction (top-down views, or to be ready for any turn).
+    All,
+    /// A wedge of this half-angle (radians) around the view direction.
+    Fixed(f32),
+    /// The horizontal half-angle of the entity's perspective `Projection`, plus `margin`
+    /// radians for turning; every direction for other projections.
+    Camera {
+        /// Extra half-angle beyond the projection's.
+        margin: f32,
+    },
+}
+
+/// Marks an entity (usually a camera) around which layers are streamed. Chunks near it are
+/// always loaded; farther ones where its view cone, laid on the ground, reaches them.
 #[derive(Component, Clone, Copy, Debug)]
 #[require(Transform)]
 pub struct RwtViewer {
-    /// Half the horizontal view angle (radians) used to skip chunks behind the viewer;
-    /// `None` streams in every direction.
-    pub half_angle: Option<f32>,
+    /// Directions streamed.
+    pub cone: ViewCone,
+}
+
+impl RwtViewer {
+    /// A viewer that streams in every direction.
+    pub fn all_around() -> Self {
+        Self {
+            cone: ViewCone::All,
+        }
+    }
 }
 
 impl Default for RwtViewer {
-    /// Streams a 130 degree wedge ahead (a 90 degree camera plus margin for turning).
+    /// The camera's own view cone plus 15 degrees on each side.
     fn default() -> Self {
         Self {
-            half_angle: Some(65f32.to_radians()),
+            cone: ViewCone::Camera {
+                margin: 15f32.to_radians(),
+            },
         }
     }
 }

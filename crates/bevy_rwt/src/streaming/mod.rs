@@ -10,7 +10,7 @@ mod tests;
 pub use plugin::StreamingPlugin;
 
 use crate::layer::{HeightFn, ScatterInstance, ScatterLayer, slope};
-use crate::{ChunkLoaded, ChunkUnloaded, RwtSettings, RwtStats, RwtViewer};
+use crate::{ChunkLoaded, ChunkUnloaded, RwtSettings, RwtStats, RwtViewer, ViewCone};
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
 use glam::DVec2;
@@ -103,18 +103,35 @@ fn ground(t: &GlobalTransform) -> DVec2 {
     DVec2::new(p.x as f64, p.z as f64)
 }
 
+/// Half-angle of a viewer's ground wedge, or `None` for every direction.
+fn half_angle(cone: ViewCone, projection: Option<&Projection>) -> Option<f32> {
+    let half = match cone {
+        ViewCone::All => return None,
+        ViewCone::Fixed(h) => h,
+        ViewCone::Camera { margin } => match projection {
+            Some(Projection::Perspective(p)) => {
+                ((p.fov * 0.5).tan() * p.aspect_ratio).atan() + margin
+            }
+            _ => return None,
+        },
+    };
+    // Wider than a half-turn is every direction.
+    (half < std::f32::consts::FRAC_PI_2 * 1.9).then_some(half)
+}
+
 /// Viewer positions and view wedges on the ground plane.
 pub fn collect_viewers(
     mut viewers: ResMut<Viewers>,
-    query: Query<(&GlobalTransform, &RwtViewer)>,
+    query: Query<(&GlobalTransform, &RwtViewer, Option<&Projection>)>,
     settings: Res<RwtSettings>,
 ) {
     viewers.0.clear();
-    for (t, v) in &query {
+    for (t, v, projection) in &query {
         let position = ground(t);
         let forward = t.forward();
         let flat = Vec2::new(forward.x, forward.z);
-        let footprint = match v.half_angle {
+        // Looking mostly down, the view covers every direction.
+        let footprint = match half_angle(v.cone, projection) {
             Some(half) if flat.length() > 0.3 => {
                 let dir = flat.normalize();
                 let reach = settings.footprint_reach as f32;
@@ -123,8 +140,18 @@ pub fn collect_viewers(
                     let d = Vec2::new(dir.x * c - dir.y * s, dir.x * s + dir.y * c) * reach;
                     DVec2::new(position.x + d.x as f64, position.y + d.y as f64)
                 };
-                // Counter-clockwise wedge: apex, then the two far corners.
-                vec![position, side(-half), side(half)]
+                if half >= std::f32::consts::FRAC_PI_2 {
+                    // A wedge wider than a half-plane is not convex: approximate it by the
+                    // half-plane ahead plus the near ring, which is loaded anyway.
+                    vec![
+                        side(-std::f32::consts::FRAC_PI_2),
+                        side(0.0),
+                        side(std::f32::consts::FRAC_PI_2),
+                    ]
+                } else {
+                    // Counter-clockwise wedge: apex, then the two far corners.
+                    vec![position, side(-half), side(half)]
+                }
             }
             _ => Vec::new(),
         };

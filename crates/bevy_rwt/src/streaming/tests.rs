@@ -73,7 +73,7 @@ fn layer(density: LayerDensity) -> ScatterLayer {
 fn spawn_viewer(app: &mut App, at: Vec3) -> Entity {
     app.world_mut()
         .spawn((
-            RwtViewer { half_angle: None },
+            RwtViewer::all_around(),
             Transform::from_translation(at),
             GlobalTransform::from_translation(at),
         ))
@@ -432,4 +432,40 @@ fn a_layer_file_loads_and_reloads() {
     let ratio = second as f64 / first as f64;
     assert!((ratio - 3.0).abs() < 0.25, "{first} -> {second}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_camera_streams_what_it_can_see() {
+    let mut app = create_app();
+    let looking = Transform::from_xyz(0.0, 2.0, 0.0).looking_to(Vec3::X, Vec3::Y);
+    let projection = Projection::Perspective(PerspectiveProjection {
+        fov: 60f32.to_radians(),
+        aspect_ratio: 1.0,
+        ..Default::default()
+    });
+    app.world_mut().spawn((
+        RwtViewer::default(),
+        projection,
+        looking,
+        GlobalTransform::from(looking),
+    ));
+    app.world_mut().spawn(layer(LayerDensity::Constant(0.3)));
+    tick_app(&mut app, 2_000);
+    let live = instances(&mut app);
+    let ahead = live.values().filter(|p| p.x > 30.0).count();
+    // The near ring (20) loads whole chunks (16): nothing beyond 36 behind.
+    let behind = live.values().filter(|p| p.x < -36.0).count();
+    assert!(ahead > 100, "{ahead} ahead");
+    assert_eq!(behind, 0, "nothing far behind the camera");
+    // Far to the side, outside 30 + 15 degrees of the view, nothing either.
+    assert!(
+        live.values()
+            .all(|p| p.x > -24.0 || Vec2::new(p.x, p.z).length() < 48.0)
+    );
+    assert!(
+        !live
+            .values()
+            .any(|p| p.x > 10.0 && p.z.abs() > p.x * 1.6 + 24.0),
+        "outside the cone"
+    );
 }
