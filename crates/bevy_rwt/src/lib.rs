@@ -28,6 +28,7 @@
 //!     .run();
 //! ```
 
+pub mod debug;
 pub mod image_density;
 pub mod layer;
 pub mod layer_asset;
@@ -43,6 +44,7 @@ use std::time::Instant;
 
 /// Everything a game needs.
 pub mod prelude {
+    pub use crate::debug::{RwtGizmos, RwtGizmosPlugin};
     pub use crate::layer_asset::{ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{
         ChunkLoaded, ChunkUnloaded, HeightSource, LayerDensity, RwtPlugin, RwtSettings, RwtStats,

@@ -85,6 +85,11 @@ impl LayerState {
         self.chunks.loaded().len()
     }
 
+    /// The loaded chunks themselves.
+    pub fn loaded_chunks(&self) -> impl Iterator<Item = &rwt_core::streaming::ChunkCoord> + '_ {
+        self.chunks.loaded().iter()
+    }
+
     /// Instances waiting for the spawn budget.
     pub fn queued(&self) -> usize {
         self.states.values().map(|c| c.queued.len()).sum()

@@ -9,12 +9,18 @@ use std::collections::HashMap;
 use std::time::Duration;
 
 fn create_app() -> App {
+    create_app_with(|_| {})
+}
+
+/// A headless app; `extra` adds plugins before the app is finished.
+fn create_app_with(extra: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins,
         AssetPlugin::default(),
         RwtPlugin::default().with_spawn_budget(50_000),
     ));
+    extra(&mut app);
     app.finish();
     app.cleanup();
     app
@@ -468,4 +474,44 @@ fn a_camera_streams_what_it_can_see() {
             .any(|p| p.x > 10.0 && p.z.abs() > p.x * 1.6 + 24.0),
         "outside the cone"
     );
+}
+
+#[test]
+fn gizmos_outline_loaded_chunks_and_their_tiles() {
+    use crate::debug::{RwtGizmos, outlines};
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let l = app
+        .world_mut()
+        .spawn(layer(LayerDensity::Constant(0.1)))
+        .id();
+    tick_app(&mut app, 2_000);
+    let (layer, state) = app
+        .world_mut()
+        .query::<(&ScatterLayer, &LayerState)>()
+        .get(app.world(), l)
+        .unwrap();
+    let chunks = state.loaded();
+    let only_chunks = outlines(
+        layer,
+        state,
+        &RwtGizmos {
+            chunks: true,
+            tiles: false,
+            lift: 0.1,
+        },
+    );
+    assert_eq!(only_chunks.len(), chunks);
+    let both = outlines(
+        layer,
+        state,
+        &RwtGizmos {
+            chunks: true,
+            tiles: true,
+            lift: 0.1,
+        },
+    );
+    // Chunks of 16 over tiles of 8: four tiles per chunk.
+    assert_eq!(both.iter().filter(|o| o.2).count(), 4 * chunks);
+    assert!(both.iter().filter(|o| o.2).all(|o| o.1 == 8.0));
 }
