@@ -494,8 +494,9 @@ pub fn on_layer_removed(
             commands.entity(e).try_despawn();
         }
     }
+    // The entity may be being despawned: removing then is a silent no-op.
     if let Ok(mut e) = commands.get_entity(remove.entity) {
-        e.remove::<LayerState>();
+        e.try_remove::<LayerState>();
     }
 }
 
