@@ -9,13 +9,16 @@ use rwt_core::density::ImageDensity;
 /// read on the CPU (compressed formats, GPU-only images).
 pub fn from_bevy_image(image: &Image, min: Vec2, size: Vec2, scale: f64) -> Option<ImageDensity> {
     let (w, h) = (image.width(), image.height());
-    let mut values = Vec::with_capacity((w * h) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let c = image.get_color_at(x, y).ok()?.to_linear();
-            values.push(0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue);
+    let values = luminance_fast(image).or_else(|| {
+        let mut values = Vec::with_capacity((w * h) as usize);
+        for y in 0..h {
+            for x in 0..w {
+                let c = image.get_color_at(x, y).ok()?.to_linear();
+                values.push(0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue);
+            }
         }
-    }
+        Some(values)
+    })?;
     // rwt's y axis is the ground's z: the image's top row lies along the max-z edge.
     ImageDensity::from_values(
         w,
@@ -26,4 +29,79 @@ pub fn from_bevy_image(image: &Image, min: Vec2, size: Vec2, scale: f64) -> Opti
         scale,
     )
     .ok()
+}
+
+/// Linear luminance straight from the bytes of the common 8-bit formats (painted maps are
+/// re-read on every stroke, so this path matters); `None` for other formats.
+fn luminance_fast(image: &Image) -> Option<Vec<f32>> {
+    use bevy::render::render_resource::TextureFormat as F;
+    let data = image.data.as_ref()?;
+    let pixels = (image.width() * image.height()) as usize;
+    let srgb: [f32; 256] = std::array::from_fn(|i| {
+        let c = i as f32 / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    });
+    let linear: [f32; 256] = std::array::from_fn(|i| i as f32 / 255.0);
+    let (channels, table) = match image.texture_descriptor.format {
+        F::Rgba8Unorm => (4, &linear),
+        F::Rgba8UnormSrgb => (4, &srgb),
+        F::R8Unorm => (1, &linear),
+        _ => return None,
+    };
+    if data.len() < pixels * channels {
+        return None;
+    }
+    Some(
+        data.chunks_exact(channels)
+            .take(pixels)
+            .map(|p| {
+                if channels == 1 {
+                    table[p[0] as usize]
+                } else {
+                    0.2126 * table[p[0] as usize]
+                        + 0.7152 * table[p[1] as usize]
+                        + 0.0722 * table[p[2] as usize]
+                }
+            })
+            .collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+
+    #[test]
+    fn fast_path_matches_the_generic_one() {
+        for format in [TextureFormat::Rgba8Unorm, TextureFormat::Rgba8UnormSrgb] {
+            let mut img = Image::new_fill(
+                Extent3d {
+                    width: 8,
+                    height: 8,
+                    depth_or_array_layers: 1,
+                },
+                TextureDimension::D2,
+                &[10, 120, 240, 255],
+                format,
+                Default::default(),
+            );
+            img.set_color_at(3, 5, Color::srgb(0.9, 0.1, 0.4)).unwrap();
+            let fast = luminance_fast(&img).unwrap();
+            for y in 0..8 {
+                for x in 0..8 {
+                    let c = img.get_color_at(x, y).unwrap().to_linear();
+                    let slow = 0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue;
+                    assert!(
+                        (fast[(y * 8 + x) as usize] - slow).abs() < 1e-3,
+                        "{format:?} {x} {y}"
+                    );
+                }
+            }
+        }
+    }
 }
