@@ -9,7 +9,7 @@
 //!     chunk_size: 32.0,
 //!     load_distance: 256.0,
 //!     unload_distance: 320.0,
-//!     falloff: Some((40.0, 200.0)),
+//!     falloff: (40.0, 200.0),
 //!     classes: [
 //!         (density: Noise(seed: 1, frequency: 0.02, octaves: 4, base: 0.2, amplitude: 0.8, scale: 0.4),
 //!          mesh: Cone(radius: 0.6, height: 2.5), material: Color(0.15, 0.4, 0.15)),
@@ -22,7 +22,7 @@
 use crate::layer::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
 use bevy::asset::{AssetLoader, LoadContext, io::Reader};
 use bevy::prelude::*;
-use rwt_core::density::NoiseDensity;
+use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::StreamingConfig;
 use serde::Deserialize;
 
@@ -41,20 +41,7 @@ pub enum DensityDescription {
     /// Instances per square unit.
     Constant(f64),
     /// Fractal noise (see [`NoiseDensity`]).
-    Noise {
-        /// Seed.
-        seed: u32,
-        /// Cycles per unit.
-        frequency: f64,
-        /// Octaves.
-        octaves: usize,
-        /// Offset of the noise value.
-        base: f64,
-        /// Gain of the noise value.
-        amplitude: f64,
-        /// Instances per square unit at value 1.
-        scale: f64,
-    },
+    Noise(NoiseParams),
     /// A painted map (asset path), over the ground rectangle `min..min + size` (x, z).
     Image {
         /// Asset path of the image.
@@ -181,9 +168,12 @@ pub enum LayerFileError {
 impl LayerDescription {
     /// Parses and checks a layer file.
     pub fn from_ron(text: &str) -> Result<Self, LayerFileError> {
-        // Optional fields take plain values (`chunk_size: 16.0`) as well as `Some(..)`.
-        let options = ron::Options::default()
-            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+        // Optional fields take plain values (`falloff: (40.0, 200.0)`, not `Some(..)`), and
+        // `Noise(seed: 1, ..)` needs no inner parentheses.
+        let options = ron::Options::default().with_default_extension(
+            ron::extensions::Extensions::IMPLICIT_SOME
+                | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES,
+        );
         let d: LayerDescription = options
             .from_str(text)
             .map_err(|e| LayerFileError::Parse(e.to_string()))?;
@@ -222,16 +212,9 @@ impl LayerDescription {
             .map(|c| ScatterClass {
                 density: match &c.density {
                     DensityDescription::Constant(v) => LayerDensity::Constant(*v),
-                    DensityDescription::Noise {
-                        seed,
-                        frequency,
-                        octaves,
-                        base,
-                        amplitude,
-                        scale,
-                    } => LayerDensity::Noise(NoiseDensity::new(
-                        *seed, *frequency, *octaves, *base, *amplitude, *scale,
-                    )),
+                    DensityDescription::Noise(params) => {
+                        LayerDensity::Noise(NoiseDensity::from_params(*params))
+                    }
                     DensityDescription::Image {
                         path,
                         min,
@@ -373,7 +356,7 @@ mod tests {
         chunk_size: 16.0,
         load_distance: 48.0,
         unload_distance: 64.0,
-        falloff: Some((20.0, 60.0)),
+        falloff: (20.0, 60.0),
         classes: [
             (density: Constant(0.4), mesh: Cone(radius: 0.5, height: 2.0), material: Color(0.1, 0.5, 0.1)),
             (density: Noise(seed: 1, frequency: 0.1, octaves: 3, base: 0.5, amplitude: 0.5, scale: 0.2),

@@ -323,6 +323,23 @@ pub struct NoiseDensity {
     lipschitz: f64,
 }
 
+/// The parameters of a [`NoiseDensity`], as plain (serializable) data.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct NoiseParams {
+    /// Noise seed.
+    pub seed: u32,
+    /// Cycles per world unit.
+    pub frequency: f64,
+    /// Octaves (1..=16).
+    pub octaves: usize,
+    /// Offset of the noise value.
+    pub base: f64,
+    /// Gain of the noise value.
+    pub amplitude: f64,
+    /// Points per unit area at value 1.
+    pub scale: f64,
+}
+
 /// Bound of the gradient magnitude of the `noise` crate's 2D Perlin noise: the largest
 /// central-difference gradient over 10^7 random samples was 3.89; doubled for safety.
 const PERLIN_GRADIENT_BOUND: f64 = 8.0;
@@ -357,6 +374,11 @@ impl NoiseDensity {
             scale,
             lipschitz,
         }
+    }
+
+    /// The density described by `params`.
+    pub fn from_params(p: NoiseParams) -> Self {
+        Self::new(p.seed, p.frequency, p.octaves, p.base, p.amplitude, p.scale)
     }
 
     #[inline]
