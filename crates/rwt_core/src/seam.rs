@@ -69,8 +69,9 @@ pub fn merge(
 ) -> (Vec<SourcedPoint>, Vec<DVec2>) {
     let union: Vec<SourcedPoint> = current.iter().chain(incoming).copied().collect();
     let seam = seam_path(&union, side, strip);
-    let polygon = side_polygon(&seam, side);
-    let from_incoming = |p: &SourcedPoint| point_in_polygon(p.pos, &polygon);
+    // The seam runs from one corner of the side to the other, so the polygon it closes
+    // (last point back to the first) is the region between the seam and the side.
+    let from_incoming = |p: &SourcedPoint| point_in_polygon(p.pos, &seam);
     let mut merged: Vec<SourcedPoint> = current
         .iter()
         .filter(|p| !from_incoming(p))
@@ -78,13 +79,6 @@ pub fn merge(
         .collect();
     merged.extend(incoming.iter().filter(|p| from_incoming(p)).copied());
     (merged, seam)
-}
-
-/// The region owned by the incoming tile: the seam closed along the side itself.
-fn side_polygon(seam: &[DVec2], _side: Side) -> Vec<DVec2> {
-    // The seam runs from one corner of the side to the other, so closing the polyline
-    // (last -> first) follows the side exactly.
-    seam.to_vec()
 }
 
 /// The two corners a side's seam joins, in a fixed order.

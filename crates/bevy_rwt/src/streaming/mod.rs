@@ -95,7 +95,14 @@ impl LayerState {
         self.states.values().map(|c| c.queued.len()).sum()
     }
 
-    /// Every instance entity of the layer (for despawning it).
+    /// Despawns every instance the layer has placed or was about to remove.
+    fn despawn_all(&self, commands: &mut Commands) {
+        for e in self.entities().chain(self.despawn.iter().copied()) {
+            commands.entity(e).try_despawn();
+        }
+    }
+
+    /// Every instance entity of the layer.
     pub fn entities(&self) -> impl Iterator<Item = Entity> + '_ {
         self.states
             .values()
@@ -490,9 +497,7 @@ pub fn on_layer_removed(
     mut commands: Commands,
 ) {
     if let Ok(state) = states.get(remove.entity) {
-        for e in state.entities().chain(state.despawn.iter().copied()) {
-            commands.entity(e).try_despawn();
-        }
+        state.despawn_all(&mut commands);
     }
     // The entity may be being despawned: removing then is a silent no-op.
     if let Ok(mut e) = commands.get_entity(remove.entity) {
@@ -508,9 +513,7 @@ pub fn on_layer_inserted(
     mut commands: Commands,
 ) {
     if let Ok(old) = states.get(insert.entity) {
-        for e in old.entities().chain(old.despawn.iter().copied()) {
-            commands.entity(e).try_despawn();
-        }
+        old.despawn_all(&mut commands);
     }
     commands.entity(insert.entity).insert(LayerState::default());
 }
