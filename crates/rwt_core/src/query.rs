@@ -1,11 +1,17 @@
 //! Random-access blue-noise queries (paper sections 3 and 5.2).
 //!
 //! For a rectangle and a density, every base tile over the rectangle contributes its points
-//! whose rank is below `density x tile area`; where the density's maximum over a tile asks
+//! whose rank plus the tile's offset is below `density x tile area`; where the density's maximum over a tile asks
 //! for more than the tile holds, the tile's subdivision ranking continues the sequence
 //! (ranks `N..n^2 N`), and where it asks for more than that, the children are visited in
 //! turn. Work and output are proportional to the integral of the density; nothing is
 //! allocated per tile (the recursion lives on the stack, results go to a callback).
+//!
+//! The offset is a number in `[0, 1)` hashed from the base tile's lattice position. Without
+//! it a tile's first point would appear at any positive density, so a density of 0.1
+//! points per tile would still put one point in every tile; with it, a tile's `k`-th point
+//! appears at `(k + offset) / area`, and the expected count is the integral at every
+//! density, however sparse.
 //!
 //! Every point is produced exactly once, at the coarsest level where it exists, with a
 //! stable [`PointId`]. A point is included exactly when the density at its position exceeds
@@ -26,6 +32,9 @@ pub const MAX_LEVEL: u32 = 24;
 /// Largest coordinate magnitude, in base tiles, a query may touch (keeps lattice indices of
 /// every level inside `i64`).
 pub const MAX_TILE_COORDINATE: f64 = 1.0e12;
+
+/// Hash stream of the per-base-tile rank offsets.
+const OFFSET_STREAM: u64 = 0x0ff5_e7a1_u64;
 
 /// A half-open rectangle `[min, max)` in world units.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -88,10 +97,14 @@ pub enum QueryError {
         /// Distance in base tiles.
         tiles: f64,
     },
-    /// The density asks for more points than the budget allows.
-    #[error("query may produce up to {estimate:.0} points, over the budget of {budget}")]
+    /// The query asks for more points, or spans more base tiles of positive density, than
+    /// the budget allows (see [`Sampler::work_bound`]).
+    #[error(
+        "query may produce up to {estimate:.0} points or tile visits, over the budget of {budget} \
+         (ask for a smaller rectangle, a lower density or larger tiles)"
+    )]
     BudgetExceeded {
-        /// Upper bound of the number of points.
+        /// Bound of the points plus base tiles visited.
         estimate: f64,
         /// The budget.
         budget: usize,
@@ -154,7 +167,8 @@ pub struct Point {
     /// Stable identity.
     pub id: PointId,
     /// The point is present wherever the density at its position exceeds this (points per
-    /// unit area): use it to fade points in, or to pick a level of detail.
+    /// unit area): use it to fade points in, or to pick a level of detail. Thresholds of one
+    /// base tile's points are `(rank + offset) / area` (see the module docs).
     pub threshold: f64,
     /// Class index (see [`Sampler::query_classes`]); 0 for single-density queries.
     pub class: u16,
@@ -273,11 +287,16 @@ impl Sampler {
         self.points_per_tile
     }
 
-    /// An upper bound of how many points `density` yields in `rect`, refined best-first
-    /// (the cell with the largest bound is split in four) until it fits the budget or 4096
-    /// bounds have been evaluated. A small dense spot in a huge empty region is bounded
-    /// tightly in a few hundred steps.
-    pub fn expected_upper_bound<D: Density + ?Sized>(&self, rect: &Rect, density: &D) -> f64 {
+    /// A bound of the work a query of `rect` does: the density's integral (the points it
+    /// yields on average) plus the tiles it visits where the density is positive (twice the
+    /// tiles of the deepest level it reaches, which covers the coarser levels). The second
+    /// term is negligible for wide rectangles but dominates for huge sparse or very thin
+    /// ones. Refined best-first (the cell
+    /// with the largest bound is split in four) until it fits the budget or 4096 bounds have
+    /// been evaluated, so a small dense spot in a huge empty region is bounded tightly in a
+    /// few hundred steps, and a huge region of very sparse density is refused instead of
+    /// visiting billions of tiles.
+    pub fn work_bound<D: Density + ?Sized>(&self, rect: &Rect, density: &D) -> f64 {
         #[derive(PartialEq)]
         struct Cell(f64, Rect);
         impl Eq for Cell {}
@@ -294,9 +313,22 @@ impl Sampler {
         if rect.is_empty() {
             return 0.0;
         }
+        let s = self.tile_size;
+        let n = self.n as f64;
+        let finest = s / n.powi(MAX_LEVEL as i32);
         let bound = |r: &Rect| {
-            let b = sanitize(density.max_over(r.min, r.max)) * r.area();
-            if b.is_nan() { f64::INFINITY } else { b }
+            let d = sanitize(density.max_over(r.min, r.max));
+            if d.is_nan() {
+                return f64::INFINITY;
+            }
+            if d <= 0.0 {
+                return 0.0;
+            }
+            // Tiles are visited down to the first level whose tiles ask for at most the
+            // full subdivision sequence: side s_deep with d * s_deep^2 <= n^2 N.
+            let s_deep = ((self.sub_len as f64 / d).sqrt() / n).clamp(finest, s);
+            let tiles = ((r.max.x - r.min.x) / s_deep + 2.0) * ((r.max.y - r.min.y) / s_deep + 2.0);
+            d * r.area() + 2.0 * tiles
         };
         let target = self.budget as f64;
         let first = bound(rect);
@@ -346,7 +378,7 @@ impl Sampler {
         mut emit: impl FnMut(Point),
     ) -> Result<usize, QueryError> {
         self.check(&rect)?;
-        let estimate = self.expected_upper_bound(&rect, density);
+        let estimate = self.work_bound(&rect, density);
         if estimate.is_nan() || estimate > self.budget as f64 {
             return Err(QueryError::BudgetExceeded {
                 estimate,
@@ -516,13 +548,16 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
             }
         }
         if level == 0 {
+            let offset = unit_f64(hash_words(
+                sampler.seed ^ OFFSET_STREAM,
+                &[ix as u64, iy as u64],
+            ));
             for (cell, points) in tile.base_cells.iter().enumerate() {
-                let lim = cell_limit[cell];
+                let lim = cell_limit[cell] - offset;
                 for cp in points.iter().take_while(|cp| (cp.rank as f64) < lim) {
                     let p = DVec2::new((ix as f64 + cp.frac[0]) * s, (iy as f64 + cp.frac[1]) * s);
-                    if self.rect.contains(p)
-                        && sanitize(self.density.density(p)) * area > cp.rank as f64
-                    {
+                    let rank = cp.rank as f64 + offset;
+                    if self.rect.contains(p) && sanitize(self.density.density(p)) * area > rank {
                         (self.emit)(Point {
                             position: p,
                             id: PointId {
@@ -531,7 +566,7 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
                                 y: iy,
                                 index: cp.index,
                             },
-                            threshold: cp.rank as f64 / area,
+                            threshold: rank / area,
                             class: 0,
                         });
                     }

@@ -375,3 +375,48 @@ fn warped_uniform_reference_follows_the_density_but_less_evenly() {
         local(&w)
     );
 }
+
+#[test]
+fn sparse_densities_give_their_integral_not_one_point_per_tile() {
+    // 0.1 points per tile over 100 x 100 tiles: 1000 on average (a first point in every tile
+    // would give 10000).
+    let mut out = Vec::new();
+    sampler(5)
+        .query(square(0.0, 100.0), &Constant(0.1), &mut out)
+        .unwrap();
+    let expected: f64 = 1000.0;
+    let sigma = expected.sqrt();
+    assert!(
+        (out.len() as f64 - expected).abs() < 4.0 * sigma,
+        "{} points",
+        out.len()
+    );
+    // Still monotone: the first points at 0.1 are among those at 0.3.
+    let mut more = Vec::new();
+    sampler(5)
+        .query(square(0.0, 100.0), &Constant(0.3), &mut more)
+        .unwrap();
+    let ids: std::collections::HashSet<_> = more.iter().map(|p| p.id).collect();
+    assert!(out.iter().all(|p| ids.contains(&p.id)));
+    assert!(out.iter().all(|p| p.threshold < 0.1 && p.threshold >= 0.0));
+}
+
+#[test]
+fn huge_sparse_or_thin_queries_are_refused_not_walked() {
+    // Found by the never-panics property in CI: a rectangle 10^11 tiles wide at a density
+    // whose integral fits the budget used to visit every one of its 10^22 tiles.
+    let s = sampler(1).with_budget(100_000);
+    let huge = Rect::new(DVec2::splat(-5.0e10), DVec2::splat(5.0e10)).unwrap();
+    let e = s.query(huge, &Constant(1.0e-18), &mut Vec::new());
+    assert!(matches!(e, Err(QueryError::BudgetExceeded { .. })), "{e:?}");
+    // A strip 10^4 tiles long and 10^-200 thick at 10^200 points per unit area: its
+    // integral is 10^4, but serving it would descend to the deepest level along the strip.
+    let strip = Rect::new(DVec2::ZERO, DVec2::new(1.0e4, 1.0e-200)).unwrap();
+    let e = s.query(strip, &Constant(1.0e200), &mut Vec::new());
+    assert!(matches!(e, Err(QueryError::BudgetExceeded { .. })), "{e:?}");
+    // A thin strip that is affordable still works.
+    let strip = Rect::new(DVec2::ZERO, DVec2::new(10.0, 1.0e-3)).unwrap();
+    let mut out = Vec::new();
+    s.query(strip, &Constant(1.0e5), &mut out).unwrap();
+    assert!(out.iter().all(|p| strip.contains(p.position)));
+}
