@@ -1,0 +1,602 @@
+//! Texton painting (paper figure 10): paint a density map per texton class and watch the
+//! textons appear as one blue-noise set shared by all classes, each with a rotation hashed
+//! from its point's identity. Repainting re-queries only the brushed region, so textons
+//! elsewhere never move.
+//!
+//! `cargo run --release --example paint_density`
+//! - left mouse: paint the selected class, right mouse: erase it; 1-4 select the class,
+//!   E erases every class under the brush instead;
+//! - `[` / `]` brush size, Up / Down strength, C clears, Space compares with random placement;
+//! - S saves the maps (PNG) and the setup (RON) to `painted/` (or `RWT_PAINT_DIR`), L loads.
+
+use bevy::asset::RenderAssetUsages;
+use bevy::prelude::*;
+use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use glam::DVec2;
+use rwt_core::density::ImageDensity;
+use rwt_core::query::{PointId, Rect, Sampler};
+use rwt_core::rng::{hash_words, unit_f64};
+use rwt_core::tileset::TileSet;
+use rwt_examples::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+fn main() {
+    App::new()
+        .insert_resource(ClearColor(Color::srgb(0.93, 0.91, 0.85)))
+        .add_plugins((example_plugins("rwt paint_density"), SmokePlugin, HudPlugin))
+        .add_systems(Startup, setup)
+        .add_systems(
+            Update,
+            (
+                paint_script.run_if(|s: Res<Smoke>| s.active()),
+                paint_input.run_if(|s: Res<Smoke>| !s.active()),
+                place,
+                show_maps,
+                hud,
+            )
+                .chain(),
+        )
+        .run();
+}
+
+/// One texton class: its picture and how dense it is where its map is 1.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+struct ClassSetup {
+    name: String,
+    /// File in `assets/textons/`.
+    texton: String,
+    /// Textons per unit area where the map is white (the canvas is 1 x 1).
+    max_density: f64,
+    /// Texton size relative to the spacing at `max_density`.
+    size: f32,
+    /// Tint of the class on the map overlay.
+    tint: [f32; 3],
+}
+
+/// What `S` saves next to the maps: enough to paint on where you left off.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+struct PaintSetup {
+    seed: u64,
+    /// Map resolution (square).
+    map_size: usize,
+    classes: Vec<ClassSetup>,
+}
+
+impl Default for PaintSetup {
+    fn default() -> Self {
+        let class = |name: &str, max_density, size, tint| ClassSetup {
+            name: name.into(),
+            texton: format!("{name}.png"),
+            max_density,
+            size,
+            tint,
+        };
+        Self {
+            seed: 10,
+            map_size: 192,
+            classes: vec![
+                class("leaf", 1400.0, 1.5, [0.3, 0.6, 0.25]),
+                class("pebble", 900.0, 1.25, [0.55, 0.55, 0.55]),
+                class("flower", 700.0, 1.3, [0.85, 0.4, 0.6]),
+                class("starfish", 500.0, 1.3, [0.9, 0.5, 0.2]),
+            ],
+        }
+    }
+}
+
+#[derive(Resource)]
+struct Canvas {
+    setup: PaintSetup,
+    /// One map per class, row 0 at the top, values in [0, 1].
+    maps: Vec<Vec<f32>>,
+    /// World rectangle painted since the last placement.
+    dirty: Option<Rect>,
+    /// Show white-noise placement instead of blue noise.
+    random: bool,
+    sampler: Sampler,
+    textures: Vec<Handle<Image>>,
+    overlay: Handle<Image>,
+    live: HashMap<PointId, (Entity, u16, DVec2)>,
+    random_live: Vec<Entity>,
+    status: String,
+}
+
+impl Canvas {
+    fn clear(&mut self) {
+        let n = self.setup.map_size;
+        self.maps = vec![vec![0.0; n * n]; self.setup.classes.len()];
+        self.dirty = Some(whole());
+    }
+
+    /// Adds `amount` (negative erases) with a smooth fall-off inside `radius` of `centre`.
+    fn brush(&mut self, class: Option<usize>, centre: DVec2, radius: f64, amount: f32) {
+        let n = self.setup.map_size;
+        let texel = 1.0 / n as f64;
+        let (x0, x1) = (
+            ((centre.x - radius) / texel).floor().max(0.0) as usize,
+            (((centre.x + radius) / texel).ceil().max(0.0) as usize).min(n),
+        );
+        let (y0, y1) = (
+            ((1.0 - centre.y - radius) / texel).floor().max(0.0) as usize,
+            (((1.0 - centre.y + radius) / texel).ceil().max(0.0) as usize).min(n),
+        );
+        for (c, map) in self.maps.iter_mut().enumerate() {
+            if class.is_some_and(|k| k != c) {
+                continue;
+            }
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let p = DVec2::new((x as f64 + 0.5) * texel, 1.0 - (y as f64 + 0.5) * texel);
+                    let d = p.distance(centre) / radius;
+                    if d < 1.0 {
+                        let w = (1.0 - d * d) as f32;
+                        let v = &mut map[y * n + x];
+                        *v = (*v + amount * w).clamp(0.0, 1.0);
+                    }
+                }
+            }
+        }
+        let r = Rect {
+            min: (centre - radius - texel).max(DVec2::ZERO),
+            max: (centre + radius + texel).min(DVec2::ONE),
+        };
+        self.dirty = Some(match self.dirty {
+            Some(d) => Rect {
+                min: d.min.min(r.min),
+                max: d.max.max(r.max),
+            },
+            None => r,
+        });
+    }
+
+    fn densities(&self) -> Vec<ImageDensity> {
+        let n = self.setup.map_size;
+        self.setup
+            .classes
+            .iter()
+            .zip(&self.maps)
+            .filter_map(|(c, map)| {
+                ImageDensity::from_values(
+                    n as u32,
+                    n as u32,
+                    map,
+                    DVec2::ZERO,
+                    DVec2::ONE,
+                    c.max_density,
+                )
+                .ok()
+            })
+            .collect()
+    }
+
+    fn save(&self, dir: &Path) -> Result<(), String> {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let n = self.setup.map_size as u32;
+        for (c, map) in self.setup.classes.iter().zip(&self.maps) {
+            let bytes: Vec<u8> = map.iter().map(|v| (v * 255.0).round() as u8).collect();
+            let img = image::GrayImage::from_raw(n, n, bytes).ok_or("map size mismatch")?;
+            let path = dir.join(format!("{}.png", c.name));
+            img.save(&path)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        let ron = ron::ser::to_string_pretty(&self.setup, ron::ser::PrettyConfig::default())
+            .map_err(|e| e.to_string())?;
+        std::fs::write(dir.join("layer.ron"), ron).map_err(|e| e.to_string())
+    }
+
+    fn load(&mut self, dir: &Path) -> Result<(), String> {
+        let text = std::fs::read_to_string(dir.join("layer.ron"))
+            .map_err(|e| format!("{}: {e}", dir.join("layer.ron").display()))?;
+        let setup: PaintSetup = ron::from_str(&text).map_err(|e| format!("layer.ron: {e}"))?;
+        if setup.classes.len() != self.setup.classes.len() || setup.map_size == 0 {
+            return Err("layer.ron: class list differs from this example's textons".into());
+        }
+        let mut maps = Vec::new();
+        for c in &setup.classes {
+            let path = dir.join(format!("{}.png", c.name));
+            let img = image::open(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let img = img
+                .resize_exact(
+                    setup.map_size as u32,
+                    setup.map_size as u32,
+                    image::imageops::FilterType::Triangle,
+                )
+                .to_luma8();
+            maps.push(img.pixels().map(|p| p[0] as f32 / 255.0).collect());
+        }
+        self.setup = setup;
+        self.maps = maps;
+        self.sampler = Sampler::new(&TileSet::embedded(), self.setup.seed);
+        self.dirty = Some(whole());
+        Ok(())
+    }
+}
+
+fn whole() -> Rect {
+    Rect {
+        min: DVec2::ZERO,
+        max: DVec2::ONE,
+    }
+}
+
+#[derive(Resource)]
+struct Brush {
+    class: usize,
+    erase_all: bool,
+    radius: f64,
+    strength: f32,
+}
+
+fn save_dir() -> PathBuf {
+    std::env::var_os("RWT_PAINT_DIR").map_or_else(|| PathBuf::from("painted"), PathBuf::from)
+}
+
+fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<Assets<Image>>) {
+    let setup = PaintSetup::default();
+    let n = setup.map_size;
+    let textures = setup
+        .classes
+        .iter()
+        .map(|c| assets.load(format!("textons/{}", c.texton)))
+        .collect();
+    let overlay = images.add(Image::new_fill(
+        Extent3d {
+            width: n as u32,
+            height: n as u32,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        &[255, 255, 255, 255],
+        TextureFormat::Rgba8UnormSrgb,
+        RenderAssetUsages::default(),
+    ));
+    let mut canvas = Canvas {
+        sampler: Sampler::new(&TileSet::embedded(), setup.seed),
+        maps: Vec::new(),
+        setup,
+        dirty: None,
+        random: false,
+        textures,
+        overlay: overlay.clone(),
+        live: HashMap::new(),
+        random_live: Vec::new(),
+        status: String::new(),
+    };
+    canvas.clear();
+    commands.insert_resource(canvas);
+    commands.insert_resource(Brush {
+        class: 0,
+        erase_all: false,
+        radius: 0.06,
+        strength: 2.0,
+    });
+    commands.spawn(Camera2d);
+    commands.spawn((
+        MapOverlay,
+        Sprite {
+            image: overlay,
+            ..default()
+        },
+        Transform::from_xyz(0.0, 0.0, -1.0),
+    ));
+}
+
+#[derive(Component)]
+struct MapOverlay;
+
+/// Pixels per world unit: the canvas fills 92 % of the window's height.
+fn pixels_per_unit(window: &Window) -> f64 {
+    window.height() as f64 * 0.92
+}
+
+fn to_screen(p: DVec2, ppu: f64) -> Vec2 {
+    ((p - 0.5) * ppu).as_vec2()
+}
+
+/// The smoke session: a stroke per class, an eraser stroke, then a save, a clear and a load
+/// (so that the screenshot shows the maps read back from disk).
+fn paint_script(
+    smoke: Res<Smoke>,
+    mut canvas: ResMut<Canvas>,
+    mut done: Local<bool>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let t = smoke.progress() as f64;
+    let classes = canvas.setup.classes.len();
+    let span = 0.7 / classes as f64;
+    let class = ((t / span) as usize).min(classes);
+    if class < classes {
+        let s = (t - class as f64 * span) / span;
+        let y = 0.16 + 0.23 * class as f64 + 0.05 * (s * 9.0).sin();
+        canvas.brush(Some(class), DVec2::new(0.08 + 0.84 * s, y), 0.09, 0.35);
+        // A second, fainter pass of the next class overlapping this one: mixed regions.
+        canvas.brush(
+            Some((class + 1) % classes),
+            DVec2::new(0.9 - 0.8 * s, y + 0.1),
+            0.05,
+            0.15,
+        );
+    } else if t < 0.8 {
+        let s = (t - 0.7) / 0.1;
+        canvas.brush(None, DVec2::new(0.5 + 0.1 * s, 0.1 + 0.8 * s), 0.035, -1.0);
+    } else if !*done {
+        *done = true;
+        let dir = save_dir();
+        let saved = canvas.save(&dir);
+        canvas.clear();
+        let loaded = canvas.load(&dir);
+        if let Err(e) = saved.and(loaded) {
+            eprintln!("rwt-smoke: save and load in {}: {e}", dir.display());
+            exit.write(AppExit::error());
+            return;
+        }
+        println!(
+            "rwt-smoke: painted maps saved to and loaded from {}",
+            dir.display()
+        );
+    }
+}
+
+fn paint_input(
+    keys: Res<ButtonInput<KeyCode>>,
+    buttons: Res<ButtonInput<MouseButton>>,
+    time: Res<Time>,
+    windows: Query<&Window>,
+    mut canvas: ResMut<Canvas>,
+    mut brush: ResMut<Brush>,
+) {
+    for (i, key) in [
+        KeyCode::Digit1,
+        KeyCode::Digit2,
+        KeyCode::Digit3,
+        KeyCode::Digit4,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        if keys.just_pressed(key) && i < canvas.setup.classes.len() {
+            brush.class = i;
+            brush.erase_all = false;
+        }
+    }
+    if keys.just_pressed(KeyCode::KeyE) {
+        brush.erase_all = !brush.erase_all;
+    }
+    if keys.just_pressed(KeyCode::BracketLeft) {
+        brush.radius = (brush.radius / 1.25).max(0.005);
+    }
+    if keys.just_pressed(KeyCode::BracketRight) {
+        brush.radius = (brush.radius * 1.25).min(0.5);
+    }
+    if keys.just_pressed(KeyCode::ArrowUp) {
+        brush.strength = (brush.strength * 1.5).min(20.0);
+    }
+    if keys.just_pressed(KeyCode::ArrowDown) {
+        brush.strength = (brush.strength / 1.5).max(0.05);
+    }
+    if keys.just_pressed(KeyCode::Space) {
+        canvas.random = !canvas.random;
+        canvas.dirty = Some(whole());
+    }
+    if keys.just_pressed(KeyCode::KeyC) {
+        canvas.clear();
+    }
+    if keys.just_pressed(KeyCode::KeyS) {
+        let dir = save_dir();
+        canvas.status = match canvas.save(&dir) {
+            Ok(()) => format!("saved to {}", dir.display()),
+            Err(e) => format!("save failed: {e}"),
+        };
+    }
+    if keys.just_pressed(KeyCode::KeyL) {
+        let dir = save_dir();
+        canvas.status = match canvas.load(&dir) {
+            Ok(()) => format!("loaded from {}", dir.display()),
+            Err(e) => format!("load failed: {e}"),
+        };
+    }
+    let Ok(window) = windows.single() else {
+        return;
+    };
+    let Some(cursor) = window.cursor_position() else {
+        return;
+    };
+    let ppu = pixels_per_unit(window);
+    let p = DVec2::new(
+        (cursor.x - window.width() / 2.0) as f64,
+        (window.height() / 2.0 - cursor.y) as f64,
+    ) / ppu
+        + 0.5;
+    let amount = brush.strength * time.delta_secs();
+    let target = (!brush.erase_all).then_some(brush.class);
+    if buttons.pressed(MouseButton::Left) {
+        let sign = if brush.erase_all { -1.0 } else { 1.0 };
+        canvas.brush(target, p, brush.radius, sign * amount);
+    } else if buttons.pressed(MouseButton::Right) {
+        canvas.brush(target, p, brush.radius, -amount);
+    }
+}
+
+fn place(mut commands: Commands, windows: Query<&Window>, mut canvas: ResMut<Canvas>) {
+    let Some(dirty) = canvas.dirty.take() else {
+        return;
+    };
+    let Ok(window) = windows.single() else {
+        return;
+    };
+    let ppu = pixels_per_unit(window);
+    let densities = canvas.densities();
+    let canvas = &mut *canvas;
+    for e in canvas.random_live.drain(..) {
+        commands.entity(e).despawn();
+    }
+    let mut wanted: Vec<(PointId, u16, DVec2)> = Vec::new();
+    if canvas.random {
+        // Comparison: white noise with the same densities (rejection sampling).
+        for (_, (e, _, _)) in canvas.live.drain() {
+            commands.entity(e).despawn();
+        }
+        let total: f64 = canvas.setup.classes.iter().map(|c| c.max_density).sum();
+        for k in 0..total as u64 {
+            let h = |salt| unit_f64(hash_words(canvas.setup.seed, &[k, salt]));
+            let p = DVec2::new(h(1), h(2));
+            let mut u = h(3) * total;
+            for (class, d) in densities.iter().enumerate() {
+                let v = rwt_core::density::Density::density(d, p);
+                if u < v {
+                    let id = PointId {
+                        level: 255,
+                        x: k as i64,
+                        y: 0,
+                        index: 0,
+                    };
+                    let e = spawn_texton(&mut commands, canvas, id, class as u16, p, ppu);
+                    canvas.random_live.push(e);
+                    break;
+                }
+                u -= v;
+            }
+        }
+        return;
+    }
+    let _ = canvas.sampler.query_classes(dirty, &densities, |p| {
+        wanted.push((p.id, p.class, p.position))
+    });
+    let fresh: HashMap<PointId, (u16, DVec2)> =
+        wanted.iter().map(|&(id, c, p)| (id, (c, p))).collect();
+    // Only the painted rectangle changes: what is outside it stays as it is.
+    canvas.live.retain(|id, (e, class, p)| {
+        let keep = !dirty.contains(*p) || fresh.get(id).is_some_and(|(c, _)| c == class);
+        if !keep {
+            commands.entity(*e).despawn();
+        }
+        keep
+    });
+    for (id, (class, p)) in fresh {
+        if !canvas.live.contains_key(&id) {
+            let e = spawn_texton(&mut commands, canvas, id, class, p, ppu);
+            canvas.live.insert(id, (e, class, p));
+        }
+    }
+}
+
+fn spawn_texton(
+    commands: &mut Commands,
+    canvas: &Canvas,
+    id: PointId,
+    class: u16,
+    p: DVec2,
+    ppu: f64,
+) -> Entity {
+    let c = &canvas.setup.classes[class as usize];
+    let seed = canvas.setup.seed;
+    let size = (c.size as f64 / c.max_density.sqrt() * ppu * id.scale(seed, 0.15)) as f32;
+    let at = to_screen(p, ppu);
+    commands
+        .spawn((
+            CountedInstance,
+            Sprite {
+                image: canvas.textures[class as usize].clone(),
+                custom_size: Some(Vec2::splat(size)),
+                ..default()
+            },
+            Transform::from_xyz(
+                at.x,
+                at.y,
+                0.1 * class as f32 + unit_f64(id.hash(seed, 9)) as f32 * 0.05,
+            )
+            .with_rotation(Quat::from_rotation_z(id.rotation(seed) as f32)),
+        ))
+        .id()
+}
+
+/// The maps, tinted by class over white, behind the textons.
+fn show_maps(
+    canvas: Res<Canvas>,
+    windows: Query<&Window>,
+    mut images: ResMut<Assets<Image>>,
+    mut overlay: Query<&mut Sprite, With<MapOverlay>>,
+) {
+    if let (Ok(window), Ok(mut sprite)) = (windows.single(), overlay.single_mut()) {
+        let side = pixels_per_unit(window) as f32;
+        if sprite.custom_size != Some(Vec2::splat(side)) {
+            sprite.custom_size = Some(Vec2::splat(side));
+        }
+    }
+    if !canvas.is_changed() {
+        return;
+    }
+    let Some(mut image) = images.get_mut(&canvas.overlay) else {
+        return;
+    };
+    let Some(data) = image.data.as_mut() else {
+        return;
+    };
+    let n = canvas.setup.map_size;
+    for (i, px) in data.chunks_exact_mut(4).enumerate().take(n * n) {
+        let mut rgb = Vec3::splat(1.0);
+        for (c, map) in canvas.setup.classes.iter().zip(&canvas.maps) {
+            let w = map[i] * 0.45;
+            rgb = rgb.lerp(Vec3::from_array(c.tint), w);
+        }
+        px.copy_from_slice(&[
+            (rgb.x * 255.0) as u8,
+            (rgb.y * 255.0) as u8,
+            (rgb.z * 255.0) as u8,
+            255,
+        ]);
+    }
+}
+
+fn hud(
+    canvas: Res<Canvas>,
+    brush: Res<Brush>,
+    live: Res<LiveInstances>,
+    windows: Query<&Window>,
+    mut gizmos: Gizmos,
+    mut hud: ResMut<Hud>,
+) {
+    let names: Vec<String> = canvas
+        .setup
+        .classes
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let mark = if i == brush.class && !brush.erase_all {
+                ">"
+            } else {
+                " "
+            };
+            format!("{mark}{} {}", i + 1, c.name)
+        })
+        .collect();
+    hud.lines = vec![
+        "rwt paint_density: left paint, right erase, 1-4 class, E erase all, [ ] size, Up/Down strength".into(),
+        "Space random/blue noise, C clear, S save, L load".into(),
+        format!(
+            "{}   brush {:.3}, strength {:.2}{}",
+            names.join("  "),
+            brush.radius,
+            brush.strength,
+            if brush.erase_all { ", ERASER" } else { "" }
+        ),
+        format!(
+            "{}: {} textons   {}",
+            if canvas.random { "random (white noise)" } else { "blue noise (rwt)" },
+            live.0,
+            canvas.status
+        ),
+    ];
+    if let Ok(window) = windows.single()
+        && let Some(cursor) = window.cursor_position()
+    {
+        let ppu = pixels_per_unit(window);
+        let at = Vec2::new(
+            cursor.x - window.width() / 2.0,
+            window.height() / 2.0 - cursor.y,
+        );
+        gizmos.circle_2d(at, (brush.radius * ppu) as f32, Color::srgb(0.2, 0.2, 0.2));
+    }
+}

@@ -1,0 +1,53 @@
+//! A text overlay in the top-left corner; examples write its lines every frame.
+
+use bevy::prelude::*;
+
+/// The HUD's lines; examples overwrite them, [`HudPlugin`] shows them.
+#[derive(Resource, Default, Debug, Clone)]
+pub struct Hud {
+    /// One entry a line.
+    pub lines: Vec<String>,
+}
+
+#[derive(Component)]
+struct HudText;
+
+/// Spawns the overlay and keeps it in sync with [`Hud`].
+pub struct HudPlugin;
+
+impl Plugin for HudPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<Hud>()
+            .add_systems(Startup, spawn)
+            .add_systems(PostUpdate, show);
+    }
+}
+
+fn spawn(mut commands: Commands) {
+    commands.spawn((
+        HudText,
+        Text::new(""),
+        TextFont::from_font_size(15.0),
+        TextColor(Color::WHITE),
+        Node {
+            position_type: PositionType::Absolute,
+            top: Val::Px(8.0),
+            left: Val::Px(10.0),
+            padding: UiRect::all(Val::Px(6.0)),
+            ..default()
+        },
+        BackgroundColor(Color::srgba(0.0, 0.0, 0.0, 0.55)),
+    ));
+}
+
+fn show(hud: Res<Hud>, mut text: Query<&mut Text, With<HudText>>) {
+    if !hud.is_changed() {
+        return;
+    }
+    let joined = hud.lines.join("\n");
+    for mut t in &mut text {
+        if t.0 != joined {
+            t.0.clone_from(&joined);
+        }
+    }
+}

@@ -1,0 +1,185 @@
+//! The scripted session CI runs in a real renderer.
+//!
+//! `RWT_SCREENSHOT=path.png` makes an example play its script (a flight, painted strokes, a
+//! zoom), take a screenshot after `RWT_EXIT_AFTER_FRAMES` frames (default 300), print its
+//! live instance count and exit with status 0. `RWT_EXIT_AFTER_FRAMES` alone runs the script
+//! and exits without a screenshot. A screenshot that never arrives exits with an error.
+
+use bevy::app::AppExit;
+use bevy::prelude::*;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy_rwt::ScatterInstance;
+use std::path::PathBuf;
+
+/// The smoke session's settings and frame counter.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct Smoke {
+    /// Where to save the screenshot.
+    pub screenshot: Option<PathBuf>,
+    /// Frames before the screenshot (or the exit); `None` outside a smoke session.
+    pub exit_after: Option<u32>,
+    /// Frames played so far.
+    pub frame: u32,
+}
+
+impl Smoke {
+    /// Reads `RWT_SCREENSHOT` and `RWT_EXIT_AFTER_FRAMES`.
+    pub fn from_env() -> Self {
+        let screenshot = std::env::var_os("RWT_SCREENSHOT").map(PathBuf::from);
+        let frames = std::env::var("RWT_EXIT_AFTER_FRAMES")
+            .ok()
+            .and_then(|v| v.trim().parse::<u32>().ok());
+        let exit_after = match (&screenshot, frames) {
+            (_, Some(n)) => Some(n.max(1)),
+            (Some(_), None) => Some(300),
+            (None, None) => None,
+        };
+        Self {
+            screenshot,
+            exit_after,
+            frame: 0,
+        }
+    }
+
+    /// Whether a scripted session runs.
+    pub fn active(&self) -> bool {
+        self.exit_after.is_some()
+    }
+
+    /// Progress of the script in `[0, 1]` (0 outside a smoke session).
+    pub fn progress(&self) -> f32 {
+        self.exit_after
+            .map_or(0.0, |n| (self.frame as f32 / n as f32).min(1.0))
+    }
+}
+
+/// Marks an instance an example spawns itself (outside `bevy_rwt`), so that it is counted.
+#[derive(Component, Default)]
+pub struct CountedInstance;
+
+/// Live instances: `bevy_rwt` instances plus [`CountedInstance`]s, updated every frame.
+#[derive(Resource, Default, Debug, Clone, Copy)]
+pub struct LiveInstances(pub usize);
+
+/// Runs the smoke session when the environment asks for one; counts instances always.
+pub struct SmokePlugin;
+
+impl Plugin for SmokePlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(Smoke::from_env())
+            .init_resource::<LiveInstances>()
+            .init_resource::<Shots>()
+            .add_systems(First, count_frame)
+            .add_systems(Last, (count_instances, finish).chain());
+    }
+}
+
+fn count_frame(mut smoke: ResMut<Smoke>) {
+    if smoke.active() {
+        smoke.frame += 1;
+    }
+}
+
+fn count_instances(
+    mut live: ResMut<LiveInstances>,
+    scattered: Query<(), With<ScatterInstance>>,
+    counted: Query<(), With<CountedInstance>>,
+) {
+    live.0 = scattered.iter().len() + counted.iter().len();
+}
+
+/// Frames to wait for a screenshot with something on it before giving up.
+const SCREENSHOT_PATIENCE: u32 = 900;
+/// Luminance variance (0..255 scale) below which a screenshot counts as blank: the first
+/// frames of a software renderer show only the clear colour while pipelines compile.
+pub const BLANK_VARIANCE: f64 = 20.0;
+
+/// The screenshot in progress.
+#[derive(Resource, Default)]
+struct Shots {
+    next: Option<u32>,
+    pending: bool,
+}
+
+fn finish(
+    mut commands: Commands,
+    smoke: Res<Smoke>,
+    live: Res<LiveInstances>,
+    mut shots: ResMut<Shots>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let Some(last) = smoke.exit_after else {
+        return;
+    };
+    let Some(path) = smoke.screenshot.clone() else {
+        if smoke.frame == last {
+            println!("rwt-smoke: instances {}", live.0);
+            exit.write(AppExit::Success);
+        }
+        return;
+    };
+    if smoke.frame == last {
+        shots.next = Some(last);
+    }
+    if smoke.frame > last + SCREENSHOT_PATIENCE {
+        eprintln!(
+            "rwt-smoke: no screenshot with content for {}",
+            path.display()
+        );
+        exit.write(AppExit::error());
+        return;
+    }
+    if shots.pending || shots.next != Some(smoke.frame) {
+        return;
+    }
+    shots.pending = true;
+    commands.spawn(Screenshot::primary_window()).observe(
+        move |captured: On<ScreenshotCaptured>,
+              smoke: Res<Smoke>,
+              live: Res<LiveInstances>,
+              mut shots: ResMut<Shots>,
+              mut exit: MessageWriter<AppExit>| {
+            shots.pending = false;
+            let Ok(image) = captured.image.clone().try_into_dynamic() else {
+                eprintln!("rwt-smoke: screenshot not convertible");
+                exit.write(AppExit::error());
+                return;
+            };
+            let rgb = image.to_rgb8();
+            if luminance_variance(&rgb) < BLANK_VARIANCE {
+                // Still compiling pipelines: look again a little later.
+                shots.next = Some(smoke.frame + 10);
+                return;
+            }
+            exit.write(save(&path, &rgb, live.0));
+        },
+    );
+}
+
+/// Variance of the luminance of every fourth pixel, 0..255 scale.
+pub fn luminance_variance(rgb: &image::RgbImage) -> f64 {
+    let lum: Vec<f64> = rgb
+        .pixels()
+        .step_by(4)
+        .map(|p| 0.299 * p[0] as f64 + 0.587 * p[1] as f64 + 0.114 * p[2] as f64)
+        .collect();
+    let mean = lum.iter().sum::<f64>() / lum.len().max(1) as f64;
+    lum.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / lum.len().max(1) as f64
+}
+
+fn save(path: &std::path::Path, rgb: &image::RgbImage, instances: usize) -> AppExit {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        let _ = std::fs::create_dir_all(dir);
+    }
+    if let Err(e) = rgb.save(path) {
+        eprintln!("rwt-smoke: cannot write {}: {e}", path.display());
+        return AppExit::error();
+    }
+    println!(
+        "rwt-smoke: screenshot {} ({}x{}) instances {instances}",
+        path.display(),
+        rgb.width(),
+        rgb.height()
+    );
+    AppExit::Success
+}
