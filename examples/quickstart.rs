@@ -44,7 +44,7 @@ fn setup(
     };
     let bush = ScatterClass::new(
         density,
-        meshes.add(Sphere::new(0.35).mesh().ico(2).unwrap()),
+        meshes.add(Sphere::new(0.35).mesh().ico(1).unwrap()),
         materials.add(Color::srgb(0.18, 0.45, 0.16)),
     );
     commands.spawn(ScatterLayer::new(vec![bush]));

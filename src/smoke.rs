@@ -1,7 +1,7 @@
 //! The scripted session CI runs in a real renderer.
 //!
 //! `RWT_SCREENSHOT=path.png` makes an example play its script (a flight, painted strokes, a
-//! zoom), take a screenshot after `RWT_EXIT_AFTER_FRAMES` frames (default 300), print its
+//! zoom), take a screenshot after `RWT_EXIT_AFTER_FRAMES` frames (default 150), print its
 //! live instance count and exit with status 0. `RWT_EXIT_AFTER_FRAMES` alone runs the script
 //! and exits without a screenshot. A screenshot that never arrives exits with an error.
 
@@ -31,7 +31,7 @@ impl Smoke {
             .and_then(|v| v.trim().parse::<u32>().ok());
         let exit_after = match (&screenshot, frames) {
             (_, Some(n)) => Some(n.max(1)),
-            (Some(_), None) => Some(300),
+            (Some(_), None) => Some(150),
             (None, None) => None,
         };
         Self {
@@ -66,7 +66,14 @@ pub struct SmokePlugin;
 
 impl Plugin for SmokePlugin {
     fn build(&self, app: &mut App) {
-        app.insert_resource(Smoke::from_env())
+        let smoke = Smoke::from_env();
+        if smoke.active() {
+            // Software rendering: no multisampling, so a scripted frame stays cheap.
+            app.add_observer(|add: On<Add, Camera>, mut commands: Commands| {
+                commands.entity(add.entity).insert(Msaa::Off);
+            });
+        }
+        app.insert_resource(smoke)
             .init_resource::<LiveInstances>()
             .init_resource::<Shots>()
             .add_systems(First, count_frame)
