@@ -106,7 +106,10 @@ pub fn image_density(data: &[u8]) -> bool {
     for i in 0..16 {
         let p = rect.min + DVec2::new((i % 4) as f64 + 0.3, (i / 4) as f64 + 0.6);
         let v = d.density(p);
-        assert!(sanitize(v) <= sanitize(max), "density {v} above its maximum {max}");
+        assert!(
+            sanitize(v) <= sanitize(max),
+            "density {v} above its maximum {max}"
+        );
     }
     check_query(&Sampler::new(embedded(), 1).with_budget(50_000), rect, &d)
 }

@@ -5,6 +5,8 @@
 
 mod plugin;
 #[cfg(test)]
+mod soak_tests;
+#[cfg(test)]
 mod tests;
 
 pub use plugin::StreamingPlugin;
@@ -62,9 +64,14 @@ pub struct LayerState {
 }
 
 impl LayerState {
-    /// Live instances of the layer.
+    /// Live instances of the layer: those its chunks hold, plus those waiting in the
+    /// despawn queue (still in the world until their turn comes).
     pub fn live(&self) -> usize {
-        self.states.values().map(|c| c.instances.len()).sum()
+        self.states
+            .values()
+            .map(|c| c.instances.len())
+            .sum::<usize>()
+            + self.despawn.len()
     }
 
     /// Chunks with a generation task in flight or waiting for one.

@@ -27,7 +27,7 @@ fn create_app_with(extra: impl FnOnce(&mut App)) -> App {
 }
 
 /// Runs frames until nothing is pending or queued (or `max` frames).
-fn tick_app(app: &mut App, max: usize) {
+pub(super) fn tick_app(app: &mut App, max: usize) {
     for _ in 0..max {
         app.update();
         let s = app.world().resource::<RwtStats>();
@@ -44,7 +44,7 @@ fn tick_app(app: &mut App, max: usize) {
 }
 
 /// A `size x size` image of one colour.
-fn solid_image(size: u32, rgba: [u8; 4]) -> Image {
+pub(super) fn solid_image(size: u32, rgba: [u8; 4]) -> Image {
     use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
     Image::new_fill(
         Extent3d {
@@ -59,7 +59,7 @@ fn solid_image(size: u32, rgba: [u8; 4]) -> Image {
     )
 }
 
-fn streaming() -> StreamingConfig {
+pub(super) fn streaming() -> StreamingConfig {
     StreamingConfig {
         chunk_size: 16.0,
         load_distance: 48.0,
@@ -68,7 +68,7 @@ fn streaming() -> StreamingConfig {
     }
 }
 
-fn layer(density: LayerDensity) -> ScatterLayer {
+pub(super) fn layer(density: LayerDensity) -> ScatterLayer {
     let class = ScatterClass::new(density, Handle::default(), Handle::default());
     ScatterLayer::new(vec![class])
         .with_tile_size(8.0)
@@ -76,7 +76,7 @@ fn layer(density: LayerDensity) -> ScatterLayer {
         .with_streaming(streaming())
 }
 
-fn spawn_viewer(app: &mut App, at: Vec3) -> Entity {
+pub(super) fn spawn_viewer(app: &mut App, at: Vec3) -> Entity {
     app.world_mut()
         .spawn((
             RwtViewer::all_around(),
@@ -86,13 +86,13 @@ fn spawn_viewer(app: &mut App, at: Vec3) -> Entity {
         .id()
 }
 
-fn move_viewer(app: &mut App, viewer: Entity, at: Vec3) {
+pub(super) fn move_viewer(app: &mut App, viewer: Entity, at: Vec3) {
     let mut e = app.world_mut().entity_mut(viewer);
     *e.get_mut::<Transform>().unwrap() = Transform::from_translation(at);
     *e.get_mut::<GlobalTransform>().unwrap() = GlobalTransform::from_translation(at);
 }
 
-fn instances(app: &mut App) -> HashMap<rwt_core::query::PointId, Vec3> {
+pub(super) fn instances(app: &mut App) -> HashMap<rwt_core::query::PointId, Vec3> {
     let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
     let mut out = HashMap::new();
     for (i, t) in q.iter(app.world()) {

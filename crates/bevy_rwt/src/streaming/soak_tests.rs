@@ -1,0 +1,192 @@
+//! The streaming soak test: a long random walk with painting and layer changes, checked
+//! every frame for duplicate identities and every few hundred frames for bounded entity,
+//! task and memory counts; back at the start, the world is as it was.
+
+use super::tests::{layer, move_viewer, solid_image, spawn_viewer, tick_app};
+use super::*;
+use crate::layer::LayerDensity;
+use crate::{RwtPlugin, RwtStats};
+use bevy::asset::AssetPlugin;
+use rwt_core::rng::Rng;
+
+/// Frames of the walk (each one `app.update()`, without waiting for streaming to settle).
+const FRAMES: usize = 10_000;
+
+/// Live instances by (layer seed, identity); panics when one layer has two instances with
+/// the same identity.
+fn instances(app: &mut App) -> HashMap<(u64, PointId), Vec3> {
+    let mut layers = app.world_mut().query::<(Entity, &ScatterLayer)>();
+    let seeds: HashMap<Entity, u64> = layers.iter(app.world()).map(|(e, l)| (e, l.seed)).collect();
+    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut out = HashMap::new();
+    for (i, t) in q.iter(app.world()) {
+        let seed = seeds[&i.layer];
+        assert!(
+            out.insert((seed, i.id), t.translation).is_none(),
+            "two live instances of layer {seed} share {:?}",
+            i.id
+        );
+    }
+    out
+}
+
+/// Entities in the world.
+fn entity_count(app: &mut App) -> usize {
+    app.world_mut().query::<Entity>().iter(app.world()).count()
+}
+
+/// Resident memory of this process in bytes (Linux), or 0 where unknown.
+fn resident_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/statm")
+        .ok()
+        .and_then(|s| s.split_whitespace().nth(1)?.parse::<u64>().ok())
+        .map_or(0, |pages| pages * 4096)
+}
+
+#[test]
+fn a_long_random_walk_with_painting_and_layer_changes() {
+    // Small per-frame budgets so that queues, in-flight tasks and cancelled chunks are
+    // exercised on every step of the walk.
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        RwtPlugin::default()
+            .with_spawn_budget(400)
+            .with_despawn_budget(400)
+            .with_max_tasks(6),
+    ));
+    app.finish();
+    app.cleanup();
+    let viewer = spawn_viewer(&mut app, Vec3::ZERO);
+    let size = 64u32;
+    let original = solid_image(size, [90, 90, 90, 255]);
+    let map = app
+        .world_mut()
+        .resource_mut::<Assets<Image>>()
+        .add(original.clone());
+    let painted = layer(LayerDensity::Image {
+        image: map.clone(),
+        min: Vec2::splat(-200.0),
+        size: Vec2::splat(400.0),
+        scale: 0.6,
+    })
+    .with_seed(5)
+    .with_falloff(20.0, 48.0);
+    app.world_mut().spawn(painted);
+    let constant = layer(LayerDensity::Constant(0.2));
+    let mut second = app.world_mut().spawn(constant.clone()).id();
+    tick_app(&mut app, 3_000);
+    let start = instances(&mut app);
+    let start_entities = entity_count(&mut app);
+    assert!(start.len() > 500, "{} instances at the start", start.len());
+
+    let mut rng = Rng::new(2006, 1);
+    let mut at = Vec2::ZERO;
+    let mut heading = 0.0f32;
+    let (mut most_live, mut most_entities, mut most_queued) = (0usize, 0usize, 0usize);
+    let mut rss_after_warm_up = 0;
+    for frame in 0..FRAMES {
+        // A wandering walk (0.5 to 4 units a frame) that stays within 250 units of the start.
+        heading += (rng.next_f64() as f32 - 0.5) * 0.6;
+        if at.length() > 250.0 {
+            heading = (-at.y).atan2(-at.x);
+        }
+        let step = 0.5 + 3.5 * rng.next_f64() as f32;
+        at += Vec2::new(heading.cos(), heading.sin()) * step;
+        move_viewer(&mut app, viewer, Vec3::new(at.x, 0.0, at.y));
+        if frame % 250 == 125 {
+            // Paint a random square white or black.
+            let (x0, y0) = (rng.below(56) as u32, rng.below(56) as u32);
+            let color = if rng.below(2) == 0 {
+                Color::WHITE
+            } else {
+                Color::BLACK
+            };
+            let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+            let mut img = images.get_mut(&map).unwrap();
+            for y in y0..y0 + 8 {
+                for x in x0..x0 + 8 {
+                    img.set_color_at(x, y, color).unwrap();
+                }
+            }
+        }
+        if frame % 1_000 == 500 {
+            // Replace the constant layer by a denser or sparser one, or by itself.
+            app.world_mut().entity_mut(second).despawn();
+            let density = 0.1 + 0.2 * rng.next_f64();
+            second = app
+                .world_mut()
+                .spawn(layer(LayerDensity::Constant(density)))
+                .id();
+        }
+        app.update();
+        let live = instances(&mut app).len(); // panics on a duplicate PointId
+        let stats = app.world().resource::<RwtStats>().clone();
+        assert_eq!(live, stats.live_instances);
+        most_live = most_live.max(live);
+        most_entities = most_entities.max(entity_count(&mut app));
+        // Waiting work never outgrows the loaded chunks it belongs to.
+        assert!(stats.pending_tasks <= stats.loaded_chunks, "{stats:?}");
+        most_queued = most_queued.max(stats.queued_spawns);
+        if frame == 500 {
+            rss_after_warm_up = resident_bytes();
+        }
+    }
+    // Bounded: two layers of at most 0.6 and 0.3 per square unit over the unload disc.
+    let disc = std::f64::consts::PI * (64.0f64 + 23.0).powi(2);
+    assert!(
+        (most_live as f64) < 0.9 * disc,
+        "{most_live} live instances"
+    );
+    assert!(
+        (most_entities as f64) < 0.9 * disc + 1_000.0,
+        "{most_entities} entities"
+    );
+    let grown = resident_bytes().saturating_sub(rss_after_warm_up);
+    eprintln!(
+        "soak: {FRAMES} frames, at most {most_live} live instances, {most_entities} entities, \
+         {most_queued} queued spawns; resident memory grew {} KiB after frame 500",
+        grown >> 10
+    );
+    assert!(
+        grown < 64 << 20,
+        "resident memory grew by {} MiB",
+        grown >> 20
+    );
+
+    // Undo the changes and walk back: the world near the start is exactly as it was.
+    *app.world_mut()
+        .resource_mut::<Assets<Image>>()
+        .get_mut(&map)
+        .unwrap() = original;
+    app.world_mut().entity_mut(second).despawn();
+    app.world_mut().spawn(constant);
+    let steps = (at.length() / 3.0).ceil() as usize;
+    let from = at;
+    for i in 1..=steps {
+        let p = from * (1.0 - i as f32 / steps as f32);
+        move_viewer(&mut app, viewer, Vec3::new(p.x, 0.0, p.y));
+        app.update();
+    }
+    tick_app(&mut app, 3_000);
+    let end = instances(&mut app);
+    let within = |p: &Vec3, d: f32| Vec2::new(p.x, p.z).length() < d;
+    for (id, p) in &start {
+        if within(p, 48.0 - 23.0) {
+            assert_eq!(end.get(id), Some(p), "{id:?} moved or vanished");
+        }
+    }
+    for (id, p) in &end {
+        if within(p, 48.0 - 23.0) {
+            assert_eq!(start.get(id), Some(p), "{id:?} appeared");
+        }
+    }
+    // Nothing leaked: apart from instances kept by hysteresis, as many entities as before.
+    let extra = end.len() as i64 - start.len() as i64;
+    let entities = entity_count(&mut app) as i64;
+    assert!(
+        (entities - start_entities as i64 - extra).abs() <= 1,
+        "{entities} entities now, {start_entities} at the start, {extra} extra instances"
+    );
+}
