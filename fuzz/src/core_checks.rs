@@ -11,9 +11,12 @@ use rwt_core::tileset::TileSet;
 use std::collections::HashSet;
 use std::sync::OnceLock;
 
-fn embedded() -> &'static TileSet {
-    static SET: OnceLock<TileSet> = OnceLock::new();
-    SET.get_or_init(TileSet::embedded)
+/// A sampler over the shipped set, prepared once (cloning and reseeding it is cheap).
+fn embedded() -> Sampler {
+    static SAMPLER: OnceLock<Sampler> = OnceLock::new();
+    SAMPLER
+        .get_or_init(|| Sampler::new(&TileSet::embedded(), 0))
+        .clone()
 }
 
 /// Reads numbers off the input, zeros once it runs out.
@@ -111,7 +114,7 @@ pub fn image_density(data: &[u8]) -> bool {
             "density {v} above its maximum {max}"
         );
     }
-    check_query(&Sampler::new(embedded(), 1).with_budget(50_000), rect, &d)
+    check_query(&embedded().with_seed(1).with_budget(50_000), rect, &d)
 }
 
 /// One density built from the input: constant, noise, a small image, a closure or a
@@ -168,7 +171,8 @@ pub fn query(data: &[u8]) -> bool {
         return false;
     };
     let d = density(&mut b, 0);
-    let sampler = Sampler::new(embedded(), seed)
+    let sampler = embedded()
+        .with_seed(seed)
         .with_tile_size(tile)
         .with_budget(budget);
     let served = check_query(&sampler, rect, &d);

@@ -11,9 +11,12 @@ use bevy_rwt::rwt_core::tileset::TileSet;
 use glam::DVec2;
 use std::sync::OnceLock;
 
-fn embedded() -> &'static TileSet {
-    static SET: OnceLock<TileSet> = OnceLock::new();
-    SET.get_or_init(TileSet::embedded)
+/// A sampler over the shipped set, prepared once (cloning and reseeding it is cheap).
+fn embedded() -> Sampler {
+    static SAMPLER: OnceLock<Sampler> = OnceLock::new();
+    SAMPLER
+        .get_or_init(|| Sampler::new(&TileSet::embedded(), 0))
+        .clone()
 }
 
 /// A `.layer.ron` file; returns whether it was accepted.
@@ -35,7 +38,8 @@ pub fn layer_file(data: &[u8]) -> bool {
     let changes = chunks.update(&layer.streaming, &[viewer]);
     assert!(changes.load.len() <= 1_000_000);
     // Every non-image class density answers with a bounded query.
-    let sampler = Sampler::new(embedded(), layer.seed)
+    let sampler = embedded()
+        .with_seed(layer.seed)
         .with_tile_size(layer.tile_size)
         .with_budget(100_000);
     let rect = Rect::new(DVec2::splat(-3.0), DVec2::splat(3.0)).unwrap();

@@ -188,6 +188,31 @@ impl LayerDescription {
                 d.tile_size
             )));
         }
+        for (name, v) in [
+            ("chunk_size", d.chunk_size),
+            ("load_distance", d.load_distance),
+            ("unload_distance", d.unload_distance),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(LayerFileError::Invalid(format!(
+                    "{name} {v} must be positive"
+                )));
+            }
+        }
+        let chunk = d
+            .chunk_size
+            .unwrap_or(StreamingConfig::default().chunk_size);
+        let load = d
+            .load_distance
+            .unwrap_or(StreamingConfig::default().load_distance);
+        if load / chunk > rwt_core::streaming::MAX_REACH_CHUNKS {
+            return Err(LayerFileError::Invalid(format!(
+                "load_distance {load} spans more than {} chunks of {chunk}",
+                rwt_core::streaming::MAX_REACH_CHUNKS
+            )));
+        }
         if let (Some(l), Some(u)) = (d.load_distance, d.unload_distance)
             && u < l
         {
@@ -389,5 +414,9 @@ mod tests {
         assert!(err(&bad_tile).contains("tile_size"));
         let inverted = MEADOW.replace("unload_distance: 64.0", "unload_distance: 10.0");
         assert!(err(&inverted).contains("unload_distance"));
+        let far = MEADOW.replace("load_distance: 48.0", "load_distance: 1e300");
+        assert!(err(&far).contains("more than 256 chunks"), "{}", err(&far));
+        let zero = MEADOW.replace("load_distance: 48.0", "load_distance: 0.0");
+        assert!(err(&zero).contains("load_distance 0 must be positive"));
     }
 }

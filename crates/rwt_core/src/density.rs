@@ -381,9 +381,20 @@ impl NoiseDensity {
         Self::new(p.seed, p.frequency, p.octaves, p.base, p.amplitude, p.scale)
     }
 
+    /// The fBm at `p`: 0 where `p * frequency` is not finite, and wrapped by Perlin noise's
+    /// period (256 lattice cells) beyond 2^40 cells, where the `noise` crate would panic
+    /// converting coordinates to `isize` (and has no precision left anyway).
     #[inline]
     fn noise(&self, p: DVec2) -> f64 {
-        self.fbm.get([p.x * self.frequency, p.y * self.frequency])
+        const WRAP: f64 = (1u64 << 40) as f64;
+        let mut q = p * self.frequency;
+        if !q.is_finite() {
+            return 0.0;
+        }
+        if q.abs().max_element() >= WRAP {
+            q = DVec2::new(q.x.rem_euclid(256.0), q.y.rem_euclid(256.0));
+        }
+        self.fbm.get([q.x, q.y])
     }
 }
 

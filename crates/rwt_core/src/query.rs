@@ -198,7 +198,8 @@ struct RuntimeTile {
 /// Generates points of a tile set's infinite point set: the run-time side of rwt.
 #[derive(Clone, Debug)]
 pub struct Sampler {
-    tiles: Vec<RuntimeTile>,
+    /// Shared: cloning a sampler (to reseed it, or to hand it to another thread) is cheap.
+    tiles: std::sync::Arc<Vec<RuntimeTile>>,
     n: i64,
     points_per_tile: usize,
     sub_len: usize,
@@ -245,9 +246,9 @@ impl Sampler {
                     children: t.children.clone(),
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
         Self {
-            tiles,
+            tiles: std::sync::Arc::new(tiles),
             n: n as i64,
             points_per_tile: big_n,
             sub_len: set.subdivision_len(),
@@ -256,6 +257,13 @@ impl Sampler {
             tile_size: 1.0,
             budget: 50_000_000,
         }
+    }
+
+    /// The same tiles with another tiling seed: another, independent point set. Cheap (the
+    /// prepared tiles are shared), unlike [`Sampler::new`].
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
     }
 
     /// Base tiles `size` world units wide (finite, positive).

@@ -92,6 +92,10 @@ pub struct ChunkChanges {
     pub unload: Vec<ChunkCoord>,
 }
 
+/// Largest load distance, in chunks: farther requests are served to this distance (a disc
+/// of about 200 000 chunks per viewer), so that no configuration can exhaust memory.
+pub const MAX_REACH_CHUNKS: f64 = 256.0;
+
 /// Tracks the loaded chunks of one layer.
 #[derive(Clone, Debug, Default)]
 pub struct ChunkSet {
@@ -146,7 +150,7 @@ impl ChunkSet {
                 if !v.position.is_finite() {
                     continue;
                 }
-                let reach = config.load_distance.max(0.0);
+                let reach = config.load_distance.max(0.0).min(MAX_REACH_CHUNKS * size);
                 let (x0, x1) = (
                     ((v.position.x - reach) / size).floor() as i64,
                     ((v.position.x + reach) / size).floor() as i64,
@@ -325,6 +329,18 @@ mod tests {
                 .load
                 .is_empty()
         );
+        // An absurd load distance is served to MAX_REACH_CHUNKS chunks, not to exhaustion.
+        let far = StreamingConfig {
+            load_distance: 1e300,
+            unload_distance: f64::INFINITY,
+            ..c
+        };
+        let n = ChunkSet::default()
+            .update(&far, &[Viewer::omni(DVec2::ZERO)])
+            .load
+            .len() as f64;
+        let disc = std::f64::consts::PI * (MAX_REACH_CHUNKS + 1.0).powi(2);
+        assert!(n > 0.9 * disc && n < 1.1 * disc, "{n} chunks");
     }
 
     #[test]
