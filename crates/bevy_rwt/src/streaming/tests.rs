@@ -515,3 +515,22 @@ fn gizmos_outline_loaded_chunks_and_their_tiles() {
     assert_eq!(both.iter().filter(|o| o.2).count(), 4 * chunks);
     assert!(both.iter().filter(|o| o.2).all(|o| o.1 == 8.0));
 }
+
+#[test]
+fn the_plugin_has_no_system_ambiguities() {
+    use bevy::ecs::schedule::{LogLevel, ScheduleBuildSettings};
+    // Every pair of plugin systems touching the same data is ordered: the schedule refuses to
+    // build otherwise (what `bevy_rapier` checks in its CI).
+    let mut app = create_app_with(|app| {
+        app.edit_schedule(Update, |schedule| {
+            schedule.set_build_settings(ScheduleBuildSettings {
+                ambiguity_detection: LogLevel::Error,
+                ..default()
+            });
+        });
+    });
+    spawn_viewer(&mut app, Vec3::ZERO);
+    app.world_mut().spawn(layer(LayerDensity::Constant(0.2)));
+    tick_app(&mut app, 2_000);
+    assert!(app.world().resource::<RwtStats>().live_instances > 0);
+}
