@@ -221,12 +221,23 @@ fn whole() -> Rect {
     }
 }
 
+/// A brush per class (its own size and strength), one of them selected.
 #[derive(Resource)]
 struct Brush {
     class: usize,
     erase_all: bool,
-    radius: f64,
-    strength: f32,
+    radius: Vec<f64>,
+    strength: Vec<f32>,
+}
+
+impl Brush {
+    fn radius(&mut self) -> &mut f64 {
+        &mut self.radius[self.class]
+    }
+
+    fn strength(&mut self) -> &mut f32 {
+        &mut self.strength[self.class]
+    }
 }
 
 fn save_dir() -> PathBuf {
@@ -265,12 +276,13 @@ fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<As
         status: String::new(),
     };
     canvas.clear();
+    let classes = canvas.setup.classes.len();
     commands.insert_resource(canvas);
     commands.insert_resource(Brush {
         class: 0,
         erase_all: false,
-        radius: 0.06,
-        strength: 2.0,
+        radius: vec![0.06; classes],
+        strength: vec![2.0; classes],
     });
     commands.spawn(Camera2d);
     commands.spawn((
@@ -365,16 +377,16 @@ fn paint_input(
         brush.erase_all = !brush.erase_all;
     }
     if keys.just_pressed(KeyCode::BracketLeft) {
-        brush.radius = (brush.radius / 1.25).max(0.005);
+        *brush.radius() = (*brush.radius() / 1.25).max(0.005);
     }
     if keys.just_pressed(KeyCode::BracketRight) {
-        brush.radius = (brush.radius * 1.25).min(0.5);
+        *brush.radius() = (*brush.radius() * 1.25).min(0.5);
     }
     if keys.just_pressed(KeyCode::ArrowUp) {
-        brush.strength = (brush.strength * 1.5).min(20.0);
+        *brush.strength() = (*brush.strength() * 1.5).min(20.0);
     }
     if keys.just_pressed(KeyCode::ArrowDown) {
-        brush.strength = (brush.strength / 1.5).max(0.05);
+        *brush.strength() = (*brush.strength() / 1.5).max(0.05);
     }
     if keys.just_pressed(KeyCode::Space) {
         canvas.random = !canvas.random;
@@ -409,13 +421,14 @@ fn paint_input(
         (window.height() / 2.0 - cursor.y) as f64,
     ) / ppu
         + 0.5;
-    let amount = brush.strength * time.delta_secs();
+    let amount = *brush.strength() * time.delta_secs();
+    let radius = *brush.radius();
     let target = (!brush.erase_all).then_some(brush.class);
     if buttons.pressed(MouseButton::Left) {
         let sign = if brush.erase_all { -1.0 } else { 1.0 };
-        canvas.brush(target, p, brush.radius, sign * amount);
+        canvas.brush(target, p, radius, sign * amount);
     } else if buttons.pressed(MouseButton::Right) {
-        canvas.brush(target, p, brush.radius, -amount);
+        canvas.brush(target, p, radius, -amount);
     }
 }
 
@@ -578,8 +591,8 @@ fn hud(
         format!(
             "{}   brush {:.3}, strength {:.2}{}",
             names.join("  "),
-            brush.radius,
-            brush.strength,
+            brush.radius[brush.class],
+            brush.strength[brush.class],
             if brush.erase_all { ", ERASER" } else { "" }
         ),
         format!(
@@ -597,6 +610,10 @@ fn hud(
             cursor.x - window.width() / 2.0,
             window.height() / 2.0 - cursor.y,
         );
-        gizmos.circle_2d(at, (brush.radius * ppu) as f32, Color::srgb(0.2, 0.2, 0.2));
+        gizmos.circle_2d(
+            at,
+            (brush.radius[brush.class] * ppu) as f32,
+            Color::srgb(0.2, 0.2, 0.2),
+        );
     }
 }
