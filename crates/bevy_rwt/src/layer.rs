@@ -196,6 +196,9 @@ pub struct ScatterLayer {
     pub height_range: Option<(f32, f32)>,
     /// Instances only where the ground slope (rise over run) is at most this.
     pub max_slope: Option<f32>,
+    /// No instances where this density is 0.5 or more (a painted exclusion map: roads,
+    /// clearings, water). Repainting it re-queries the chunks it covers, like a class map.
+    pub exclusion: Option<LayerDensity>,
 }
 
 impl ScatterLayer {
@@ -210,6 +213,7 @@ impl ScatterLayer {
             height: HeightSource::Constant(0.0),
             height_range: None,
             max_slope: None,
+            exclusion: None,
         }
     }
 
@@ -253,6 +257,20 @@ impl ScatterLayer {
     pub fn with_max_slope(mut self, max: f32) -> Self {
         self.max_slope = Some(max);
         self
+    }
+
+    /// Removes instances where `mask` is 0.5 or more (e.g. a painted map with `scale: 1.0`).
+    pub fn with_exclusion(mut self, mask: LayerDensity) -> Self {
+        self.exclusion = Some(mask);
+        self
+    }
+
+    /// Every density the layer reads: its classes', then its exclusion's.
+    pub fn densities(&self) -> impl Iterator<Item = &LayerDensity> {
+        self.classes
+            .iter()
+            .map(|c| &c.density)
+            .chain(self.exclusion.iter())
     }
 }
 

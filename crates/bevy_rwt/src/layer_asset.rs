@@ -16,6 +16,7 @@
 //!         (density: Image(path: "maps/flowers.png", min: (-128.0, -128.0), size: (256.0, 256.0), scale: 2.0),
 //!          mesh: Path("models/flower.glb#Mesh0/Primitive0"), material: Path("models/flower.glb#Material0")),
 //!     ],
+//!     exclusion: Image(path: "maps/roads.png", min: (-128.0, -128.0), size: (256.0, 256.0), scale: 1.0),
 //! )
 //! ```
 
@@ -149,6 +150,32 @@ pub struct LayerDescription {
     /// Largest ground slope.
     #[serde(default)]
     pub max_slope: Option<f32>,
+    /// No instances where this is 0.5 or more (e.g. `Image(path: "roads.png", .., scale: 1.0)`).
+    #[serde(default)]
+    pub exclusion: Option<DensityDescription>,
+}
+
+impl DensityDescription {
+    /// The layer density, with image handles made by `image`.
+    fn to_density(&self, image: &mut impl FnMut(&str) -> Handle<Image>) -> LayerDensity {
+        match self {
+            DensityDescription::Constant(v) => LayerDensity::Constant(*v),
+            DensityDescription::Noise(params) => {
+                LayerDensity::Noise(NoiseDensity::from_params(*params))
+            }
+            DensityDescription::Image {
+                path,
+                min,
+                size,
+                scale,
+            } => LayerDensity::Image {
+                image: image(path),
+                min: Vec2::new(min.0, min.1),
+                size: Vec2::new(size.0, size.1),
+                scale: *scale,
+            },
+        }
+    }
 }
 
 /// What is wrong with a layer file.
@@ -235,23 +262,7 @@ impl LayerDescription {
             .classes
             .iter()
             .map(|c| ScatterClass {
-                density: match &c.density {
-                    DensityDescription::Constant(v) => LayerDensity::Constant(*v),
-                    DensityDescription::Noise(params) => {
-                        LayerDensity::Noise(NoiseDensity::from_params(*params))
-                    }
-                    DensityDescription::Image {
-                        path,
-                        min,
-                        size,
-                        scale,
-                    } => LayerDensity::Image {
-                        image: image(path),
-                        min: Vec2::new(min.0, min.1),
-                        size: Vec2::new(size.0, size.1),
-                        scale: *scale,
-                    },
-                },
+                density: c.density.to_density(&mut image),
                 mesh: mesh(&c.mesh),
                 material: material(&c.material),
                 scale: c.scale,
@@ -269,6 +280,7 @@ impl LayerDescription {
             })
             .with_height(HeightSource::Constant(self.height));
         layer.falloff = self.falloff;
+        layer.exclusion = self.exclusion.as_ref().map(|e| e.to_density(&mut image));
         layer.height_range = self.height_range;
         layer.max_slope = self.max_slope;
         layer
@@ -324,8 +336,13 @@ impl AssetLoader for ScatterLayerLoader {
             });
         }
         let mut images = Vec::new();
-        for c in &description.classes {
-            if let DensityDescription::Image { path, .. } = &c.density {
+        for d in description
+            .classes
+            .iter()
+            .map(|c| &c.density)
+            .chain(description.exclusion.iter())
+        {
+            if let DensityDescription::Image { path, .. } = d {
                 images.push(ctx.load(path.clone()));
             }
         }
@@ -403,6 +420,22 @@ mod tests {
         assert_eq!(layer.tile_size, 4.0);
         assert_eq!(layer.streaming.load_distance, 48.0);
         assert_eq!(layer.falloff, Some((20.0, 60.0)));
+        assert!(layer.exclusion.is_none());
+        let excluded = MEADOW.replace(
+            "falloff: (20.0, 60.0),",
+            "falloff: (20.0, 60.0), exclusion: Image(path: \"roads.png\", min: (0.0, 0.0), size: (8.0, 8.0), scale: 1.0),",
+        );
+        let mut loads = Vec::new();
+        let layer = LayerDescription::from_ron(&excluded).unwrap().to_layer(
+            |_| Handle::default(),
+            |_| Handle::default(),
+            |path| {
+                loads.push(path.to_string());
+                Handle::default()
+            },
+        );
+        assert!(matches!(layer.exclusion, Some(LayerDensity::Image { .. })));
+        assert_eq!(loads, ["roads.png"]);
     }
 
     #[test]

@@ -485,6 +485,33 @@ impl<D: Density, M: Density> Density for Mask<D, M> {
     }
 }
 
+/// `inner` except where `mask >= threshold` (painted exclusion zones: roads, clearings).
+/// Its bound is `inner`'s: an exclusion can only remove points, so the bound stays
+/// conservative without a minimum of the mask.
+#[derive(Clone, Debug)]
+pub struct Exclude<D, M> {
+    /// The density kept outside the exclusion.
+    pub inner: D,
+    /// The exclusion mask.
+    pub mask: M,
+    /// Mask values at or above this remove the density.
+    pub threshold: f64,
+}
+
+impl<D: Density, M: Density> Density for Exclude<D, M> {
+    #[inline]
+    fn density(&self, p: DVec2) -> f64 {
+        if sanitize(self.mask.density(p)) >= self.threshold {
+            0.0
+        } else {
+            self.inner.density(p)
+        }
+    }
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        self.inner.max_over(min, max)
+    }
+}
+
 /// `inner` fading linearly from full at `near` to zero at `far` from `centre` (level of
 /// detail by density around a viewer).
 #[derive(Clone, Debug)]

@@ -16,7 +16,7 @@ use crate::{ChunkLoaded, ChunkUnloaded, RwtSettings, RwtStats, RwtViewer, ViewCo
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
 use glam::DVec2;
-use rwt_core::density::{Density, Scale};
+use rwt_core::density::{Density, Exclude, Scale};
 use rwt_core::query::{Point, PointId, Sampler};
 use rwt_core::streaming::{ChunkCoord, ChunkSet, Viewer, diff_instances};
 use rwt_core::tileset::TileSet;
@@ -261,10 +261,24 @@ pub fn plan_chunks(
                 .iter()
                 .map(|c| c.density.resolve(&images))
                 .collect();
-            match resolved {
-                Some(d) => state.densities = Some(d),
+            let exclusion = layer.exclusion.as_ref().map(|m| m.resolve(&images));
+            match (resolved, exclusion) {
                 // A painted map is still loading: try again next frame.
-                None => continue,
+                (None, _) | (_, Some(None)) => continue,
+                (Some(d), None) => state.densities = Some(d),
+                (Some(d), Some(Some(mask))) => {
+                    state.densities = Some(
+                        d.into_iter()
+                            .map(|inner| {
+                                Arc::new(Exclude {
+                                    inner,
+                                    mask: mask.clone(),
+                                    threshold: 0.5,
+                                }) as Arc<dyn Density + Send + Sync>
+                            })
+                            .collect(),
+                    )
+                }
             }
         }
         if state.height.is_none() {
@@ -468,9 +482,8 @@ pub fn repaint(
     }
     for (layer, mut state) in &mut layers {
         let touched: Vec<(Vec2, Vec2)> = layer
-            .classes
-            .iter()
-            .filter_map(|c| match &c.density {
+            .densities()
+            .filter_map(|d| match d {
                 crate::layer::LayerDensity::Image {
                     image, min, size, ..
                 } if changed.contains(&image.id()) => Some((*min, *size)),

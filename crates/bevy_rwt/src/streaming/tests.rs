@@ -534,3 +534,58 @@ fn the_plugin_has_no_system_ambiguities() {
     tick_app(&mut app, 2_000);
     assert!(app.world().resource::<RwtStats>().live_instances > 0);
 }
+
+#[test]
+fn painting_an_exclusion_map_removes_only_what_it_covers() {
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let handle = app
+        .world_mut()
+        .resource_mut::<Assets<Image>>()
+        .add(solid_image(64, [0, 0, 0, 255]));
+    let mask = LayerDensity::Image {
+        image: handle.clone(),
+        min: Vec2::splat(-64.0),
+        size: Vec2::splat(128.0),
+        scale: 1.0,
+    };
+    app.world_mut()
+        .spawn(layer(LayerDensity::Constant(0.5)).with_exclusion(mask));
+    tick_app(&mut app, 2_000);
+    let before = instances(&mut app);
+    assert!(before.len() > 1000, "{} instances", before.len());
+    // White over texels 40..48: world x in 16..32, z in -32..-16 (see the painting test).
+    {
+        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+        let mut img = images.get_mut(&handle).unwrap();
+        for y in 40..48u32 {
+            for x in 40..48u32 {
+                img.set_color_at(x, y, Color::WHITE).unwrap();
+            }
+        }
+    }
+    tick_app(&mut app, 2_000);
+    let after = instances(&mut app);
+    let removed: Vec<_> = before
+        .iter()
+        .filter(|(id, _)| !after.contains_key(id))
+        .collect();
+    assert!(removed.len() > 50, "excluded {} instances", removed.len());
+    assert!(
+        after.keys().all(|id| before.contains_key(id)),
+        "exclusion added instances"
+    );
+    // Removed: inside the painted square (widened by bilinear blending); kept: outside it,
+    // and nothing remains well inside it.
+    assert!(
+        removed
+            .iter()
+            .all(|(_, p)| p.x > 15.0 && p.x < 33.0 && p.z > -33.0 && p.z < -15.0),
+        "{removed:?}"
+    );
+    assert!(
+        !after
+            .values()
+            .any(|p| p.x > 17.0 && p.x < 31.0 && p.z > -31.0 && p.z < -17.0)
+    );
+}
