@@ -2,7 +2,7 @@
 //! every frame for duplicate identities and every few hundred frames for bounded entity,
 //! task and memory counts; back at the start, the world is as it was.
 
-use super::tests::{layer, move_viewer, solid_image, spawn_viewer, tick_app};
+use super::tests::{layer, move_viewer, paint_square, solid_image, spawn_viewer, tick_app};
 use super::*;
 use crate::layer::LayerDensity;
 use crate::{RwtPlugin, RwtStats};
@@ -103,13 +103,7 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
             } else {
                 Color::BLACK
             };
-            let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-            let mut img = images.get_mut(&map).unwrap();
-            for y in y0..y0 + 8 {
-                for x in x0..x0 + 8 {
-                    img.set_color_at(x, y, color).unwrap();
-                }
-            }
+            paint_square(&mut app, &map, x0, y0, color);
         }
         if frame % 1_000 == 500 {
             // Replace the constant layer by a denser or sparser one, or by itself.

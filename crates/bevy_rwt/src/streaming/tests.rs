@@ -59,6 +59,24 @@ pub(super) fn solid_image(size: u32, rgba: [u8; 4]) -> Image {
     )
 }
 
+/// Paints texels `[x0, x0 + 8) x [y0, y0 + 8)` of `image` with `color`.
+pub(super) fn paint_square(app: &mut App, image: &Handle<Image>, x0: u32, y0: u32, color: Color) {
+    let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+    let mut img = images.get_mut(image).unwrap();
+    for y in y0..y0 + 8 {
+        for x in x0..x0 + 8 {
+            img.set_color_at(x, y, color).unwrap();
+        }
+    }
+}
+
+/// Whether `p` lies where texels 40..48 of a 64-texel map over -64..64 reach: x in 16..32,
+/// z in -32..-16 (rows count from the top, max z = 64), widened by half a texel by bilinear
+/// blending.
+fn in_painted_square(p: &Vec3) -> bool {
+    p.x > 15.0 && p.x < 33.0 && p.z > -33.0 && p.z < -15.0
+}
+
 pub(super) fn streaming() -> StreamingConfig {
     StreamingConfig {
         chunk_size: 16.0,
@@ -260,16 +278,7 @@ fn painting_changes_only_the_painted_region() {
     app.world_mut().spawn(layer(density));
     tick_app(&mut app, 2_000);
     let before = instances(&mut app);
-    // Paint a white square over texels 40..48 (world x, z in 16..32 and -32..-16).
-    {
-        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut img = images.get_mut(&handle).unwrap();
-        for y in 40..48u32 {
-            for x in 40..48u32 {
-                img.set_color_at(x, y, Color::WHITE).unwrap();
-            }
-        }
-    }
+    paint_square(&mut app, &handle, 40, 40, Color::WHITE);
     tick_app(&mut app, 2_000);
     let after = instances(&mut app);
     let added: Vec<_> = after
@@ -279,14 +288,7 @@ fn painting_changes_only_the_painted_region() {
     let removed = before.keys().filter(|id| !after.contains_key(id)).count();
     assert!(added.len() > 20, "painting added {} instances", added.len());
     assert_eq!(removed, 0);
-    // Texels 40..48 of 64 over 128 units from -64: x in 16..32; rows 40..48 from the top
-    // (max z = 64): z in -32..-16. Bilinear blending widens that by half a texel.
-    assert!(
-        added
-            .iter()
-            .all(|(_, p)| p.x > 15.0 && p.x < 33.0 && p.z > -33.0 && p.z < -15.0),
-        "{added:?}"
-    );
+    assert!(added.iter().all(|(_, p)| in_painted_square(p)), "{added:?}");
 }
 
 #[test]
@@ -554,16 +556,7 @@ fn painting_an_exclusion_map_removes_only_what_it_covers() {
     tick_app(&mut app, 2_000);
     let before = instances(&mut app);
     assert!(before.len() > 1000, "{} instances", before.len());
-    // White over texels 40..48: world x in 16..32, z in -32..-16 (see the painting test).
-    {
-        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut img = images.get_mut(&handle).unwrap();
-        for y in 40..48u32 {
-            for x in 40..48u32 {
-                img.set_color_at(x, y, Color::WHITE).unwrap();
-            }
-        }
-    }
+    paint_square(&mut app, &handle, 40, 40, Color::WHITE);
     tick_app(&mut app, 2_000);
     let after = instances(&mut app);
     let removed: Vec<_> = before
@@ -578,9 +571,7 @@ fn painting_an_exclusion_map_removes_only_what_it_covers() {
     // Removed: inside the painted square (widened by bilinear blending); kept: outside it,
     // and nothing remains well inside it.
     assert!(
-        removed
-            .iter()
-            .all(|(_, p)| p.x > 15.0 && p.x < 33.0 && p.z > -33.0 && p.z < -15.0),
+        removed.iter().all(|(_, p)| in_painted_square(p)),
         "{removed:?}"
     );
     assert!(
