@@ -60,6 +60,9 @@ enum Command {
         /// Output file (default: standard output).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Tile set file built by `rwt tileset build` (default: the embedded set).
+        #[arg(long)]
+        tileset: Option<PathBuf>,
     },
     /// Normalized minimum distance, spectrum and anisotropy of a point file, beside dart
     /// throwing, a jittered grid and white noise computed in the same run.
@@ -166,6 +169,7 @@ fn main() -> ExitCode {
             tile_size,
             budget,
             out,
+            tileset,
         } => points_cmd::run(points_cmd::PointsArgs {
             rect: [rect[0], rect[1], rect[2], rect[3]],
             density: &density,
@@ -173,6 +177,7 @@ fn main() -> ExitCode {
             tile_size,
             budget,
             out: out.as_deref(),
+            tileset: tileset.as_deref(),
         })
         .map(|()| true),
         Command::Analyse { file, plot } => analyse_cmd::run(&file, plot.as_deref()).map(|()| true),

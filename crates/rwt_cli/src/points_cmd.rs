@@ -21,6 +21,8 @@ pub struct PointsArgs<'a> {
     pub budget: usize,
     /// Output file (stdout when `None`).
     pub out: Option<&'a Path>,
+    /// Tile set file (the embedded set when `None`).
+    pub tileset: Option<&'a Path>,
 }
 
 /// Runs `rwt points`.
@@ -34,7 +36,10 @@ pub fn run(args: PointsArgs) -> Result<(), String> {
         ));
     }
     let density = spec::parse(args.density, (rect.min, rect.max))?;
-    let set = TileSet::embedded();
+    let set = match args.tileset {
+        Some(path) => crate::tileset_cmd::load(path)?,
+        None => TileSet::embedded(),
+    };
     let sampler = Sampler::new(&set, args.seed)
         .with_tile_size(args.tile_size)
         .with_budget(args.budget);

@@ -78,6 +78,12 @@ pub fn build_cmd(out: &Path, config: BuildConfig) -> Result<(), String> {
     Ok(())
 }
 
+/// Reads and validates a tile set file; the error names the file.
+pub fn load(path: &Path) -> Result<TileSet, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    TileSet::from_ron_bytes(&bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
 /// `rwt tileset check`: returns whether the set is valid.
 pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -126,8 +132,26 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
             if pass { "" } else { "  (below --min-rho)" }
         );
     }
+    // Every prefix between the listed ones matters too (a query at 0.3 N per tile reads the
+    // first 614): the worst over quarter-octave steps from 16 to N.
+    let (worst_k, worst) = quarter_octaves(n)
+        .map(|k| (k, base_prefix_rho(&set, k, 8, 10)))
+        .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+    let pass = min_rho.is_none_or(|m| worst >= m);
+    ok &= pass;
+    say!(
+        "  worst k in 16..{n} (quarter octaves): rho = {worst:.3} at k = {worst_k}{}",
+        if pass { "" } else { "  (below --min-rho)" }
+    );
     say!("{}", if ok { "OK" } else { "FAILED" });
     Ok(ok)
+}
+
+/// Prefix sizes `16 * 2^(i/4)` up to `n`.
+fn quarter_octaves(n: usize) -> impl Iterator<Item = usize> {
+    (0..)
+        .map(|i| (16.0 * 2f64.powf(i as f64 / 4.0)).round() as usize)
+        .take_while(move |&k| k <= n)
 }
 
 const ORIGIN_COLOURS: [[u8; 3]; 5] = [
@@ -162,8 +186,7 @@ fn edge_bars(c: &mut Canvas, set: &TileSet, t: usize, x: f64, y: f64, s: f64, w:
 /// subdivided twice with the edge colours of every level (figure 6); and a corner of that
 /// tile where its points sit exactly on points of its subdivision (figure 7).
 pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let set = TileSet::from_ron_bytes(&bytes).map_err(|e| e.to_string())?;
+    let set = load(path)?;
     let cols = (set.tiles.len() as f64).sqrt().ceil() as usize;
     let s = 220.0;
     let gap = 12.0;

@@ -161,52 +161,100 @@ pub fn rank(
     tau
 }
 
+/// How far ahead in the threshold order the prefix pass looks for a point with room.
+#[derive(Clone, Copy, Debug)]
+pub struct Lookahead {
+    /// Window (in points) searched for the first point with room; `usize::MAX` searches the
+    /// whole remaining order.
+    pub window: usize,
+    /// When no point in the window has room: the one with the most room among this many.
+    pub fallback: usize,
+}
+
+/// For each tile `u`: the tiles whose candidates a point placed in `u` constrains, with the
+/// offset that takes `u`'s frame to theirs (the tile itself first, offset zero).
+fn constrained_by(neighbours: &Neighbours) -> Vec<Vec<(usize, DVec2)>> {
+    let mut affects: Vec<Vec<(usize, DVec2)>> = (0..neighbours.len())
+        .map(|u| vec![(u, DVec2::ZERO)])
+        .collect();
+    for (t, around) in neighbours.iter().enumerate() {
+        for (o, &(dx, dy)) in OFFSETS.iter().enumerate() {
+            for &u in &around[o] {
+                affects[u as usize].push((t, DVec2::new(dx as f64, dy as f64)));
+            }
+        }
+    }
+    affects
+}
+
 /// The paper's figure 5 in rank space, on top of a threshold order: ranks are fixed one at a
-/// time, in lockstep over all tiles, and rank `k` goes to the first of the next `window`
-/// points (in `order`) that keeps `alpha / sqrt(k + 1)` from the tile's earlier ranks and
-/// from those of every tile that may neighbour it. When none does, the one with the most room
-/// takes it. The first `fixed` ranks of every tile are kept as they are (for a subdivision,
-/// its base points). `order[t]` is rewritten in place; returns how many ranks found no such
-/// point.
+/// time, in lockstep over all tiles, and rank `k` goes to the first point (in `order`, within
+/// the [`Lookahead`]) that keeps `alpha / sqrt(k + 1)` from the tile's earlier ranks and from
+/// those of every tile that may neighbour it. When none does, the one with the most room
+/// takes it. Only ranks in `ranks` are fixed; the earlier ones are kept as they are (for a
+/// subdivision, its base points). `order[t]` is rewritten in place; returns how many ranks
+/// found no such point.
 pub fn repair_prefixes(
     tiles: &[Vec<Candidate>],
     order: &mut [Vec<usize>],
     neighbours: &Neighbours,
     alpha: f64,
-    window: usize,
-    fixed: usize,
+    lookahead: Lookahead,
+    ranks: std::ops::Range<usize>,
 ) -> usize {
     let len = order.iter().map(Vec::len).min().unwrap_or(0);
-    let mut placed = Placed::new(tiles.len(), alpha / (len.max(1) as f64).sqrt());
+    let (fixed, until) = (ranks.start.min(len), ranks.end.min(len));
+    let radius = |k: usize| alpha / ((k + 1) as f64).sqrt();
+    let affects = constrained_by(neighbours);
+    let grids: Vec<BucketGrid> = tiles
+        .iter()
+        .map(|cands| {
+            let mut grid = BucketGrid::new(DVec2::ZERO, DVec2::ONE, radius(len));
+            for (i, c) in cands.iter().enumerate() {
+                grid.insert(c.pos, i as u32);
+            }
+            grid
+        })
+        .collect();
+    // Clearance of every candidate, kept up to date as points are placed. A point only
+    // updates candidates within the current radius, so a stored value is exact when it is
+    // below the radius in force when its nearest point was placed, and at least that radius
+    // otherwise: enough, since the radius only shrinks.
+    let mut clearance: Vec<Vec<f64>> = tiles.iter().map(|c| vec![f64::INFINITY; c.len()]).collect();
+    let place = |clearance: &mut [Vec<f64>], t: usize, p: DVec2, reach: f64| {
+        for &(v, offset) in &affects[t] {
+            let q = p + offset;
+            if q.x < -reach || q.x > 1.0 + reach || q.y < -reach || q.y > 1.0 + reach {
+                continue;
+            }
+            let (room, cands) = (&mut clearance[v], &tiles[v]);
+            grids[v].for_each_near(q, reach, |i| {
+                let c = &mut room[i as usize];
+                *c = c.min((cands[i as usize].pos - q).length());
+            });
+        }
+    };
     for (t, o) in order.iter().enumerate() {
-        for &i in &o[..fixed.min(len)] {
-            placed.insert(t, tiles[t][i].pos);
+        for &i in &o[..fixed] {
+            place(&mut clearance, t, tiles[t][i].pos, radius(fixed));
         }
     }
     let mut misses = 0;
-    for k in fixed.min(len)..len {
-        let r = alpha / ((k + 1) as f64).sqrt();
+    for k in fixed..until {
+        let r = radius(k);
         for t in 0..tiles.len() {
-            let clearance = |p: DVec2| placed.clearance(neighbours, t, p, r);
-            let end = (k + window).min(order[t].len());
-            let mut best = (-1.0f64, k);
-            let mut pick = None;
-            for slot in k..end {
-                let c = clearance(tiles[t][order[t][slot]].pos);
-                if c >= r {
-                    pick = Some(slot);
-                    break;
-                }
-                if c > best.0 {
-                    best = (c, slot);
-                }
-            }
-            if pick.is_none() {
+            let (o, room) = (&order[t], &clearance[t]);
+            let end = o.len().min(k.saturating_add(lookahead.window));
+            let slot = (k..end).find(|&s| room[o[s]] >= r).unwrap_or_else(|| {
                 misses += 1;
-            }
-            let slot = pick.unwrap_or(best.1);
+                let end = o.len().min(k + lookahead.fallback);
+                // The most room; the earliest among equals.
+                (k..end)
+                    .max_by(|&a, &b| room[o[a]].total_cmp(&room[o[b]]).then(b.cmp(&a)))
+                    .unwrap_or(k)
+            });
             order[t][k..=slot].rotate_right(1);
-            placed.insert(t, tiles[t][order[t][k]].pos);
+            place(&mut clearance, t, tiles[t][order[t][k]].pos, r);
         }
     }
     misses
