@@ -71,16 +71,46 @@ impl LayerDensity {
     }
 }
 
+/// Inserts a class's own components into every instance it spawns (after `Transform` and
+/// [`ScatterInstance`](crate::ScatterInstance)).
+pub type InstanceInserter = Arc<dyn Fn(&mut EntityCommands) + Send + Sync>;
+
+/// How the instances of a class look.
+#[derive(Clone)]
+pub enum ClassLook {
+    /// A mesh and a material shared by every instance, so Bevy batches them.
+    Mesh {
+        /// The mesh.
+        mesh: Handle<Mesh>,
+        /// The material.
+        material: Handle<StandardMaterial>,
+    },
+    /// Whatever the function inserts: a scene (`SceneRoot(handle.clone())`, with Bevy's
+    /// `bevy_scene` feature in the game), another material type, colliders, markers.
+    Custom(InstanceInserter),
+}
+
+impl std::fmt::Debug for ClassLook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ClassLook::Mesh { mesh, material } => f
+                .debug_struct("Mesh")
+                .field("mesh", mesh)
+                .field("material", material)
+                .finish(),
+            ClassLook::Custom(_) => f.write_str("Custom(..)"),
+        }
+    }
+}
+
 /// One kind of instance in a layer: its own density (the layer's classes share one blue-noise
 /// point set, paper section 6.3) and how it looks.
 #[derive(Clone, Debug)]
 pub struct ScatterClass {
     /// Where and how densely this class grows.
     pub density: LayerDensity,
-    /// Mesh shared by every instance (Bevy batches them).
-    pub mesh: Handle<Mesh>,
-    /// Material shared by every instance.
-    pub material: Handle<StandardMaterial>,
+    /// What its instances are made of.
+    pub look: ClassLook,
     /// Base scale of the instances.
     pub scale: f32,
     /// Random scale variation, hashed per instance: scale in `scale * (1 +- variation)`.
@@ -88,16 +118,34 @@ pub struct ScatterClass {
 }
 
 impl ScatterClass {
-    /// A class with unit scale and 20 % variation.
+    /// A class of one shared mesh and material, unit scale and 20 % variation.
     pub fn new(
         density: LayerDensity,
         mesh: Handle<Mesh>,
         material: Handle<StandardMaterial>,
     ) -> Self {
+        Self::with_look(density, ClassLook::Mesh { mesh, material })
+    }
+
+    /// A class whose instances get what `insert` puts on them, e.g. a scene:
+    ///
+    /// ```ignore
+    /// let tree = asset_server.load(GltfAssetLabel::Scene(0).from_asset("tree.glb"));
+    /// ScatterClass::custom(LayerDensity::Constant(0.05), move |e| {
+    ///     e.insert(SceneRoot(tree.clone()));
+    /// })
+    /// ```
+    pub fn custom(
+        density: LayerDensity,
+        insert: impl Fn(&mut EntityCommands) + Send + Sync + 'static,
+    ) -> Self {
+        Self::with_look(density, ClassLook::Custom(Arc::new(insert)))
+    }
+
+    fn with_look(density: LayerDensity, look: ClassLook) -> Self {
         Self {
             density,
-            mesh,
-            material,
+            look,
             scale: 1.0,
             scale_variation: 0.2,
         }

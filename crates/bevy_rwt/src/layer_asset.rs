@@ -262,11 +262,13 @@ impl LayerDescription {
             .classes
             .iter()
             .map(|c| ScatterClass {
-                density: c.density.to_density(&mut image),
-                mesh: mesh(&c.mesh),
-                material: material(&c.material),
                 scale: c.scale,
                 scale_variation: c.scale_variation,
+                ..ScatterClass::new(
+                    c.density.to_density(&mut image),
+                    mesh(&c.mesh),
+                    material(&c.material),
+                )
             })
             .collect();
         let mut layer = ScatterLayer::new(classes)

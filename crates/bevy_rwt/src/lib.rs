@@ -37,7 +37,10 @@ pub mod streaming;
 use bevy::diagnostic::{Diagnostic, Diagnostics, RegisterDiagnostic};
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
-pub use layer::{HeightSource, LayerDensity, ScatterClass, ScatterInstance, ScatterLayer};
+pub use layer::{
+    ClassLook, HeightSource, InstanceInserter, LayerDensity, ScatterClass, ScatterInstance,
+    ScatterLayer,
+};
 pub use rwt_core;
 use rwt_core::streaming::ChunkCoord;
 use std::time::Instant;
@@ -47,8 +50,8 @@ pub mod prelude {
     pub use crate::debug::{RwtGizmos, RwtGizmosPlugin};
     pub use crate::layer_asset::{ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{
-        ChunkLoaded, ChunkUnloaded, HeightSource, LayerDensity, RwtPlugin, RwtSettings, RwtStats,
-        RwtSystems, RwtViewer, ScatterClass, ScatterInstance, ScatterLayer, ViewCone,
+        ChunkLoaded, ChunkUnloaded, ClassLook, HeightSource, LayerDensity, RwtPlugin, RwtSettings,
+        RwtStats, RwtSystems, RwtViewer, ScatterClass, ScatterInstance, ScatterLayer, ViewCone,
     };
     pub use rwt_core::streaming::StreamingConfig;
 }

@@ -11,7 +11,7 @@ mod tests;
 
 pub use plugin::StreamingPlugin;
 
-use crate::layer::{HeightFn, ScatterInstance, ScatterLayer, slope};
+use crate::layer::{ClassLook, HeightFn, ScatterInstance, ScatterLayer, slope};
 use crate::{ChunkLoaded, ChunkUnloaded, RwtSettings, RwtStats, RwtViewer, ViewCone};
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
@@ -443,18 +443,21 @@ pub fn apply_budget(
                 let transform = Transform::from_xyz(ground.x, height(ground), ground.y)
                     .with_rotation(Quat::from_rotation_y(p.id.rotation(layer.seed) as f32))
                     .with_scale(Vec3::splat(scale));
-                let e = commands
-                    .spawn((
-                        ScatterInstance {
-                            layer: entity,
-                            id: p.id,
-                            class: p.class,
-                        },
-                        Mesh3d(class.mesh.clone()),
-                        MeshMaterial3d(class.material.clone()),
-                        transform,
-                    ))
-                    .id();
+                let mut instance = commands.spawn((
+                    ScatterInstance {
+                        layer: entity,
+                        id: p.id,
+                        class: p.class,
+                    },
+                    transform,
+                ));
+                match &class.look {
+                    ClassLook::Mesh { mesh, material } => {
+                        instance.insert((Mesh3d(mesh.clone()), MeshMaterial3d(material.clone())));
+                    }
+                    ClassLook::Custom(insert) => insert(&mut instance),
+                }
+                let e = instance.id();
                 c.instances.insert(p.id, e);
                 spawn_budget -= 1;
             }

@@ -580,3 +580,48 @@ fn painting_an_exclusion_map_removes_only_what_it_covers() {
             .any(|p| p.x > 17.0 && p.x < 31.0 && p.z > -31.0 && p.z < -17.0)
     );
 }
+
+#[test]
+fn a_custom_class_inserts_its_own_components() {
+    #[derive(Component)]
+    struct Tree(u32);
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let meshes = ScatterClass::new(
+        LayerDensity::Constant(0.2),
+        Handle::default(),
+        Handle::default(),
+    );
+    let trees = ScatterClass::custom(LayerDensity::Constant(0.1), |e| {
+        e.insert(Tree(7));
+    });
+    app.world_mut().spawn(
+        ScatterLayer::new(vec![meshes, trees])
+            .with_tile_size(8.0)
+            .with_streaming(streaming()),
+    );
+    tick_app(&mut app, 2_000);
+    let mut q = app
+        .world_mut()
+        .query::<(&ScatterInstance, Has<Mesh3d>, Option<&Tree>)>();
+    let (mut mesh_count, mut tree_count) = (0, 0);
+    for (instance, has_mesh, tree) in q.iter(app.world()) {
+        match instance.class {
+            0 => {
+                assert!(has_mesh && tree.is_none());
+                mesh_count += 1;
+            }
+            _ => {
+                assert!(!has_mesh && tree.is_some_and(|t| t.0 == 7));
+                tree_count += 1;
+            }
+        }
+    }
+    // One third of the instances are trees.
+    let share = tree_count as f64 / (mesh_count + tree_count) as f64;
+    assert!(
+        (share - 1.0 / 3.0).abs() < 0.05,
+        "{tree_count} trees of {}",
+        mesh_count + tree_count
+    );
+}
