@@ -18,6 +18,13 @@ pub trait Density {
     fn density(&self, p: DVec2) -> f64;
     /// An upper bound of [`Density::density`] over the rectangle `[min, max]`.
     fn max_over(&self, min: DVec2, max: DVec2) -> f64;
+    /// A lower bound of [`Density::density`] over the rectangle `[min, max]`. Queries take
+    /// points whose threshold lies below it without evaluating the density, so it must never
+    /// exceed the density anywhere in the rectangle; the default, 0, is always right.
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        let _ = (min, max);
+        0.0
+    }
 }
 
 impl<D: Density + ?Sized> Density for &D {
@@ -26,6 +33,9 @@ impl<D: Density + ?Sized> Density for &D {
     }
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         (**self).max_over(min, max)
+    }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        (**self).min_over(min, max)
     }
 }
 
@@ -36,6 +46,9 @@ impl<D: Density + ?Sized> Density for Box<D> {
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         (**self).max_over(min, max)
     }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        (**self).min_over(min, max)
+    }
 }
 
 impl<D: Density + ?Sized> Density for std::sync::Arc<D> {
@@ -44,6 +57,9 @@ impl<D: Density + ?Sized> Density for std::sync::Arc<D> {
     }
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         (**self).max_over(min, max)
+    }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        (**self).min_over(min, max)
     }
 }
 
@@ -58,6 +74,10 @@ impl Density for Constant {
     }
     #[inline]
     fn max_over(&self, _: DVec2, _: DVec2) -> f64 {
+        self.0
+    }
+    #[inline]
+    fn min_over(&self, _: DVec2, _: DVec2) -> f64 {
         self.0
     }
 }
@@ -116,6 +136,8 @@ pub struct ImageDensity {
     padded: Vec<f32>,
     /// Level 0 is the image (values in [0, 1]); level `l` holds 2x2 maxima of level `l - 1`.
     levels: Vec<(usize, usize, Vec<f32>)>,
+    /// The same with 2x2 minima (level 0 is not repeated: `min_levels[l - 1]` is level `l`).
+    min_levels: Vec<Vec<f32>>,
 }
 
 /// Why an image density could not be made.
@@ -165,18 +187,22 @@ impl ImageDensity {
             .collect();
         let (w, h) = (width as usize, height as usize);
         let mut levels = vec![(w, h, clean)];
+        let mut min_levels: Vec<Vec<f32>> = Vec::new();
         while levels.last().is_some_and(|l| l.0 > 1 || l.1 > 1) {
             let (pw, ph, prev) = levels.last().expect("non-empty");
+            let prev_min = min_levels.last().unwrap_or(prev);
             let (nw, nh) = (pw.div_ceil(2), ph.div_ceil(2));
             let mut next = vec![0.0f32; nw * nh];
+            let mut next_min = vec![1.0f32; nw * nh];
             for y in 0..*ph {
                 for x in 0..*pw {
-                    let v = prev[y * pw + x];
-                    let slot = &mut next[(y / 2) * nw + x / 2];
-                    *slot = slot.max(v);
+                    let at = (y / 2) * nw + x / 2;
+                    next[at] = next[at].max(prev[y * pw + x]);
+                    next_min[at] = next_min[at].min(prev_min[y * pw + x]);
                 }
             }
             levels.push((nw, nh, next));
+            min_levels.push(next_min);
         }
         let img = &levels[0].2;
         let mut padded = Vec::with_capacity((w + 1) * (h + 1));
@@ -194,6 +220,7 @@ impl ImageDensity {
             texels_per_unit: DVec2::new(w as f64, h as f64) / size,
             padded,
             levels,
+            min_levels,
         })
     }
 
@@ -282,31 +309,82 @@ impl Density for ImageDensity {
     }
 
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
-        // Texel range touched by bilinear interpolation anywhere in the rectangle.
+        let Some((level, x, y)) = self.texel_range(min, max) else {
+            return 0.0;
+        };
+        let (lw, _, texels) = &self.levels[level];
+        let mut best = 0.0f32;
+        for y in y.clone() {
+            for x in x.clone() {
+                best = best.max(texels[y * lw + x]);
+            }
+        }
+        best as f64 * self.scale
+    }
+
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        // Only well inside the image: at its border `value` reads 0, after f32 rounding.
+        let inside = |p: DVec2| {
+            let t = self.texel(p);
+            let (w, h) = (self.width as f64, self.height as f64);
+            t.x >= 0.5 && t.y >= 0.5 && t.x <= w - 0.5 && t.y <= h - 0.5
+        };
+        if !(inside(min) && inside(max)) {
+            return 0.0;
+        }
+        let Some((level, x, y)) = self.texel_range(min, max) else {
+            return 0.0;
+        };
+        let (lw, _, _) = &self.levels[level];
+        let texels = if level == 0 {
+            &self.levels[0].2
+        } else {
+            &self.min_levels[level - 1]
+        };
+        let mut least = 1.0f32;
+        for y in y.clone() {
+            for x in x.clone() {
+                least = least.min(texels[y * lw + x]);
+            }
+        }
+        // Bilinear blending in f32 rounds by a few units in the last place of 1.0 (texels
+        // are at most 1), so it can land a hair below its smallest texel.
+        (least as f64 - 1e-6).max(0.0) * self.scale
+    }
+}
+
+impl ImageDensity {
+    /// The texels bilinear interpolation reads anywhere in the rectangle, at the coarsest
+    /// mip level where they span at most 4 texels per axis: `(level, columns, rows)`.
+    fn texel_range(
+        &self,
+        min: DVec2,
+        max: DVec2,
+    ) -> Option<(
+        usize,
+        std::ops::RangeInclusive<usize>,
+        std::ops::RangeInclusive<usize>,
+    )> {
         let a = self.texel(DVec2::new(min.x, max.y));
         let b = self.texel(DVec2::new(max.x, min.y));
         let (w, h) = (self.width as f64, self.height as f64);
         if b.x < 0.0 || b.y < 0.0 || a.x >= w || a.y >= h || !(a.is_finite() && b.is_finite()) {
-            return 0.0;
+            return None;
         }
         let x0 = (a.x - 1.0).floor().max(0.0) as usize;
         let y0 = (a.y - 1.0).floor().max(0.0) as usize;
         let x1 = ((b.x + 1.0).ceil() as usize).min(self.width - 1);
         let y1 = ((b.y + 1.0).ceil() as usize).min(self.height - 1);
-        // Coarsest level at which the range spans at most 4 texels per axis.
         let span = (x1 - x0).max(y1 - y0) + 1;
         let mut level = 0;
         while level + 1 < self.levels.len() && (span >> (level + 1)) >= 2 {
             level += 1;
         }
-        let (lw, _, texels) = &self.levels[level];
-        let mut best = 0.0f32;
-        for y in (y0 >> level)..=(y1 >> level) {
-            for x in (x0 >> level)..=(x1 >> level) {
-                best = best.max(texels[y * lw + x]);
-            }
-        }
-        best as f64 * self.scale
+        Some((
+            level,
+            (x0 >> level)..=(x1 >> level),
+            (y0 >> level)..=(y1 >> level),
+        ))
     }
 }
 
@@ -412,19 +490,39 @@ impl Density for NoiseDensity {
         let hi = (self.base + self.amplitude * n).max(self.base + self.amplitude * n_low);
         self.scale * hi.max(0.0)
     }
+
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        let centre = (min + max) * 0.5;
+        let reach = (max - min).length() * 0.5 * self.lipschitz;
+        let at_centre = self.noise(centre);
+        let n = (at_centre + reach).min(1.0);
+        let n_low = (at_centre - reach).max(-1.0);
+        let lo = (self.base + self.amplitude * n).min(self.base + self.amplitude * n_low);
+        // A hair under, for the rounding of the noise crate's own arithmetic.
+        self.scale * (lo - 1e-9).max(0.0)
+    }
 }
 
-/// `inner * factor`.
+/// `inner * factor` (a negative inner density counts as 0 first).
 #[derive(Clone, Debug)]
 pub struct Scale<D>(pub D, pub f64);
 
 impl<D: Density> Density for Scale<D> {
+    // The inner density is sanitized first: a negative one times a negative factor must
+    // stay 0, not turn positive behind the bounds' back.
     #[inline]
     fn density(&self, p: DVec2) -> f64 {
-        self.0.density(p) * self.1
+        sanitize(self.0.density(p)) * self.1
     }
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
-        self.0.max_over(min, max) * self.1.max(0.0)
+        sanitize(self.0.max_over(min, max)) * self.1.max(0.0)
+    }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        if self.1 >= 0.0 {
+            sanitize(self.0.min_over(min, max)) * self.1
+        } else {
+            0.0
+        }
     }
 }
 
@@ -440,6 +538,9 @@ impl<A: Density, B: Density> Density for Sum<A, B> {
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         sanitize(self.0.max_over(min, max)) + sanitize(self.1.max_over(min, max))
     }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        sanitize(self.0.min_over(min, max)) + sanitize(self.1.min_over(min, max))
+    }
 }
 
 /// `a * b`.
@@ -453,6 +554,9 @@ impl<A: Density, B: Density> Density for Product<A, B> {
     }
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         sanitize(self.0.max_over(min, max)) * sanitize(self.1.max_over(min, max))
+    }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        sanitize(self.0.min_over(min, max)) * sanitize(self.1.min_over(min, max))
     }
 }
 
@@ -483,6 +587,13 @@ impl<D: Density, M: Density> Density for Mask<D, M> {
             0.0
         }
     }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        if self.mask.min_over(min, max) >= self.threshold {
+            self.inner.min_over(min, max)
+        } else {
+            0.0
+        }
+    }
 }
 
 /// `inner` except where `mask >= threshold` (painted exclusion zones: roads, clearings).
@@ -509,6 +620,14 @@ impl<D: Density, M: Density> Density for Exclude<D, M> {
     }
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         self.inner.max_over(min, max)
+    }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        // Only where nothing can be excluded.
+        if self.threshold > 0.0 && self.mask.max_over(min, max) < self.threshold {
+            self.inner.min_over(min, max)
+        } else {
+            0.0
+        }
     }
 }
 
@@ -548,6 +667,10 @@ impl<D: Density> Density for DistanceFalloff<D> {
         let nearest = self.centre.clamp(min, max);
         self.inner.max_over(min, max) * self.factor(nearest.distance(self.centre))
     }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        let farthest = (min - self.centre).abs().max((max - self.centre).abs());
+        sanitize(self.inner.min_over(min, max)) * self.factor(farthest.length())
+    }
 }
 
 /// NaN and negative densities count as zero.
@@ -561,21 +684,39 @@ mod tests {
     use super::*;
     use crate::rng::Rng;
 
-    fn check_bound(d: &impl Density, rng: &mut Rng, world: f64) {
+    /// Upper bounds hold within rounding; lower bounds exactly (queries take points below
+    /// them without evaluating). Returns the share of rectangles with a positive lower bound.
+    fn check_bound(d: &impl Density, rng: &mut Rng, world: f64) -> f64 {
+        let mut useful = 0;
         for _ in 0..300 {
             let a = DVec2::new(rng.next_f64(), rng.next_f64()) * world;
             let ext = DVec2::new(rng.next_f64(), rng.next_f64()) * world * 0.2 * rng.next_f64();
             let b = a + ext;
             let bound = d.max_over(a, b);
-            for _ in 0..40 {
-                let p = a + DVec2::new(rng.next_f64(), rng.next_f64()) * ext;
+            let low = sanitize(d.min_over(a, b));
+            useful += usize::from(low > 0.0);
+            for k in 0..40 {
+                // Corners and edges too: bilinear blending is least exact there.
+                let t = match k {
+                    0 => DVec2::ZERO,
+                    1 => DVec2::ONE,
+                    2 => DVec2::X,
+                    3 => DVec2::Y,
+                    _ => DVec2::new(rng.next_f64(), rng.next_f64()),
+                };
+                let p = a + t * ext;
                 let v = d.density(p);
                 assert!(
                     bound >= v - 1e-9,
                     "bound {bound} < value {v} at {p:?} in {a:?}..{b:?}"
                 );
+                assert!(
+                    low <= sanitize(v),
+                    "lower bound {low} > value {v} at {p:?} in {a:?}..{b:?}"
+                );
             }
         }
+        useful as f64 / 300.0
     }
 
     #[test]
@@ -599,7 +740,11 @@ mod tests {
             100.0,
         )
         .unwrap();
-        check_bound(&d, &mut rng, 6.0);
+        let useful = check_bound(&d, &mut rng, 6.0);
+        assert!(
+            useful > 0.2,
+            "lower bounds positive in {useful} of rectangles"
+        );
         // The stroke is 0.1 world units wide; any rectangle containing it sees density 100.
         let x = -3.0 + 6.4 * 37.5 / 64.0;
         assert!(d.max_over(DVec2::new(x - 2.0, 2.5), DVec2::new(x + 2.0, 3.0)) >= 100.0);
@@ -615,6 +760,12 @@ mod tests {
     fn noise_maximum_is_conservative() {
         let d = NoiseDensity::new(7, 0.37, 5, 0.3, 0.8, 50.0);
         check_bound(&d, &mut Rng::new(2, 2), 40.0);
+        // Small rectangles get useful lower bounds.
+        let useful = check_bound(&d, &mut Rng::new(2, 3), 4.0);
+        assert!(
+            useful > 0.1,
+            "lower bounds positive in {useful} of rectangles"
+        );
     }
 
     #[test]
@@ -641,6 +792,26 @@ mod tests {
                 inner: noise.clone(),
                 mask: img.clone(),
                 threshold: 5.0,
+            },
+            &mut rng,
+            10.0,
+        );
+        check_bound(
+            &Exclude {
+                inner: Sum(noise.clone(), Constant(3.0)),
+                mask: img.clone(),
+                threshold: 10.0,
+            },
+            &mut rng,
+            10.0,
+        );
+        check_bound(&Scale(Constant(-2.0), -1.5), &mut rng, 10.0);
+        check_bound(
+            &DistanceFalloff {
+                inner: Sum(noise.clone(), Constant(1.0)),
+                centre: DVec2::splat(5.0),
+                near: 1.0,
+                far: 4.0,
             },
             &mut rng,
             10.0,

@@ -466,6 +466,9 @@ impl<D: Density> Density for SumOf<'_, D> {
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         self.0.iter().map(|d| sanitize(d.max_over(min, max))).sum()
     }
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        self.0.iter().map(|d| sanitize(d.min_over(min, max))).sum()
+    }
 }
 
 struct Visit<'a, D: ?Sized, F> {
@@ -513,9 +516,17 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
         }
     }
 
+    /// The lower density bound over `rect` times `area`, at most `limit`; 0 when not finite.
+    fn low(&self, rect: &Rect, limit: f64, area: f64) -> f64 {
+        let low = sanitize(self.density.min_over(rect.min, rect.max)) * area;
+        if low.is_finite() { low.min(limit) } else { 0.0 }
+    }
+
     /// Visits tile `t` of level `level` at lattice `(ix, iy)`, side `s`. `known` is the
-    /// density bound over its part of the query times its area, when the parent has it.
-    fn tile(&mut self, t: u16, level: u32, ix: i64, iy: i64, s: f64, known: Option<f64>) {
+    /// upper and lower density bounds over its part of the query times its area, when the
+    /// parent has them. Points ranked below the lower bound are taken without evaluating the
+    /// density (the bound guarantees the evaluation would take them).
+    fn tile(&mut self, t: u16, level: u32, ix: i64, iy: i64, s: f64, known: Option<(f64, f64)>) {
         let tile_rect = Rect {
             min: DVec2::new(ix as f64 * s, iy as f64 * s),
             max: DVec2::new((ix + 1) as f64 * s, (iy + 1) as f64 * s),
@@ -525,8 +536,10 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
             return;
         }
         let area = s * s;
-        let limit =
-            known.unwrap_or_else(|| sanitize(self.density.max_over(clip.min, clip.max)) * area);
+        let (limit, low) = known.unwrap_or_else(|| {
+            let limit = sanitize(self.density.max_over(clip.min, clip.max)) * area;
+            (limit, self.low(&clip, limit, area))
+        });
         if limit.is_nan() || limit <= 0.0 {
             return;
         }
@@ -539,19 +552,26 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
         // Per-cell bounds pay off once the tile asks for more than a few points per cell, or
         // when it is only partly inside the query; otherwise the tile's bound serves all.
         let mut cell_limit = [limit; 64];
+        let mut cell_low = [low; 64];
         if limit > 4.0 * cells as f64 || clip != tile_rect {
-            for (cell, slot) in cell_limit[..cells].iter_mut().enumerate() {
+            for (cell, (slot, low_slot)) in cell_limit[..cells]
+                .iter_mut()
+                .zip(&mut cell_low[..cells])
+                .enumerate()
+            {
                 let (a, b) = ((cell as i64 % n) as f64, (cell as i64 / n) as f64);
                 let cell_rect = Rect {
                     min: tile_rect.min + DVec2::new(a, b) * child_s,
                     max: tile_rect.min + DVec2::new(a + 1.0, b + 1.0) * child_s,
                 }
                 .intersect(&self.rect);
-                *slot = if cell_rect.is_empty() {
-                    0.0
+                (*slot, *low_slot) = if cell_rect.is_empty() {
+                    (0.0, 0.0)
                 } else {
-                    (sanitize(self.density.max_over(cell_rect.min, cell_rect.max)) * area)
-                        .min(limit)
+                    let cell_max = (sanitize(self.density.max_over(cell_rect.min, cell_rect.max))
+                        * area)
+                        .min(limit);
+                    (cell_max, self.low(&cell_rect, cell_max, area).max(low))
                 };
             }
         }
@@ -562,10 +582,13 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
             ));
             for (cell, points) in tile.base_cells.iter().enumerate() {
                 let lim = cell_limit[cell] - offset;
+                let sure = cell_low[cell];
                 for cp in points.iter().take_while(|cp| (cp.rank as f64) < lim) {
                     let p = DVec2::new((ix as f64 + cp.frac[0]) * s, (iy as f64 + cp.frac[1]) * s);
                     let rank = cp.rank as f64 + offset;
-                    if self.rect.contains(p) && sanitize(self.density.density(p)) * area > rank {
+                    if self.rect.contains(p)
+                        && (rank < sure || sanitize(self.density.density(p)) * area > rank)
+                    {
                         (self.emit)(Point {
                             position: p,
                             id: PointId {
@@ -595,14 +618,16 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
             if lim <= big_n {
                 continue;
             }
+            let sure = cell_low[cell];
             let (cx, cy) = (cx0 + cell as i64 % n, cy0 + cell as i64 / n);
             for cp in points.iter().take_while(|cp| (cp.rank as f64) < lim) {
                 let p = DVec2::new(
                     (cx as f64 + cp.frac[0]) * child_s,
                     (cy as f64 + cp.frac[1]) * child_s,
                 );
+                let rank = cp.rank as f64;
                 if self.rect.contains(p)
-                    && sanitize(self.density.density(p)) * area > cp.rank as f64
+                    && (rank < sure || sanitize(self.density.density(p)) * area > rank)
                 {
                     (self.emit)(Point {
                         position: p,
@@ -622,14 +647,15 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
             let lim = cell_limit[cell];
             if lim > full {
                 let (cx, cy) = (cx0 + cell as i64 % n, cy0 + cell as i64 / n);
-                // The cell's bound in the child's own area units.
+                // The cell's bounds in the child's own area units.
+                let cells = (n * n) as f64;
                 self.tile(
                     child_tile,
                     level + 1,
                     cx,
                     cy,
                     child_s,
-                    Some(lim / (n * n) as f64),
+                    Some((lim / cells, cell_low[cell] / cells)),
                 );
             }
         }

@@ -421,3 +421,74 @@ fn huge_sparse_or_thin_queries_are_refused_not_walked() {
     s.query(strip, &Constant(1.0e5), &mut out).unwrap();
     assert!(out.iter().all(|p| strip.contains(p.position)));
 }
+
+/// A density that hides its lower bound, so every candidate is evaluated.
+struct Evaluated<D>(D);
+
+impl<D: Density> Density for Evaluated<D> {
+    fn density(&self, p: DVec2) -> f64 {
+        self.0.density(p)
+    }
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        self.0.max_over(min, max)
+    }
+}
+
+#[test]
+fn lower_bounds_skip_evaluations_without_changing_any_point() {
+    use rwt_core::density::{DistanceFalloff, Exclude, Scale};
+    let n = set().points_per_tile as f64;
+    // A smooth map with a sharp stroke, over 6 x 6 tiles, and noise.
+    let (w, h) = (96usize, 96usize);
+    let values: Vec<f32> = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+            if (x - 0.6).abs() < 0.01 {
+                1.0
+            } else {
+                0.2 + 0.5 * x * y
+            }
+        })
+        .collect();
+    let image = ImageDensity::from_values(
+        w as u32,
+        h as u32,
+        &values,
+        DVec2::ZERO,
+        DVec2::splat(6.0),
+        3.0 * n,
+    )
+    .unwrap();
+    let noise = NoiseDensity::new(4, 0.4, 3, 0.6, 0.5, 2.0 * n);
+    let s = sampler(12);
+    let rect = Rect::new(DVec2::new(-0.3, 0.2), DVec2::new(6.3, 5.7)).unwrap();
+    let compare = |name: &str, d: &dyn Density| {
+        let (mut fast, mut slow) = (Vec::new(), Vec::new());
+        s.query(rect, &d, &mut fast).unwrap();
+        s.query(rect, &Evaluated(d), &mut slow).unwrap();
+        assert!(fast.len() > 10_000, "{name}: {} points", fast.len());
+        assert!(
+            fast == slow,
+            "{name}: {} vs {} points",
+            fast.len(),
+            slow.len()
+        );
+    };
+    compare("constant", &Constant(2.5 * n));
+    compare("image", &image);
+    compare("noise", &noise);
+    compare("sum", &Sum(image.clone(), Scale(noise.clone(), 0.5)));
+    compare(
+        "fall-off with exclusion",
+        &DistanceFalloff {
+            inner: Exclude {
+                inner: image.clone(),
+                mask: Scale(image.clone(), 1.0 / n),
+                threshold: 2.9,
+            },
+            centre: DVec2::splat(3.0),
+            near: 1.0,
+            far: 5.0,
+        },
+    );
+}
