@@ -76,7 +76,9 @@ fn check_query<D: Density + ?Sized>(sampler: &Sampler, rect: Rect, density: &D) 
     // Again with every candidate evaluated: the same output, so lower bounds never took a
     // point the density would not (and the query is deterministic).
     let mut second: Vec<Point> = Vec::new();
-    sampler.query(rect, &Evaluated(density), &mut second).unwrap();
+    sampler
+        .query(rect, &Evaluated(density), &mut second)
+        .unwrap();
     assert_eq!(first, second);
     true
 }
