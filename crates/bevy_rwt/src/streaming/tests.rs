@@ -159,7 +159,7 @@ fn a_round_trip_returns_to_the_same_instances_and_stays_bounded() {
     app.world_mut().spawn(layer(LayerDensity::Constant(0.3)));
     // Arrive at the start along the path, as the return will: chunks kept by hysteresis
     // (between load and unload distance) depend on where the viewer came from.
-    let mut fly = |app: &mut App, stops: &mut dyn Iterator<Item = usize>| {
+    let fly = |app: &mut App, stops: &mut dyn Iterator<Item = usize>| {
         let mut most = 0;
         for i in stops {
             move_viewer(app, viewer, stop(i));
