@@ -20,7 +20,8 @@ use rwt_core::density::{Density, Exclude, Scale};
 use rwt_core::query::{Point, PointId, Sampler};
 use rwt_core::streaming::{ChunkCoord, ChunkSet, Viewer, diff_instances};
 use rwt_core::tileset::TileSet;
-use std::collections::{HashMap, VecDeque};
+use bevy::platform::collections::{HashMap, HashSet};
+use std::collections::VecDeque;
 use std::sync::Arc;
 
 /// The shipped tile set, parsed once for the app.
@@ -381,7 +382,7 @@ pub fn collect_results(
                 .collect();
             let diff = diff_instances(shown.iter(), &points);
             if !diff.removed.is_empty() {
-                let removed: std::collections::HashSet<PointId> =
+                let removed: HashSet<PointId> =
                     diff.removed.iter().copied().collect();
                 c.queued.retain(|p| !removed.contains(&p.id));
                 for id in &diff.removed {
@@ -443,21 +444,28 @@ pub fn apply_budget(
                 let transform = Transform::from_xyz(ground.x, height(ground), ground.y)
                     .with_rotation(Quat::from_rotation_y(p.id.rotation(layer.seed) as f32))
                     .with_scale(Vec3::splat(scale));
-                let mut instance = commands.spawn((
-                    ScatterInstance {
-                        layer: entity,
-                        id: p.id,
-                        class: p.class,
-                    },
-                    transform,
-                ));
-                match &class.look {
-                    ClassLook::Mesh { mesh, material } => {
-                        instance.insert((Mesh3d(mesh.clone()), MeshMaterial3d(material.clone())));
+                let instance = ScatterInstance {
+                    layer: entity,
+                    id: p.id,
+                    class: p.class,
+                };
+                // One bundle for the common case: an insert after the spawn would move
+                // every instance to a second archetype.
+                let e = match &class.look {
+                    ClassLook::Mesh { mesh, material } => commands
+                        .spawn((
+                            instance,
+                            Mesh3d(mesh.clone()),
+                            MeshMaterial3d(material.clone()),
+                            transform,
+                        ))
+                        .id(),
+                    ClassLook::Custom(insert) => {
+                        let mut custom = commands.spawn((instance, transform));
+                        insert(&mut custom);
+                        custom.id()
                     }
-                    ClassLook::Custom(insert) => insert(&mut instance),
-                }
-                let e = instance.id();
+                };
                 c.instances.insert(p.id, e);
                 spawn_budget -= 1;
             }
