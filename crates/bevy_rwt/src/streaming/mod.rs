@@ -13,6 +13,7 @@ pub use plugin::StreamingPlugin;
 
 use crate::layer::{ClassLook, HeightFn, ScatterInstance, ScatterLayer, slope};
 use crate::{ChunkLoaded, ChunkUnloaded, RwtSettings, RwtStats, RwtViewer, ViewCone};
+use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
 use glam::DVec2;
@@ -20,7 +21,6 @@ use rwt_core::density::{Density, Exclude, Scale};
 use rwt_core::query::{Point, PointId, Sampler};
 use rwt_core::streaming::{ChunkCoord, ChunkSet, Viewer, diff_instances};
 use rwt_core::tileset::TileSet;
-use bevy::platform::collections::{HashMap, HashSet};
 use std::collections::VecDeque;
 use std::sync::Arc;
 
@@ -382,8 +382,7 @@ pub fn collect_results(
                 .collect();
             let diff = diff_instances(shown.iter(), &points);
             if !diff.removed.is_empty() {
-                let removed: HashSet<PointId> =
-                    diff.removed.iter().copied().collect();
+                let removed: HashSet<PointId> = diff.removed.iter().copied().collect();
                 c.queued.retain(|p| !removed.contains(&p.id));
                 for id in &diff.removed {
                     if let Some(e) = c.instances.remove(id) {
