@@ -162,6 +162,22 @@ const PREFIX_LOOKAHEAD: Lookahead = Lookahead {
 /// The same for the subdivision ranking. Its threshold order already comes sorted by room
 /// (every candidate starts at `N` and waits for its clearance), so when the first point has
 /// no room none of the next has either: a wider search changes nothing there (measured).
+///
+/// From about `3.5 N` on, no candidate has the `prefix_alpha` room: the ranking picks
+/// nested subsets of a fixed, discrete set (the children's `16 N` points), and the
+/// farthest-point order fills it unevenly. Shipped set, normalized minimum distance at
+/// 4 / 6 / 8.5 / 12 N: 0.636 / 0.624 / 0.643 / 0.675; low-frequency power 1.3x / 1.8x /
+/// 1.9x / 1.8x dart throwing's. Tried in session 4, none better in the trough:
+/// - the whole order as window: no change (15 107 of the 65 536 ranks 4096..8191 miss);
+/// - among the first 8 or 32 points with room, the one blocking the fewest others: 14 982;
+/// - minimum-degree packing in stages from `N` or `2 N` (a one-shot independent set at
+///   `4 N` spacing holds 9 600 points, but packing tightly early leaves holes too small
+///   later): 0.637 / 0.623 / 0.644;
+/// - weighted sample elimination (Yuksel 2015) from `16 N` down, neighbours averaged or
+///   summed, alone or below a farthest-point prefix of `2 N` / `3 N`: 0.49 to 0.59 at 4 N,
+///   but 0.669 / 0.681 at 12 / 14 N;
+/// - preferring candidates with fewer placed points within 3-4 radii (balance): low-frequency
+///   power 1.9x -> 1.8x at 8.5 N for rho 0.631.
 const SUB_PREFIX_LOOKAHEAD: Lookahead = Lookahead {
     window: 64,
     fallback: 64,
