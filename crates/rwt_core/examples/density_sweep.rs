@@ -60,7 +60,12 @@ fn main() {
             .collect();
         let ours = Spectrum::averaged(&windows, side, 96);
         let dart: Vec<(DVec2, Vec<DVec2>)> = (0..12)
-            .map(|i| (DVec2::ZERO, reference::dart_throwing(DVec2::ZERO, side, count, i)))
+            .map(|i| {
+                (
+                    DVec2::ZERO,
+                    reference::dart_throwing(DVec2::ZERO, side, count, i),
+                )
+            })
             .collect();
         let dart = Spectrum::averaged(&dart, side, 96);
         let low = |s: &Spectrum| s.low_frequency_power(side, density, 0.5);

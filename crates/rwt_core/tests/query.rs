@@ -94,7 +94,14 @@ fn spectrum_beside_references() {
     // asks for 1.5; the sparse base prefixes (0.3 N) and the middle of a subdivision ranking
     // (6 N, 8.5 N) stay above it (measured 1.78, 1.78, 1.94): those ceilings only guard
     // against regressions.
-    let cases = [(0.3, 1.9), (1.0, 1.5), (2.0, 1.5), (6.0, 1.9), (8.5, 2.05), (16.0, 1.5)];
+    let cases = [
+        (0.3, 1.9),
+        (1.0, 1.5),
+        (2.0, 1.5),
+        (6.0, 1.9),
+        (8.5, 2.05),
+        (16.0, 1.5),
+    ];
     for (multiple, ceiling) in cases {
         let density = multiple * n;
         let side = (2_500.0 / density).sqrt();
