@@ -129,7 +129,9 @@ fn spectrum_beside_references() {
             low(&ours),
             low(&dart)
         );
-        assert!(low(&ours) < low(&jitter) && low(&white) > 0.7);
+        // Where the target holds, well below a jittered grid; elsewhere at least below it.
+        let share = if ceiling <= 1.5 { 0.5 } else { 1.0 };
+        assert!(low(&ours) < share * low(&jitter) && low(&white) > 0.7);
     }
 }
 
