@@ -313,13 +313,7 @@ impl Density for ImageDensity {
             return 0.0;
         };
         let (lw, _, texels) = &self.levels[level];
-        let mut best = 0.0f32;
-        for y in y.clone() {
-            for x in x.clone() {
-                best = best.max(texels[y * lw + x]);
-            }
-        }
-        best as f64 * self.scale
+        fold_texels(texels, *lw, x, y, 0.0, f32::max) as f64 * self.scale
     }
 
     fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
@@ -341,16 +335,29 @@ impl Density for ImageDensity {
         } else {
             &self.min_levels[level - 1]
         };
-        let mut least = 1.0f32;
-        for y in y.clone() {
-            for x in x.clone() {
-                least = least.min(texels[y * lw + x]);
-            }
-        }
+        let least = fold_texels(texels, *lw, x, y, 1.0, f32::min);
         // Bilinear blending in f32 rounds by a few units in the last place of 1.0 (texels
         // are at most 1), so it can land a hair below its smallest texel.
         (least as f64 - 1e-6).max(0.0) * self.scale
     }
+}
+
+/// Folds the texels `columns x rows` of a `width`-wide level.
+fn fold_texels(
+    texels: &[f32],
+    width: usize,
+    columns: std::ops::RangeInclusive<usize>,
+    rows: std::ops::RangeInclusive<usize>,
+    init: f32,
+    f: fn(f32, f32) -> f32,
+) -> f32 {
+    let mut acc = init;
+    for y in rows {
+        for x in columns.clone() {
+            acc = f(acc, texels[y * width + x]);
+        }
+    }
+    acc
 }
 
 impl ImageDensity {
@@ -483,23 +490,27 @@ impl Density for NoiseDensity {
     }
 
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
-        let centre = (min + max) * 0.5;
-        let reach = (max - min).length() * 0.5 * self.lipschitz;
-        let n = (self.noise(centre) + reach).min(1.0);
-        let n_low = (self.noise(centre) - reach).max(-1.0);
-        let hi = (self.base + self.amplitude * n).max(self.base + self.amplitude * n_low);
+        let (_, hi) = self.range_over(min, max);
         self.scale * hi.max(0.0)
     }
 
     fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        let (lo, _) = self.range_over(min, max);
+        // A hair under, for the rounding of the noise crate's own arithmetic.
+        self.scale * (lo - 1e-9).max(0.0)
+    }
+}
+
+impl NoiseDensity {
+    /// Bounds of `base + amplitude * noise` over the rectangle, before clamping and
+    /// scaling: the noise at the centre plus or minus its Lipschitz reach, within [-1, 1].
+    fn range_over(&self, min: DVec2, max: DVec2) -> (f64, f64) {
         let centre = (min + max) * 0.5;
         let reach = (max - min).length() * 0.5 * self.lipschitz;
         let at_centre = self.noise(centre);
-        let n = (at_centre + reach).min(1.0);
-        let n_low = (at_centre - reach).max(-1.0);
-        let lo = (self.base + self.amplitude * n).min(self.base + self.amplitude * n_low);
-        // A hair under, for the rounding of the noise crate's own arithmetic.
-        self.scale * (lo - 1e-9).max(0.0)
+        let a = self.base + self.amplitude * (at_centre + reach).min(1.0);
+        let b = self.base + self.amplitude * (at_centre - reach).max(-1.0);
+        (a.min(b), a.max(b))
     }
 }
 
