@@ -159,29 +159,51 @@ const PREFIX_LOOKAHEAD: Lookahead = Lookahead {
     fallback: 1024,
 };
 
-/// The same for the subdivision ranking. Its threshold order already comes sorted by room
-/// (every candidate starts at `N` and waits for its clearance), so when the first point has
-/// no room none of the next has either: a wider search changes nothing there (measured).
+/// The same for the subdivision ranking after [`SUB_WIDE_PREFIX`].
 ///
 /// From about `3.5 N` on, no candidate has the `prefix_alpha` room: the ranking picks
-/// nested subsets of a fixed, discrete set (the children's `16 N` points), and the
-/// farthest-point order fills it unevenly. Shipped set, normalized minimum distance at
-/// 4 / 6 / 8.5 / 12 N: 0.636 / 0.624 / 0.643 / 0.675; low-frequency power 1.3x / 1.8x /
-/// 1.9x / 1.8x dart throwing's. Tried in session 4, none better in the trough:
+/// nested subsets of a fixed, discrete set (the children's `16 N` points). With every
+/// candidate entering at `N` (the paper's random order, i.e. farthest-point picks) the
+/// shipped set reached, at 4 / 6 / 8.5 / 12 N, a normalized minimum distance of 0.636 /
+/// 0.624 / 0.643 / 0.675 and low-frequency power 1.3x / 1.8x / 1.9x / 1.8x dart
+/// throwing's. Measured in session 5 with the in-tile minimum distance of each prefix
+/// (which tracks the query's to 0.002): farthest-point ranks of all `16 N` points with the
+/// base points left free have the same trough (0.638 / 0.623 / 0.642), and so does a
+/// weighted sample elimination order (Yuksel 2015) from `16 N` down (0.621-0.633 at 4-6 N),
+/// so the base points are not the cause; a more regular `16 N` set (seam smoothing over
+/// the whole tile) lifts `N` and `16 N` to 0.68 but sinks 6 N to 0.612. What helped is the
+/// children's own rankings as a prior ([`SUB_CHILD_RANK_LEAD`]) with the wide first search:
+/// 0.643 / 0.643 / 0.653 / 0.677, low-frequency 1.47x / 1.68x / 1.72x / 1.61x, for
+/// 0.651 (was 0.683) and 1.4x (was 1.1x) at 1.5-2 N. Leads from 0.3 to 0.6 and wide
+/// prefixes from 2.5 N to 3.5 N all stay between 0.638 and 0.645 at the worst density.
+///
+/// Tried in session 4, none better in the trough:
 /// - the whole order as window: no change (15 107 of the 65 536 ranks 4096..8191 miss);
 /// - among the first 8 or 32 points with room, the one blocking the fewest others: 14 982;
 /// - minimum-degree packing in stages from `N` or `2 N` (a one-shot independent set at
 ///   `4 N` spacing holds 9 600 points, but packing tightly early leaves holes too small
 ///   later): 0.637 / 0.623 / 0.644;
-/// - weighted sample elimination (Yuksel 2015) from `16 N` down, neighbours averaged or
-///   summed, alone or below a farthest-point prefix of `2 N` / `3 N`: 0.49 to 0.59 at 4 N,
-///   but 0.669 / 0.681 at 12 / 14 N;
+/// - weighted sample elimination from `16 N` down, neighbours averaged or summed, alone or
+///   below a farthest-point prefix of `2 N` / `3 N`: 0.49 to 0.59 at 4 N, but 0.669 / 0.681
+///   at 12 / 14 N;
 /// - preferring candidates with fewer placed points within 3-4 radii (balance): low-frequency
 ///   power 1.9x -> 1.8x at 8.5 N for rho 0.631.
 const SUB_PREFIX_LOOKAHEAD: Lookahead = Lookahead {
     window: 64,
     fallback: 64,
 };
+
+/// Subdivision ranks from `N` to `SUB_WIDE_PREFIX * N` search the whole threshold order for
+/// a point with room, like the base ranks below [`WIDE_PREFIX_FRACTION`]; the rest is ranked
+/// again around them.
+const SUB_WIDE_PREFIX: f64 = 3.0;
+
+/// A subdivision candidate that is not a base point enters the ranking at this share of
+/// the density at which its own child tile shows it (`n^2 (rank in child + 1)`), or at `N`
+/// if that is lower. The children's base rankings are good progressive sets at every
+/// density, so this prior keeps the nested subsets balanced where farthest-point picks from
+/// the fixed `16 N` points are not.
+const SUB_CHILD_RANK_LEAD: f64 = 0.35;
 
 /// A merged Wang tile: its points in progressive order and its seams.
 type MergedTile = (Vec<SourcedPoint>, Vec<Vec<[f32; 2]>>);
@@ -283,6 +305,21 @@ pub fn complete_set_neighbours(tiles: &[EdgeColors]) -> Neighbours {
             })
         })
         .collect()
+}
+
+/// A tile's candidates for ranking the rest of `order` again around its first `len` ranks:
+/// those keep their ranks, every other point enters no earlier than `len`.
+fn around_prefix(cands: &[Candidate], order: &[usize], len: usize) -> Vec<Candidate> {
+    let mut around = cands.to_vec();
+    for c in &mut around {
+        c.tau0 = c.tau0.max(len as f64);
+        c.fixed = false;
+    }
+    for (rank, &i) in order[..len].iter().enumerate() {
+        around[i].tau0 = rank as f64;
+        around[i].fixed = true;
+    }
+    around
 }
 
 /// Builds a tile set.
@@ -473,22 +510,12 @@ pub fn build(
     );
     // The wide search took points from anywhere in the threshold order: rank the rest
     // again around them, or the next ranks find only points that crowd them.
-    let around_prefix: Vec<Vec<Candidate>> = (0..tile_count)
-        .map(|t| {
-            let mut cands = base_cands[t].clone();
-            for c in &mut cands {
-                c.tau0 = c.tau0.max(wide as f64);
-            }
-            for (rank, &i) in order[t][..wide].iter().enumerate() {
-                cands[i].tau0 = rank as f64;
-                cands[i].fixed = true;
-            }
-            cands
-        })
+    let around_wide: Vec<Vec<Candidate>> = (0..tile_count)
+        .map(|t| around_prefix(&base_cands[t], &order[t], wide))
         .collect();
-    let around_tau = rank(&around_prefix, &neighbours, |_| config.alpha, big_n as f64);
+    let around_tau = rank(&around_wide, &neighbours, |_| config.alpha, big_n as f64);
     for t in 0..tile_count {
-        order[t] = order_by_threshold(&around_prefix[t], &around_tau[t]);
+        order[t] = order_by_threshold(&around_wide[t], &around_tau[t]);
     }
     prefix_misses += repair_prefixes(
         &base_cands,
@@ -526,9 +553,9 @@ pub fn build(
                         tau0: if base_rank != usize::MAX {
                             base_rank as f64
                         } else {
-                            // The paper's figure 8: candidates in random order, spaced by
-                            // the shrinking radius alone.
-                            big_n as f64
+                            // The paper's figure 8 draws them in random order; we let each
+                            // enter at a share of the density where its own child shows it.
+                            (SUB_CHILD_RANK_LEAD * (n * n * (kk + 1)) as f64).max(big_n as f64)
                                 * (1.0
                                     + 1e-3
                                         * unit_f64(hash_words(
@@ -547,14 +574,34 @@ pub fn build(
     let mut sub_order: Vec<Vec<usize>> = (0..tile_count)
         .map(|t| order_by_threshold(&sub_cands[t], &sub_tau[t]))
         .collect();
-    // The base points keep the first N ranks (they are fixed candidates with tau < N).
-    let sub_prefix_misses = repair_prefixes(
+    // The base points keep the first N ranks (they are fixed candidates with tau < N). As
+    // for the base ranking: a whole-order search first, then the rest ranked around it.
+    let wide = ((big_n as f64 * SUB_WIDE_PREFIX) as usize).clamp(big_n, sub_len);
+    let mut sub_prefix_misses = repair_prefixes(
+        &sub_cands,
+        &mut sub_order,
+        &neighbours,
+        config.prefix_alpha,
+        Lookahead {
+            window: usize::MAX,
+            fallback: SUB_PREFIX_LOOKAHEAD.fallback,
+        },
+        big_n..wide,
+    );
+    let around_wide: Vec<Vec<Candidate>> = (0..tile_count)
+        .map(|t| around_prefix(&sub_cands[t], &sub_order[t], wide))
+        .collect();
+    let around_tau = rank(&around_wide, &neighbours, |_| config.alpha, sub_len as f64);
+    for t in 0..tile_count {
+        sub_order[t] = order_by_threshold(&around_wide[t], &around_tau[t]);
+    }
+    sub_prefix_misses += repair_prefixes(
         &sub_cands,
         &mut sub_order,
         &neighbours,
         config.prefix_alpha,
         SUB_PREFIX_LOOKAHEAD,
-        big_n..sub_len,
+        wide..sub_len,
     );
     progress.advance(1);
     progress.finish();

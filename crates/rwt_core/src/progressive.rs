@@ -239,23 +239,47 @@ pub fn repair_prefixes(
             place(&mut clearance, t, tiles[t][i].pos, radius(fixed));
         }
     }
+    // Picks are recorded apart from `order` and the rest appended at the end, so a pick from
+    // far down the order costs nothing to move.
+    let mut taken: Vec<Vec<bool>> = tiles.iter().map(|c| vec![false; c.len()]).collect();
+    let mut picked: Vec<Vec<usize>> = order.iter().map(|o| o[..fixed].to_vec()).collect();
+    for (t, o) in order.iter().enumerate() {
+        for &i in &o[..fixed] {
+            taken[t][i] = true;
+        }
+    }
+    let mut cursor = vec![fixed; tiles.len()];
     let mut misses = 0;
     for k in fixed..until {
         let r = radius(k);
         for t in 0..tiles.len() {
-            let (o, room) = (&order[t], &clearance[t]);
-            let end = o.len().min(k.saturating_add(lookahead.window));
-            let slot = (k..end).find(|&s| room[o[s]] >= r).unwrap_or_else(|| {
-                misses += 1;
-                let end = o.len().min(k + lookahead.fallback);
-                // The most room; the earliest among equals.
-                (k..end)
-                    .max_by(|&a, &b| room[o[a]].total_cmp(&room[o[b]]).then(b.cmp(&a)))
-                    .unwrap_or(k)
-            });
-            order[t][k..=slot].rotate_right(1);
-            place(&mut clearance, t, tiles[t][order[t][k]].pos, r);
+            let (o, room, done) = (&order[t], &clearance[t], &taken[t]);
+            while cursor[t] < o.len() && done[o[cursor[t]]] {
+                cursor[t] += 1;
+            }
+            let untaken = || o[cursor[t]..].iter().copied().filter(|&i| !done[i]);
+            let pick = match untaken().take(lookahead.window).find(|&i| room[i] >= r) {
+                Some(i) => i,
+                None => {
+                    misses += 1;
+                    // The most room among the next `fallback`; the earliest among equals.
+                    let roomiest = untaken()
+                        .take(lookahead.fallback)
+                        .reduce(|a, b| if room[b] > room[a] { b } else { a });
+                    let Some(i) = roomiest else { continue };
+                    i
+                }
+            };
+            taken[t][pick] = true;
+            picked[t].push(pick);
+            place(&mut clearance, t, tiles[t][pick].pos, r);
         }
+    }
+    for (t, o) in order.iter_mut().enumerate() {
+        let rest: Vec<usize> = o.iter().copied().filter(|&i| !taken[t][i]).collect();
+        let mut full = std::mem::take(&mut picked[t]);
+        full.extend(rest);
+        *o = full;
     }
     misses
 }

@@ -32,20 +32,21 @@ fn uniform_densities_are_well_spaced_at_and_between_levels() {
     // end, between levels 0 and 1 (1.5, 4 = geometric middle, 8.5 = arithmetic middle), at
     // level 1's end and inside level 2.
     // Floors are what the shipped set reaches. The issue's target is 0.65 everywhere; deep
-    // in a level's subdivision ranking (4 N to 9 N, and again 64 N to 144 N) it reaches
-    // 0.624 to 0.643, and at 0.3 N, where the base ranking pays for its sparse prefixes,
-    // 0.649. `cargo run --release -p rwt_core --example density_sweep` prints the whole
-    // curve; the construction docs say what was tried against the trough.
+    // in a level's subdivision ranking (4 N to 6 N, and again 64 N to 96 N) it reaches
+    // 0.643, and at 0.3 N, where the base ranking pays for its sparse prefixes, 0.648.
+    // `cargo run --release -p rwt_core --example density_sweep` prints the whole curve; the
+    // construction docs say what was tried against the trough.
     let cases = [
         (0.3, 0.64),
         (1.0, 0.65),
         (1.5, 0.65),
-        (4.0, 0.63),
-        (6.0, 0.62),
-        (8.5, 0.63),
+        (2.0, 0.65),
+        (4.0, 0.64),
+        (6.0, 0.64),
+        (8.5, 0.65),
         (16.0, 0.65),
         (24.0, 0.65),
-        (64.0, 0.63),
+        (64.0, 0.64),
     ];
     let s = sampler(11);
     for (multiple, floor) in cases {
@@ -92,14 +93,15 @@ fn spectrum_beside_references() {
     let n = set().points_per_tile as f64;
     // (multiple of N, ceiling of our low-frequency power over dart throwing's). The issue
     // asks for 1.5; the sparse base prefixes (0.3 N) and the middle of a subdivision ranking
-    // (6 N, 8.5 N) stay above it (measured 1.78, 1.78, 1.94): those ceilings only guard
+    // (6 N, 8.5 N) stay above it (measured 1.78, 1.68, 1.72): those ceilings only guard
     // against regressions.
     let cases = [
         (0.3, 1.9),
         (1.0, 1.5),
         (2.0, 1.5),
-        (6.0, 1.9),
-        (8.5, 2.05),
+        (4.0, 1.5),
+        (6.0, 1.75),
+        (8.5, 1.8),
         (16.0, 1.5),
     ];
     for (multiple, ceiling) in cases {
@@ -129,8 +131,9 @@ fn spectrum_beside_references() {
             low(&ours),
             low(&dart)
         );
-        // Where the target holds, well below a jittered grid; elsewhere at least below it.
-        let share = if ceiling <= 1.5 { 0.5 } else { 1.0 };
+        // Where the target holds, well below a jittered grid (2 N and 4 N, in the subdivision
+        // ranking, reach 0.54 and 0.57 of it); elsewhere at least below it.
+        let share = if ceiling <= 1.5 { 0.6 } else { 1.0 };
         assert!(low(&ours) < share * low(&jitter) && low(&white) > 0.7);
     }
 }
