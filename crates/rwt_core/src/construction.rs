@@ -174,8 +174,9 @@ const PREFIX_LOOKAHEAD: Lookahead = Lookahead {
 /// the whole tile) lifts `N` and `16 N` to 0.68 but sinks 6 N to 0.612. What helped is the
 /// children's own rankings as a prior ([`SUB_CHILD_RANK_LEAD`]) with the wide first search:
 /// 0.643 / 0.643 / 0.653 / 0.677, low-frequency 1.47x / 1.68x / 1.72x / 1.61x, for
-/// 0.651 (was 0.683) and 1.4x (was 1.1x) at 1.5-2 N. Leads from 0.3 to 0.6 and wide
-/// prefixes from 2.5 N to 3.5 N all stay between 0.638 and 0.645 at the worst density.
+/// 0.651 (was 0.683) and 1.4x (was 1.1x) at 1.5-2 N. Leads from 0.3 to 0.42 and wide
+/// prefixes from 2.5 N to 3.5 N all stay between 0.638 and 0.645 at the worst density
+/// (a lead of 0.6: 0.631); re-ranking again at 4.5 N or 6 N changes nothing.
 ///
 /// Tried in session 4, none better in the trough:
 /// - the whole order as window: no change (15 107 of the 65 536 ranks 4096..8191 miss);
