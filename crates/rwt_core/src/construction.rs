@@ -323,6 +323,51 @@ fn around_prefix(cands: &[Candidate], order: &[usize], len: usize) -> Vec<Candid
     around
 }
 
+/// The final prefix pass of a ranking: ranks in `wide` search the whole threshold order
+/// for a point with room; those picks come from anywhere in the order, so the rest is
+/// ranked again around them (or the next ranks find only points that crowd them) and
+/// fixed with `lookahead`. Returns the ranks that found no point with room.
+fn wide_then_windowed(
+    cands: &[Vec<Candidate>],
+    order: &mut [Vec<usize>],
+    neighbours: &Neighbours,
+    config: &BuildConfig,
+    lookahead: Lookahead,
+    wide: std::ops::Range<usize>,
+) -> usize {
+    let len = cands.first().map_or(0, Vec::len);
+    let whole_order = Lookahead {
+        window: usize::MAX,
+        fallback: lookahead.fallback,
+    };
+    let mut misses = repair_prefixes(
+        cands,
+        order,
+        neighbours,
+        config.prefix_alpha,
+        whole_order,
+        wide.clone(),
+    );
+    let around: Vec<Vec<Candidate>> = cands
+        .iter()
+        .zip(order.iter())
+        .map(|(c, o)| around_prefix(c, o, wide.end))
+        .collect();
+    let tau = rank(&around, neighbours, |_| config.alpha, len as f64);
+    for ((o, c), t) in order.iter_mut().zip(&around).zip(&tau) {
+        *o = order_by_threshold(c, t);
+    }
+    misses += repair_prefixes(
+        cands,
+        order,
+        neighbours,
+        config.prefix_alpha,
+        lookahead,
+        wide.end..len,
+    );
+    misses
+}
+
 /// Builds a tile set.
 pub fn build(
     config: &BuildConfig,
@@ -498,33 +543,13 @@ pub fn build(
         })
         .collect();
     let wide = ((big_n as f64 * WIDE_PREFIX_FRACTION) as usize).min(big_n);
-    let mut prefix_misses = repair_prefixes(
+    let prefix_misses = wide_then_windowed(
         &base_cands,
         &mut order,
         &neighbours,
-        config.prefix_alpha,
-        Lookahead {
-            window: usize::MAX,
-            fallback: PREFIX_LOOKAHEAD.fallback,
-        },
-        0..wide,
-    );
-    // The wide search took points from anywhere in the threshold order: rank the rest
-    // again around them, or the next ranks find only points that crowd them.
-    let around_wide: Vec<Vec<Candidate>> = (0..tile_count)
-        .map(|t| around_prefix(&base_cands[t], &order[t], wide))
-        .collect();
-    let around_tau = rank(&around_wide, &neighbours, |_| config.alpha, big_n as f64);
-    for t in 0..tile_count {
-        order[t] = order_by_threshold(&around_wide[t], &around_tau[t]);
-    }
-    prefix_misses += repair_prefixes(
-        &base_cands,
-        &mut order,
-        &neighbours,
-        config.prefix_alpha,
+        config,
         PREFIX_LOOKAHEAD,
-        wide..big_n,
+        0..wide,
     );
     let mut new_index = vec![vec![0usize; big_n]; tile_count];
     for t in 0..tile_count {
@@ -578,31 +603,13 @@ pub fn build(
     // The base points keep the first N ranks (they are fixed candidates with tau < N). As
     // for the base ranking: a whole-order search first, then the rest ranked around it.
     let wide = ((big_n as f64 * SUB_WIDE_PREFIX) as usize).clamp(big_n, sub_len);
-    let mut sub_prefix_misses = repair_prefixes(
+    let sub_prefix_misses = wide_then_windowed(
         &sub_cands,
         &mut sub_order,
         &neighbours,
-        config.prefix_alpha,
-        Lookahead {
-            window: usize::MAX,
-            fallback: SUB_PREFIX_LOOKAHEAD.fallback,
-        },
-        big_n..wide,
-    );
-    let around_wide: Vec<Vec<Candidate>> = (0..tile_count)
-        .map(|t| around_prefix(&sub_cands[t], &sub_order[t], wide))
-        .collect();
-    let around_tau = rank(&around_wide, &neighbours, |_| config.alpha, sub_len as f64);
-    for t in 0..tile_count {
-        sub_order[t] = order_by_threshold(&around_wide[t], &around_tau[t]);
-    }
-    sub_prefix_misses += repair_prefixes(
-        &sub_cands,
-        &mut sub_order,
-        &neighbours,
-        config.prefix_alpha,
+        config,
         SUB_PREFIX_LOOKAHEAD,
-        wide..sub_len,
+        big_n..wide,
     );
     progress.advance(1);
     progress.finish();
