@@ -2,7 +2,7 @@
 
 use crate::draw::Canvas;
 use indicatif::{ProgressBar, ProgressStyle};
-use rwt_core::check::{base_prefix_rho, edge_violations};
+use rwt_core::check::{base_prefix_rho, edge_violations, subdivision_prefix_rho};
 use rwt_core::construction::{BuildConfig, Progress, Stage, build};
 use rwt_core::tileset::{TileSet, fixed_to_unit};
 use std::path::Path;
@@ -141,6 +141,29 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
     ok &= pass;
     say!(
         "  worst k in 16..{n} (quarter octaves): rho = {worst:.3} at k = {worst_k}{}",
+        if pass { "" } else { "  (below --min-rho)" }
+    );
+    // Between the base level and the next, a query shows a prefix of each tile's
+    // subdivision ranking: the points are nested subsets of a fixed set there.
+    let levels = set.subdivision_len() / n;
+    say!(
+        "the same for each tile's first k subdivision points, k = m N (2 seeds, 4x4 tiles):"
+    );
+    let mut worst = (0.0, f64::INFINITY);
+    for m in [1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.5, 12.0, levels as f64] {
+        let k = (m * n as f64) as usize;
+        let rho = subdivision_prefix_rho(&set, k, 2, 4);
+        say!("  m = {m:>4}: rho = {rho:.3}");
+        if rho < worst.1 {
+            worst = (m, rho);
+        }
+    }
+    let pass = min_rho.is_none_or(|m| worst.1 >= m);
+    ok &= pass;
+    say!(
+        "  worst: rho = {:.3} at m = {}{}",
+        worst.1,
+        worst.0,
         if pass { "" } else { "  (below --min-rho)" }
     );
     say!("{}", if ok { "OK" } else { "FAILED" });

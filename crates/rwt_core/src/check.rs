@@ -23,15 +23,23 @@ pub fn edge_violations(set: &TileSet, seed: u64, level: u32, window: i64) -> usi
     bad
 }
 
-/// The first `k` base points of every tile of a `window x window` tiling, in world units
-/// (tiles of side 1).
-pub fn base_prefix_points(set: &TileSet, seed: u64, window: i64, k: usize) -> Vec<DVec2> {
+/// The first `k` points of every tile of a `window x window` tiling, in world units (tiles
+/// of side 1), where `point(tile, rank)` gives a rank's position in the tile's fixed-point
+/// frame.
+fn tiled_prefix(
+    set: &TileSet,
+    seed: u64,
+    window: i64,
+    k: usize,
+    point: impl Fn(usize, usize) -> [u32; 2],
+) -> Vec<DVec2> {
     let tiling = Tiling::new(set, seed);
     let mut out = Vec::with_capacity((window * window) as usize * k);
     for j in 0..window {
         for i in 0..window {
-            let t = &set.tiles[tiling.base_tile(i, j) as usize];
-            for p in &t.points[..k.min(t.points.len())] {
+            let t = tiling.base_tile(i, j) as usize;
+            for rank in 0..k {
+                let p = point(t, rank);
                 out.push(DVec2::new(
                     i as f64 + fixed_to_unit(p[0]),
                     j as f64 + fixed_to_unit(p[1]),
@@ -42,13 +50,37 @@ pub fn base_prefix_points(set: &TileSet, seed: u64, window: i64, k: usize) -> Ve
     out
 }
 
+/// The first `k` base points of every tile of a `window x window` tiling, in world units
+/// (tiles of side 1).
+pub fn base_prefix_points(set: &TileSet, seed: u64, window: i64, k: usize) -> Vec<DVec2> {
+    let k = k.min(set.points_per_tile as usize);
+    tiled_prefix(set, seed, window, k, |t, rank| set.tiles[t].points[rank])
+}
+
+/// The first `k` points of every tile's subdivision ranking (what a query at `k` points per
+/// tile shows between the base level and the next) in a `window x window` tiling, in world
+/// units (tiles of side 1).
+pub fn subdivision_prefix_points(set: &TileSet, seed: u64, window: i64, k: usize) -> Vec<DVec2> {
+    let k = k.min(set.subdivision_len());
+    tiled_prefix(set, seed, window, k, |t, rank| {
+        set.subdivision_point_fixed(t, set.tiles[t].subdivision[rank])
+    })
+}
+
+fn worst_rho(points: impl Fn(u64) -> Vec<DVec2>, k: usize, seeds: u64) -> f64 {
+    (0..seeds)
+        .map(|s| min_distance(&points(s)).unwrap_or(f64::INFINITY) / hex_spacing(k as f64))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Worst normalized minimum distance of the first `k` points of every tile, measured on
 /// real tilings (every tile together with its neighbours) over `seeds` seeds.
 pub fn base_prefix_rho(set: &TileSet, k: usize, seeds: u64, window: i64) -> f64 {
-    (0..seeds)
-        .map(|s| {
-            let pts = base_prefix_points(set, s, window, k);
-            min_distance(&pts).unwrap_or(f64::INFINITY) / hex_spacing(k as f64)
-        })
-        .fold(f64::INFINITY, f64::min)
+    worst_rho(|s| base_prefix_points(set, s, window, k), k, seeds)
+}
+
+/// The same for the first `k` points of every tile's subdivision ranking (`N <= k <= n^2
+/// N`): the quality of uniform densities between two levels.
+pub fn subdivision_prefix_rho(set: &TileSet, k: usize, seeds: u64, window: i64) -> f64 {
+    worst_rho(|s| subdivision_prefix_points(set, s, window, k), k, seeds)
 }
