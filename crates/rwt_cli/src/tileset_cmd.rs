@@ -145,12 +145,10 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
     );
     // Between the base level and the next, a query shows a prefix of each tile's
     // subdivision ranking: the points are nested subsets of a fixed set there.
-    let levels = set.subdivision_len() / n;
-    say!(
-        "the same for each tile's first k subdivision points, k = m N (2 seeds, 4x4 tiles):"
-    );
+    let full = set.subdivision_len() / n;
+    say!("the same for each tile's first k subdivision points, k = m N (2 seeds, 4x4 tiles):");
     let mut worst = (0.0, f64::INFINITY);
-    for m in [1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.5, 12.0, levels as f64] {
+    for m in [1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.5, 12.0, full as f64] {
         let k = (m * n as f64) as usize;
         let rho = subdivision_prefix_rho(&set, k, 2, 4);
         say!("  m = {m:>4}: rho = {rho:.3}");

@@ -178,6 +178,13 @@ const PREFIX_LOOKAHEAD: Lookahead = Lookahead {
 /// prefixes from 2.5 N to 3.5 N all stay between 0.638 and 0.645 at the worst density
 /// (a lead of 0.6: 0.631); re-ranking again at 4.5 N or 6 N changes nothing.
 ///
+/// Session 6 (`rwt tileset check` prints these prefixes): the trough is a capacity curve,
+/// not a few bad picks: from 3.5 N to 7 N nearly every rank of every tile gets a little
+/// less than the `prefix_alpha` room, none less than 0.64 of the hexagonal spacing. Ranking
+/// every tile as its own only neighbour: 0.644. `prefix_alpha` 0.69 / 0.705: trough 0.645 /
+/// 0.639, 1.5-2 N 0.642 / 0.656. Candidate sets from seam smoothing targets 0.6-0.75 or a
+/// relaxation spacing of 0.6-0.68: 0.642-0.647 (0.6 costs 1 N its 0.668, down to 0.600).
+///
 /// Tried in session 4, none better in the trough:
 /// - the whole order as window: no change (15 107 of the 65 536 ranks 4096..8191 miss);
 /// - among the first 8 or 32 points with room, the one blocking the fewest others: 14 982;
