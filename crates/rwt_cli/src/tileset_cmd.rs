@@ -293,3 +293,18 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
     say!("wrote {}", out.display());
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn check_gates_base_and_subdivision_prefixes_on_min_rho() {
+        let shipped =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/tilesets/default.ron");
+        assert_eq!(check_cmd(&shipped, Some(0.6)), Ok(true));
+        // The shipped set's worst prefixes are 0.642 (base, 431 points) and 0.643 (4 N).
+        assert_eq!(check_cmd(&shipped, Some(0.66)), Ok(false));
+        assert!(check_cmd(Path::new("/does/not/exist.ron"), None).is_err());
+    }
+}
