@@ -148,7 +148,9 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
     let full = set.subdivision_len() / n;
     say!("the same for each tile's first k subdivision points, k = m N (2 seeds, 4x4 tiles):");
     let mut worst = (0.0, f64::INFINITY);
-    for m in [1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.5, 12.0, full as f64] {
+    let multiples = [1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.5, 12.0].into_iter();
+    // Only multiples within this set's subdivision (a 2x2 set holds 4 N).
+    for m in multiples.filter(|&m| m < full as f64).chain([full as f64]) {
         let k = (m * n as f64) as usize;
         let rho = subdivision_prefix_rho(&set, k, 2, 4);
         say!("  m = {m:>4}: rho = {rho:.3}");
