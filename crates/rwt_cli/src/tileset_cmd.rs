@@ -127,10 +127,7 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
         let rho = base_prefix_rho(&set, k, 8, 10);
         let pass = min_rho.is_none_or(|m| rho >= m);
         ok &= pass;
-        say!(
-            "  k = {k:>5}: rho = {rho:.3}{}",
-            if pass { "" } else { "  (below --min-rho)" }
-        );
+        say!("  k = {k:>5}: rho = {rho:.3}{}", below_min_rho(pass));
     }
     // Every prefix between the listed ones matters too (a query at 0.3 N per tile reads the
     // first 614): the worst over quarter-octave steps from 16 to N.
@@ -141,7 +138,7 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
     ok &= pass;
     say!(
         "  worst k in 16..{n} (quarter octaves): rho = {worst:.3} at k = {worst_k}{}",
-        if pass { "" } else { "  (below --min-rho)" }
+        below_min_rho(pass)
     );
     // Between the base level and the next, a query shows a prefix of each tile's
     // subdivision ranking: the points are nested subsets of a fixed set there.
@@ -164,10 +161,15 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
         "  worst: rho = {:.3} at m = {}{}",
         worst.1,
         worst.0,
-        if pass { "" } else { "  (below --min-rho)" }
+        below_min_rho(pass)
     );
     say!("{}", if ok { "OK" } else { "FAILED" });
     Ok(ok)
+}
+
+/// What `rwt tileset check` appends to a figure that fails `--min-rho`.
+fn below_min_rho(pass: bool) -> &'static str {
+    if pass { "" } else { "  (below --min-rho)" }
 }
 
 /// Prefix sizes `16 * 2^(i/4)` up to `n`.

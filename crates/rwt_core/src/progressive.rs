@@ -234,11 +234,6 @@ pub fn repair_prefixes(
             });
         }
     };
-    for (t, o) in order.iter().enumerate() {
-        for &i in &o[..fixed] {
-            place(&mut clearance, t, tiles[t][i].pos, radius(fixed));
-        }
-    }
     // Picks are recorded apart from `order` and the rest appended at the end, so a pick from
     // far down the order costs nothing to move.
     let mut taken: Vec<Vec<bool>> = tiles.iter().map(|c| vec![false; c.len()]).collect();
@@ -246,6 +241,7 @@ pub fn repair_prefixes(
     for (t, o) in order.iter().enumerate() {
         for &i in &o[..fixed] {
             taken[t][i] = true;
+            place(&mut clearance, t, tiles[t][i].pos, radius(fixed));
         }
     }
     let mut cursor = vec![fixed; tiles.len()];
