@@ -13,7 +13,7 @@ use bevy::pbr::{DistanceFog, FogFalloff};
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
-use rwt_core::density::NoiseDensity;
+use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_examples::prelude::*;
 use std::sync::Arc;
 
@@ -174,7 +174,16 @@ fn setup(
         .add(Mesh::from(Cone::new(0.12, 0.9).mesh().resolution(3)).translated_by(Vec3::Y * 0.45));
 
     // Trees: two classes sharing one blue-noise set, forests from noise.
-    let forest = |seed| NoiseDensity::new(seed, 1.0 / 700.0, 4, -0.05, 1.8, 0.012);
+    let forest = |seed| {
+        NoiseDensity::new(NoiseParams {
+            seed,
+            frequency: 1.0 / 700.0,
+            octaves: 4,
+            base: -0.05,
+            amplitude: 1.8,
+            scale: 0.012,
+        })
+    };
     let trees = ScatterLayer::new(vec![
         ScatterClass::new(
             LayerDensity::Noise(forest(11)),
@@ -227,7 +236,14 @@ fn setup(
 
     // Grass: dense noise patches close to the camera only.
     let grass = ScatterLayer::new(vec![ScatterClass::new(
-        LayerDensity::Noise(NoiseDensity::new(3, 1.0 / 120.0, 3, 0.35, 0.9, 1.2)),
+        LayerDensity::Noise(NoiseDensity::new(NoiseParams {
+            seed: 3,
+            frequency: 1.0 / 120.0,
+            octaves: 3,
+            base: 0.35,
+            amplitude: 0.9,
+            scale: 1.2,
+        })),
         blade,
         solid(Color::srgb(0.38, 0.55, 0.2)),
     )])

@@ -138,15 +138,13 @@ impl Canvas {
                 }
             }
         }
-        let r = Rect {
-            min: (centre - radius - texel).max(DVec2::ZERO),
-            max: (centre + radius + texel).min(DVec2::ONE),
-        };
+        let r = Rect::new(
+            (centre - radius - texel).max(DVec2::ZERO),
+            (centre + radius + texel).min(DVec2::ONE),
+        )
+        .unwrap_or(Rect::EMPTY);
         self.dirty = Some(match self.dirty {
-            Some(d) => Rect {
-                min: d.min.min(r.min),
-                max: d.max.max(r.max),
-            },
+            Some(d) => Rect::new(d.min().min(r.min()), d.max().max(r.max())).unwrap_or(d),
             None => r,
         });
     }
@@ -215,10 +213,7 @@ impl Canvas {
 }
 
 fn whole() -> Rect {
-    Rect {
-        min: DVec2::ZERO,
-        max: DVec2::ONE,
-    }
+    Rect::new(DVec2::ZERO, DVec2::ONE).expect("ordered")
 }
 
 /// A brush per class (its own size and strength), one of them selected.

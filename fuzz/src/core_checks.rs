@@ -3,8 +3,8 @@
 
 use glam::DVec2;
 use rwt_core::density::{
-    Constant, Density, DistanceFalloff, ImageDensity, NoiseDensity, Product, Scale, Sum, from_fn,
-    sanitize,
+    Constant, Density, DistanceFalloff, ImageDensity, NoiseDensity, NoiseParams, Product, Scale,
+    Sum, from_fn, sanitize,
 };
 use rwt_core::query::{Point, Rect, Sampler};
 use rwt_core::tileset::TileSet;
@@ -121,9 +121,9 @@ pub fn image_density(data: &[u8]) -> bool {
         return false;
     };
     let rect = Rect::new(DVec2::splat(-2.0), DVec2::splat(2.0)).unwrap();
-    let max = d.max_over(rect.min, rect.max);
+    let max = d.max_over(rect.min(), rect.max());
     for i in 0..16 {
-        let p = rect.min + DVec2::new((i % 4) as f64 + 0.3, (i / 4) as f64 + 0.6);
+        let p = rect.min() + DVec2::new((i % 4) as f64 + 0.3, (i / 4) as f64 + 0.6);
         let v = d.density(p);
         assert!(
             sanitize(v) <= sanitize(max),
@@ -139,14 +139,14 @@ fn density(b: &mut Bytes, depth: u32) -> Box<dyn Density + Send + Sync> {
     let kind = if depth > 2 { b.u8() % 4 } else { b.u8() % 8 };
     match kind {
         0 => Box::new(Constant(b.number())),
-        1 => Box::new(NoiseDensity::new(
-            b.u8() as u32,
-            b.number(),
-            b.u8() as usize,
-            b.number(),
-            b.number(),
-            b.number(),
-        )),
+        1 => Box::new(NoiseDensity::new(NoiseParams {
+            seed: b.u8() as u32,
+            frequency: b.number(),
+            octaves: b.u8() as usize,
+            base: b.number(),
+            amplitude: b.number(),
+            scale: b.number(),
+        })),
         2 => {
             let (w, h) = (b.u8() as u32 % 9, b.u8() as u32 % 9);
             let values: Vec<f32> = (0..w * h).map(|_| b.number() as f32).collect();

@@ -3,7 +3,7 @@
 
 use bevy::prelude::Handle;
 use bevy_rwt::LayerDensity;
-use bevy_rwt::layer_asset::LayerDescription;
+use bevy_rwt::layers::file::LayerDescription;
 use bevy_rwt::rwt_core::density::{Density, sanitize};
 use bevy_rwt::rwt_core::query::{Rect, Sampler};
 use bevy_rwt::rwt_core::streaming::{ChunkSet, Viewer};

@@ -15,8 +15,7 @@ fn main() {
         Default::default(),
     );
     let t = std::time::Instant::now();
-    let d = bevy_rwt::image_density::from_bevy_image(&img, Vec2::ZERO, Vec2::splat(100.0), 1.0)
-        .unwrap();
+    let d = bevy_rwt::layers::from_bevy_image(&img, Vec2::ZERO, Vec2::splat(100.0), 1.0).unwrap();
     println!(
         "1024^2 conversion: {:.1} ms ({:?})",
         t.elapsed().as_secs_f64() * 1e3,

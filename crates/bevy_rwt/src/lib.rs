@@ -8,6 +8,42 @@
 //! chunks they cover, and level of detail by density only ever adds instances between the
 //! existing ones as a viewer approaches.
 //!
+//! ## How it is built
+//!
+//! [`RwtPlugin`] is a group of small plugins, each registering its own systems in one of
+//! the [`RwtSystems`] sets (in order: `Viewers`, `Plan`, `Collect`, `Apply`, `Stats`):
+//!
+//! | plugin | module | does |
+//! |---|---|---|
+//! | [`viewers::RwtViewersPlugin`] | [`viewers`] | lays every [`RwtViewer`] on the ground |
+//! | [`layers::RwtLayersPlugin`] | [`layers`] | layer files (`*.layer.ron`) and asset status |
+//! | [`streaming::RwtStreamingPlugin`] | [`streaming`] | chunks, generation tasks, budgeted spawns, repainting |
+//! | [`diagnostics::RwtDiagnosticsPlugin`] | [`diagnostics`] | [`RwtStats`] and `rwt/` diagnostics |
+//! | [`gizmos::RwtGizmosPlugin`] (opt-in) | [`gizmos`] | chunk and tile outlines |
+//!
+//! The data path from a painted map to an instance: a brush writes the map (`Image`) and a
+//! [`DensityMapPainted`] message → `repaint` forgets the snapshots that read the map and
+//! marks the chunks under the stroke stale → `plan_chunks` resolves the map into an
+//! [`rwt_core::ImageDensity`] and starts a query task per stale chunk → `collect_results`
+//! diffs the points by [`rwt_core::PointId`] → `apply_budget` spawns what appeared and
+//! despawns what went. `docs/ARCHITECTURE.md` draws it whole.
+//!
+//! ## Names
+//!
+//! - `Rwt*`: the plugin and its parts, their resources, system sets and the viewer marker
+//!   ([`RwtPlugin`], [`RwtSettings`], [`RwtSystems`], [`RwtStats`], [`RwtViewer`]);
+//! - `Scatter*`: components and assets that describe a layer and what it places
+//!   ([`ScatterLayer`], [`ScatterClass`], [`ScatterInstance`], [`ScatterLayerStatus`],
+//!   [`layers::file::ScatterLayerSource`]);
+//! - plain names for the values inside them and for messages ([`LayerDensity`],
+//!   [`HeightSource`], [`ClassLook`], [`GroundPlane`], [`ViewCone`], [`ChunkLoaded`]).
+//!
+//! ## Errors
+//!
+//! A layer whose layer file, density map or heightmap cannot load does not stream; the
+//! plugin logs an error naming the layer and the asset, its [`ScatterLayerStatus`] lists
+//! what failed, and [`RwtStats::layers_failed`] counts it.
+//!
 //! ```no_run
 //! use bevy::prelude::*;
 //! use bevy_rwt::prelude::*;
@@ -28,156 +64,44 @@
 //!     .run();
 //! ```
 
-pub mod debug;
-pub mod image_density;
-pub mod layer;
-pub mod layer_asset;
+pub mod diagnostics;
+pub mod gizmos;
+pub mod layers;
+mod settings;
 pub mod streaming;
+pub mod viewers;
 
-use bevy::diagnostic::{Diagnostic, Diagnostics, RegisterDiagnostic};
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
-pub use layer::{
-    ClassLook, HeightSource, InstanceInserter, LayerDensity, ScatterClass, ScatterInstance,
-    ScatterLayer,
+pub use diagnostics::RwtStats;
+pub use layers::{
+    AssetStatus, ClassLook, GroundPlane, HeightSource, InstanceInserter, LayerDensity,
+    ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus,
 };
 pub use rwt_core;
-use rwt_core::streaming::ChunkCoord;
-use std::time::Instant;
+use rwt_core::tileset::TileSet;
+pub use settings::{RwtSettings, RwtSystems};
+use std::sync::Arc;
+pub use streaming::{ChunkLoaded, ChunkUnloaded, DensityMapPainted};
+pub use viewers::{RwtViewer, ViewCone};
 
 /// Everything a game needs.
 pub mod prelude {
-    pub use crate::debug::{RwtGizmos, RwtGizmosPlugin};
-    pub use crate::layer_asset::{ScatterLayerAsset, ScatterLayerSource};
+    pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
+    pub use crate::layers::file::{ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{
-        ChunkLoaded, ChunkUnloaded, ClassLook, HeightSource, LayerDensity, RwtPlugin, RwtSettings,
-        RwtStats, RwtSystems, RwtViewer, ScatterClass, ScatterInstance, ScatterLayer, ViewCone,
+        AssetStatus, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
+        HeightSource, LayerDensity, RwtPlugin, RwtSettings, RwtStats, RwtSystems, RwtViewer,
+        ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus, ViewCone,
     };
-    pub use rwt_core::streaming::StreamingConfig;
+    pub use rwt_core::streaming::{Falloff, StreamingConfig};
 }
 
-/// Which directions a viewer streams in.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ViewCone {
-    /// Every direction (top-down views, or to be ready for any turn).
-    All,
-    /// A wedge of this half-angle (radians) around the view direction.
-    Fixed(f32),
-    /// The horizontal half-angle of the entity's perspective `Projection`, plus `margin`
-    /// radians for turning; every direction for other projections.
-    Camera {
-        /// Extra half-angle beyond the projection's.
-        margin: f32,
-    },
-}
-
-/// Marks an entity (usually a camera) around which layers are streamed. Chunks near it are
-/// always loaded; farther ones where its view cone, laid on the ground, reaches them.
-#[derive(Component, Clone, Copy, Debug)]
-#[require(Transform)]
-pub struct RwtViewer {
-    /// Directions streamed.
-    pub cone: ViewCone,
-}
-
-impl RwtViewer {
-    /// A viewer that streams in every direction.
-    pub fn all_around() -> Self {
-        Self {
-            cone: ViewCone::All,
-        }
-    }
-}
-
-impl Default for RwtViewer {
-    /// The camera's own view cone plus 15 degrees on each side.
-    fn default() -> Self {
-        Self {
-            cone: ViewCone::Camera {
-                margin: 15f32.to_radians(),
-            },
-        }
-    }
-}
-
-/// A chunk's instances were generated (or regenerated) and queued for spawning.
-#[derive(Message, Clone, Copy, Debug, PartialEq)]
-pub struct ChunkLoaded {
-    /// The layer entity.
-    pub layer: Entity,
-    /// The chunk.
-    pub chunk: ChunkCoord,
-    /// Instances the chunk holds now.
-    pub instances: usize,
-}
-
-/// A chunk left every viewer's unload distance; its instances are being despawned.
-#[derive(Message, Clone, Copy, Debug, PartialEq)]
-pub struct ChunkUnloaded {
-    /// The layer entity.
-    pub layer: Entity,
-    /// The chunk.
-    pub chunk: ChunkCoord,
-}
-
-/// Budgets of the streaming systems.
-#[derive(Resource, Clone, Debug)]
-pub struct RwtSettings {
-    /// Most instances spawned per frame (all layers).
-    pub spawn_budget: usize,
-    /// Most instances despawned per frame (all layers).
-    pub despawn_budget: usize,
-    /// Most chunk generation tasks in flight per layer.
-    pub max_tasks_in_flight: usize,
-    /// Length of the view wedge drawn from a viewer on the ground.
-    pub footprint_reach: f64,
-}
-
-impl Default for RwtSettings {
-    fn default() -> Self {
-        Self {
-            spawn_budget: 5_000,
-            despawn_budget: 10_000,
-            max_tasks_in_flight: 8,
-            footprint_reach: 1.0e4,
-        }
-    }
-}
-
-/// Live figures of the plugin (also published as Bevy diagnostics under `rwt/`).
-#[derive(Resource, Clone, Debug, Default, PartialEq)]
-pub struct RwtStats {
-    /// Instances alive.
-    pub live_instances: usize,
-    /// Chunks loaded.
-    pub loaded_chunks: usize,
-    /// Chunks being generated or waiting to be.
-    pub pending_tasks: usize,
-    /// Instances waiting for the spawn budget.
-    pub queued_spawns: usize,
-    /// Time spent in the plugin's systems last frame, milliseconds.
-    pub streaming_ms: f64,
-}
-
-/// The plugin's system sets, in order.
-#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum RwtSystems {
-    /// Viewers to ground positions.
-    Viewers,
-    /// Chunk planning and task start.
-    Plan,
-    /// Finished tasks to spawn and despawn queues.
-    Collect,
-    /// Budgeted spawning and despawning.
-    Apply,
-    /// Statistics.
-    Stats,
-}
-
-/// The plugin: streaming plus statistics. Builder-style settings.
+/// The plugin: viewers, layers, streaming and diagnostics. Builder-style settings.
 pub struct RwtPlugin {
     settings: RwtSettings,
     schedule: InternedScheduleLabel,
+    tile_set: Option<Arc<TileSet>>,
 }
 
 impl Default for RwtPlugin {
@@ -185,6 +109,7 @@ impl Default for RwtPlugin {
         Self {
             settings: RwtSettings::default(),
             schedule: Update.intern(),
+            tile_set: None,
         }
     }
 }
@@ -213,67 +138,38 @@ impl RwtPlugin {
         self.settings.max_tasks_in_flight = n.max(1);
         self
     }
-}
 
-/// Diagnostic paths published by the plugin.
-pub mod diagnostics {
-    use bevy::diagnostic::DiagnosticPath;
-    /// Live instances.
-    pub const LIVE_INSTANCES: DiagnosticPath = DiagnosticPath::const_new("rwt/live_instances");
-    /// Loaded chunks.
-    pub const LOADED_CHUNKS: DiagnosticPath = DiagnosticPath::const_new("rwt/loaded_chunks");
-    /// Tasks in flight.
-    pub const PENDING_TASKS: DiagnosticPath = DiagnosticPath::const_new("rwt/pending_tasks");
-    /// Milliseconds in the plugin's systems per frame.
-    pub const STREAMING_MS: DiagnosticPath = DiagnosticPath::const_new("rwt/streaming_ms");
-}
-
-#[derive(Resource)]
-struct FrameStart(Instant);
-
-fn start_timer(mut start: ResMut<FrameStart>) {
-    start.0 = Instant::now();
-}
-
-fn publish(mut stats: ResMut<RwtStats>, start: Res<FrameStart>, mut diagnostics: Diagnostics) {
-    stats.streaming_ms = start.0.elapsed().as_secs_f64() * 1e3;
-    let s = stats.clone();
-    diagnostics.add_measurement(&diagnostics::LIVE_INSTANCES, || s.live_instances as f64);
-    diagnostics.add_measurement(&diagnostics::LOADED_CHUNKS, || s.loaded_chunks as f64);
-    diagnostics.add_measurement(&diagnostics::PENDING_TASKS, || s.pending_tasks as f64);
-    diagnostics.add_measurement(&diagnostics::STREAMING_MS, || s.streaming_ms);
+    /// Samples this tile set instead of the shipped one (e.g. one built with `rwt tileset
+    /// build` and loaded with [`TileSet::from_ron_bytes`]).
+    pub fn with_tile_set(mut self, set: TileSet) -> Self {
+        self.tile_set = Some(Arc::new(set));
+        self
+    }
 }
 
 impl Plugin for RwtPlugin {
     fn build(&self, app: &mut App) {
-        app.insert_resource(self.settings.clone())
-            .init_resource::<RwtStats>()
-            .insert_resource(FrameStart(Instant::now()))
-            .add_message::<ChunkLoaded>()
-            .add_message::<ChunkUnloaded>()
-            .configure_sets(
-                self.schedule,
-                (
-                    RwtSystems::Viewers,
-                    RwtSystems::Plan,
-                    RwtSystems::Collect,
-                    RwtSystems::Apply,
-                    RwtSystems::Stats,
-                )
-                    .chain(),
+        let schedule = self.schedule;
+        app.insert_resource(self.settings.clone()).configure_sets(
+            schedule,
+            (
+                RwtSystems::Viewers,
+                RwtSystems::Plan,
+                RwtSystems::Collect,
+                RwtSystems::Apply,
+                RwtSystems::Stats,
             )
-            .add_systems(self.schedule, start_timer.before(RwtSystems::Viewers))
-            .add_systems(self.schedule, publish.after(RwtSystems::Stats));
-        for path in [
-            diagnostics::LIVE_INSTANCES,
-            diagnostics::LOADED_CHUNKS,
-            diagnostics::PENDING_TASKS,
-            diagnostics::STREAMING_MS,
-        ] {
-            app.register_diagnostic(Diagnostic::new(path));
-        }
-        app.add_plugins(streaming::StreamingPlugin {
-            schedule: self.schedule,
-        });
+                .chain(),
+        );
+        let tile_set = self
+            .tile_set
+            .clone()
+            .unwrap_or_else(|| Arc::new(TileSet::embedded()));
+        app.add_plugins((
+            viewers::RwtViewersPlugin { schedule },
+            layers::RwtLayersPlugin { schedule },
+            streaming::RwtStreamingPlugin { schedule, tile_set },
+            diagnostics::RwtDiagnosticsPlugin { schedule },
+        ));
     }
 }

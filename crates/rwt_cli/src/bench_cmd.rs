@@ -2,8 +2,7 @@
 
 use fast_poisson::Poisson2D;
 use glam::DVec2;
-use rwt_core::analysis::reference;
-use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity};
+use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity, NoiseParams};
 use rwt_core::query::{Point, Rect, Sampler};
 use rwt_core::rng::Rng;
 use rwt_core::tileset::TileSet;
@@ -82,7 +81,14 @@ pub fn run(quick: bool) -> Result<(), String> {
         ImageDensity::from_values(1024, 1024, &map, DVec2::ZERO, DVec2::splat(tiles), scale)
             .map_err(|e| e.to_string())?
     };
-    let noise = NoiseDensity::new(3, 0.15, 4, 0.5, 0.5, 2.0 * d_uniform);
+    let noise = NoiseDensity::new(NoiseParams {
+        seed: 3,
+        frequency: 0.15,
+        octaves: 4,
+        base: 0.5,
+        amplitude: 0.5,
+        scale: 2.0 * d_uniform,
+    });
     let rows = vec![
         measure(
             &sampler,
@@ -106,7 +112,7 @@ pub fn run(quick: bool) -> Result<(), String> {
     let floor_count = rows[0].1;
     let floor = best_time(runs, || {
         out.clear();
-        reference::white_noise_floor(floor_count, tiles, &mut out);
+        rwt_core::bench::white_noise_floor(floor_count, tiles, &mut out);
         black_box(&out);
     });
     let floor_rate = floor_count as f64 / floor;

@@ -35,7 +35,7 @@ pub fn run(args: PointsArgs) -> Result<(), String> {
             args.tile_size
         ));
     }
-    let density = spec::parse(args.density, (rect.min, rect.max))?;
+    let density = spec::parse(args.density, (rect.min(), rect.max()))?;
     let set = match args.tileset {
         Some(path) => crate::tileset_cmd::load(path)?,
         None => TileSet::embedded(),

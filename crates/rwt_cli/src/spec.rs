@@ -2,7 +2,7 @@
 //! `dark:PATH[:V]` (dark pixels dense), `noise:V[:FREQUENCY[:OCTAVES[:SEED]]]`.
 
 use glam::DVec2;
-use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity};
+use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity, NoiseParams};
 
 /// A parsed density, boxed so every kind goes through one query path.
 pub type BoxedDensity = Box<dyn Density + Send + Sync>;
@@ -57,14 +57,14 @@ pub fn parse(spec: &str, rect: (DVec2, DVec2)) -> Result<BoxedDensity, String> {
                 .map(|s| number(s, "noise seed"))
                 .transpose()?
                 .unwrap_or(0.0);
-            Ok(Box::new(NoiseDensity::new(
-                seed as u32,
-                freq,
-                octaves as usize,
-                0.5,
-                0.5,
-                v,
-            )))
+            Ok(Box::new(NoiseDensity::new(NoiseParams {
+                seed: seed as u32,
+                frequency: freq,
+                octaves: octaves as usize,
+                base: 0.5,
+                amplitude: 0.5,
+                scale: v,
+            })))
         }
         _ => Err(format!(
             "unknown density {spec:?}: use const:V, image:PATH[:V], dark:PATH[:V] or noise:V[:FREQ[:OCTAVES[:SEED]]]"

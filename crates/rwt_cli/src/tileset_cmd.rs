@@ -2,7 +2,7 @@
 
 use crate::draw::Canvas;
 use indicatif::{ProgressBar, ProgressStyle};
-use rwt_core::check::{base_prefix_rho, edge_violations, subdivision_prefix_rho};
+use rwt_core::analysis::check::{base_prefix_rho, edge_violations, subdivision_prefix_rho};
 use rwt_core::construction::{BuildConfig, Progress, Stage, build};
 use rwt_core::tileset::{TileSet, fixed_to_unit};
 use std::path::Path;

@@ -3,7 +3,7 @@
 
 use divan::{Bencher, black_box};
 use glam::DVec2;
-use rwt_core::density::{Constant, ImageDensity, NoiseDensity};
+use rwt_core::density::{Constant, ImageDensity, NoiseDensity, NoiseParams};
 use rwt_core::query::{Point, Rect, Sampler};
 use rwt_core::tileset::TileSet;
 
@@ -59,7 +59,14 @@ fn image(b: Bencher) {
 #[divan::bench(counter = divan::counter::ItemsCount::new(POINTS as usize))]
 fn noise(b: Bencher) {
     let (s, rect, mut out) = setup();
-    let d = NoiseDensity::new(3, 0.2, 4, 0.5, 0.5, 2.0 * POINTS / (TILES * TILES));
+    let d = NoiseDensity::new(NoiseParams {
+        seed: 3,
+        frequency: 0.2,
+        octaves: 4,
+        base: 0.5,
+        amplitude: 0.5,
+        scale: 2.0 * POINTS / (TILES * TILES),
+    });
     b.bench_local(|| {
         out.clear();
         black_box(s.query(rect, &d, &mut out).unwrap());
@@ -71,7 +78,7 @@ fn white_noise_floor(b: Bencher) {
     let mut out: Vec<Point> = Vec::with_capacity(POINTS as usize);
     b.bench_local(|| {
         out.clear();
-        rwt_core::analysis::reference::white_noise_floor(POINTS as usize, TILES, &mut out);
+        rwt_core::bench::white_noise_floor(POINTS as usize, TILES, &mut out);
         black_box(&out);
     });
 }

@@ -10,6 +10,7 @@ pub fn hex_spacing(points_per_unit_area: f64) -> f64 {
 }
 
 /// Shortest offset from `a` to `b` on the unit torus.
+#[cfg(feature = "build")]
 #[inline]
 pub fn torus_delta(a: DVec2, b: DVec2) -> DVec2 {
     let mut d = b - a;
@@ -18,11 +19,25 @@ pub fn torus_delta(a: DVec2, b: DVec2) -> DVec2 {
     d
 }
 
-/// Wraps a coordinate into `[0, 1)`.
-#[inline]
-pub fn wrap01(v: f64) -> f64 {
-    let w = v - v.floor();
-    if w >= 1.0 { 0.0 } else { w }
+/// The translations under which a disc of radius `r` around `p` overlaps the unit square
+/// (the identity first), for toroidal neighbour searches.
+pub fn torus_shifts(p: DVec2, r: f64) -> impl Iterator<Item = DVec2> {
+    let xs: &[f64] = if p.x < r {
+        &[0.0, 1.0]
+    } else if p.x > 1.0 - r {
+        &[0.0, -1.0]
+    } else {
+        &[0.0]
+    };
+    let ys: &[f64] = if p.y < r {
+        &[0.0, 1.0]
+    } else if p.y > 1.0 - r {
+        &[0.0, -1.0]
+    } else {
+        &[0.0]
+    };
+    xs.iter()
+        .flat_map(move |&x| ys.iter().map(move |&y| DVec2::new(x, y)))
 }
 
 /// A uniform bucket grid over a rectangle, storing indices. Used for neighbour searches in
@@ -85,6 +100,7 @@ impl BucketGrid {
     }
 }
 
+#[cfg(feature = "build")]
 /// Even-odd point-in-polygon test.
 pub fn point_in_polygon(p: DVec2, polygon: &[DVec2]) -> bool {
     let mut inside = false;

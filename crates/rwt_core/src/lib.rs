@@ -5,17 +5,27 @@
 //!
 //! The work splits in two:
 //!
-//! - **Construction**, offline and deterministic from a seed ([`construction::build`]):
-//!   progressive source tiles ([`source_tile`]), Wang tiles merged along Voronoi seams
-//!   ([`seam`]), subdivision rules ([`subdivision`]), relaxation to the exact subset property
-//!   ([`relaxation`]) and progressive rankings with spacing guaranteed across tile borders
-//!   ([`progressive`]). The result is a [`tileset::TileSet`]; one is shipped and embedded.
-//! - **Use**, at run time: [`tiling::Tiling`] places tiles anywhere in O(1) by hashing edge
-//!   colours, and the tile set's rankings give points at any density.
+//! - **Construction**, offline and deterministic from a seed (`construction::build`, with
+//!   the `build` feature): progressive source tiles, Wang tiles merged along Voronoi seams,
+//!   subdivision rules, relaxation to the exact subset property and progressive rankings
+//!   with spacing guaranteed across tile borders. The result is a [`TileSet`]; one is
+//!   shipped and embedded ([`TileSet::embedded`]). Games that only query need none of the
+//!   builder, and do not compile its dependencies (spade, rayon).
+//! - **Use**, at run time: [`Tiling`] places tiles anywhere in O(1) by hashing edge
+//!   colours, and a [`Sampler`] turns the tile set's rankings into points at any density.
+//!
+//! | paper section | module |
+//! |---|---|
+//! | 3, 5.2 recursive tiling, queries | [`tiling`], [`query`] |
+//! | 4 progressive source tiles, seams, rankings | `construction` (feature `build`) |
+//! | 5.1 subdivision rules, 5.2 relaxation | `construction` (feature `build`) |
+//! | 6.1 densities | [`density`] |
+//! | 6.3 classes | [`Sampler::query_classes`] |
+//! | figures' measurements | [`analysis`] |
+//! | streaming and level of detail around viewers | [`streaming`] |
 //!
 //! ```
-//! use rwt_core::tileset::TileSet;
-//! use rwt_core::tiling::Tiling;
+//! use rwt_core::{TileSet, Tiling};
 //!
 //! let set = TileSet::embedded();
 //! assert_eq!(set.tiles.len(), 16); // complete set of 2 colours: 2^4 tiles
@@ -27,15 +37,13 @@
 //!
 //! ## Queries
 //!
-//! A [`query::Sampler`] produces the points of any rectangle for any [`density::Density`]
-//! (points per unit area). Each point has a stable [`query::PointId`], and the point set only
+//! A [`Sampler`] produces the points of any rectangle for any [`Density`] (points per unit
+//! area). Each point has a stable [`PointId`], and the point set only
 //! grows when the density grows, so chunked, streamed or zoomed views never see a point move:
 //!
 //! ```
 //! use glam::DVec2;
-//! use rwt_core::density::{Constant, NoiseDensity};
-//! use rwt_core::query::{Rect, Sampler};
-//! use rwt_core::tileset::TileSet;
+//! use rwt_core::{Constant, NoiseDensity, NoiseParams, Rect, Sampler, TileSet};
 //!
 //! let set = TileSet::embedded();
 //! let sampler = Sampler::new(&set, 7).with_tile_size(4.0); // base tiles 4 units wide
@@ -56,29 +64,38 @@
 //! assert!(n[1] > 2 * n[0]);
 //! let yaw = dense[0].id.rotation(7);
 //! assert!((0.0..std::f64::consts::TAU).contains(&yaw));
-//! # let _ = NoiseDensity::new(1, 0.1, 3, 0.5, 0.5, 10.0);
+//!
+//! // Densities compose: fBm noise, painted images, closures, sums, masks, fall-off.
+//! let noise = NoiseDensity::new(NoiseParams { frequency: 0.1, scale: 10.0, ..Default::default() });
+//! let mut patchy = Vec::new();
+//! sampler.query(rect, &noise, &mut patchy).unwrap();
+//! assert!(patchy.len() < 10 * 64);
 //! ```
 //!
 //! Bad input is a typed error, never a panic; loading a tile set validates it:
 //!
 //! ```
-//! use rwt_core::tileset::{TileSet, TileSetError};
+//! use rwt_core::{TileSet, TileSetError};
 //! assert!(matches!(TileSet::from_ron_bytes(b"(format: 1"), Err(TileSetError::Parse(_))));
 //! ```
 
 pub mod analysis;
-pub mod check;
+pub mod bench;
+#[cfg(feature = "build")]
 pub mod construction;
 pub mod density;
-pub mod geometry;
-pub mod progressive;
+mod geometry;
 pub mod query;
-pub mod relaxation;
 pub mod rng;
-pub mod seam;
-pub mod source_tile;
 pub mod streaming;
-pub mod subdivision;
 pub mod tileset;
 pub mod tiling;
 pub mod wang;
+
+pub use density::{
+    Constant, Density, DistanceFalloff, Exclude, FnDensity, ImageDensity, Mask, NoiseDensity,
+    NoiseParams, Product, Scale, Sum, SumOf,
+};
+pub use query::{Point, PointId, QueryError, Rect, Sampler};
+pub use tileset::{TileSet, TileSetError};
+pub use tiling::Tiling;

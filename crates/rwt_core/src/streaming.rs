@@ -21,18 +21,84 @@ pub struct ChunkCoord {
 }
 
 impl ChunkCoord {
-    /// The chunk's rectangle.
+    /// The chunk's rectangle; empty for a size that is not finite and positive.
     pub fn rect(&self, size: f64) -> Rect {
-        Rect {
-            min: DVec2::new(self.x as f64 * size, self.y as f64 * size),
-            max: DVec2::new((self.x + 1) as f64 * size, (self.y + 1) as f64 * size),
-        }
+        Rect::new(
+            DVec2::new(self.x as f64 * size, self.y as f64 * size),
+            DVec2::new((self.x + 1) as f64 * size, (self.y + 1) as f64 * size),
+        )
+        .unwrap_or(Rect::EMPTY)
     }
 
     /// Distance from `p` to the nearest point of the chunk (0 inside).
     pub fn distance(&self, size: f64, p: DVec2) -> f64 {
         let r = self.rect(size);
-        p.clamp(r.min, r.max).distance(p)
+        p.clamp(r.min(), r.max()).distance(p)
+    }
+
+    /// Distance to the nearest of `viewers` (infinite without viewers).
+    pub fn viewer_distance(&self, size: f64, viewers: &[Viewer]) -> f64 {
+        viewers
+            .iter()
+            .map(|v| self.distance(size, v.position))
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// `chunks` sorted nearest to a viewer first (ties by coordinate): the order in which
+/// chunks are generated, so that the ground around a viewer fills first.
+pub fn nearest_first(
+    chunks: impl IntoIterator<Item = ChunkCoord>,
+    size: f64,
+    viewers: &[Viewer],
+) -> Vec<ChunkCoord> {
+    let mut order: Vec<(f64, ChunkCoord)> = chunks
+        .into_iter()
+        .map(|c| (c.viewer_distance(size, viewers), c))
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    order.into_iter().map(|(_, c)| c).collect()
+}
+
+/// Level of detail by density: full density up to `near` from the nearest viewer, falling
+/// linearly to none at `far`. Approaching only adds points between the existing ones.
+///
+/// The fall-off is quantized into [`Falloff::BANDS`] bands by the chunk's distance: a chunk
+/// is generated for a band, and re-generated only when a viewer moves it into another one,
+/// so moving a little does not re-query, and every query of a band gives the same content.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Falloff {
+    /// Distance up to which the density is full.
+    pub near: f64,
+    /// Distance from which the density is zero.
+    pub far: f64,
+}
+
+impl Falloff {
+    /// Bands between `near` and `far`.
+    pub const BANDS: f64 = 8.0;
+
+    /// Width of a band (never zero).
+    fn step(&self) -> f64 {
+        ((self.far - self.near) / Self::BANDS).max(1e-6)
+    }
+
+    /// The band of a chunk at `distance` from the nearest viewer: 0 within `near`.
+    pub fn band(&self, distance: f64) -> i64 {
+        ((distance - self.near).max(0.0) / self.step())
+            .floor()
+            .min(1e6) as i64
+    }
+
+    /// The density factor of a band: 1 for band 0, falling linearly to 0 at `far`. Lower
+    /// bands (nearer) have higher factors, so approaching only adds points.
+    pub fn factor(&self, band: i64) -> f64 {
+        (1.0 - band as f64 * self.step() / (self.far - self.near).max(1e-6)).clamp(0.0, 1.0)
+    }
+
+    /// The band of `chunk` for `viewers`.
+    pub fn chunk_band(&self, chunk: ChunkCoord, size: f64, viewers: &[Viewer]) -> i64 {
+        self.band(chunk.viewer_distance(size, viewers))
     }
 }
 
@@ -108,17 +174,18 @@ fn overlaps_convex(rect: &Rect, polygon: &[DVec2]) -> bool {
     }
     // Separating axis test: the rectangle's axes and the polygon's edge normals.
     let corners = [
-        rect.min,
-        DVec2::new(rect.max.x, rect.min.y),
-        rect.max,
-        DVec2::new(rect.min.x, rect.max.y),
+        rect.min(),
+        DVec2::new(rect.max().x, rect.min().y),
+        rect.max(),
+        DVec2::new(rect.min().x, rect.max().y),
     ];
     let (mut lo, mut hi) = (polygon[0], polygon[0]);
     for &p in polygon {
         lo = lo.min(p);
         hi = hi.max(p);
     }
-    if hi.x < rect.min.x || lo.x > rect.max.x || hi.y < rect.min.y || lo.y > rect.max.y {
+    let (min, max) = (rect.min(), rect.max());
+    if hi.x < min.x || lo.x > max.x || hi.y < min.y || lo.y > max.y {
         return false;
     }
     for i in 0..polygon.len() {
@@ -204,28 +271,30 @@ impl ChunkSet {
     }
 }
 
-/// Instances a re-query adds and removes, by identity: existing instances never move.
+/// Instances a re-query adds and removes, by identity and class: existing instances never
+/// move, and a point whose class changed (a repainted class map) is replaced.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct InstanceDiff {
-    /// Points that are new.
+    /// Points that are new, or shown with another class.
     pub added: Vec<Point>,
-    /// Identities that are gone.
+    /// Identities that are gone, or shown with another class now.
     pub removed: Vec<PointId>,
 }
 
-/// Compares the identities a chunk shows with a fresh query result.
-pub fn diff_instances<'a>(
-    current: impl IntoIterator<Item = &'a PointId>,
+/// Compares what a chunk shows (identity and class of each instance) with a fresh query
+/// result.
+pub fn diff_instances(
+    current: impl IntoIterator<Item = (PointId, u16)>,
     fresh: &[Point],
 ) -> InstanceDiff {
-    let current: HashSet<PointId> = current.into_iter().copied().collect();
-    let fresh_ids: HashSet<PointId> = fresh.iter().map(|p| p.id).collect();
-    let mut removed: Vec<PointId> = current.difference(&fresh_ids).copied().collect();
+    let current: HashSet<(PointId, u16)> = current.into_iter().collect();
+    let fresh_set: HashSet<(PointId, u16)> = fresh.iter().map(|p| (p.id, p.class)).collect();
+    let mut removed: Vec<PointId> = current.difference(&fresh_set).map(|(id, _)| *id).collect();
     removed.sort();
     InstanceDiff {
         added: fresh
             .iter()
-            .filter(|p| !current.contains(&p.id))
+            .filter(|p| !current.contains(&(p.id, p.class)))
             .copied()
             .collect(),
         removed,
@@ -344,6 +413,49 @@ mod tests {
     }
 
     #[test]
+    fn falloff_bands_quantize_distance_and_only_add_on_approach() {
+        let f = Falloff {
+            near: 20.0,
+            far: 100.0,
+        };
+        assert_eq!(f.band(0.0), 0);
+        assert_eq!(f.band(20.0), 0);
+        assert_eq!(f.band(29.9), 0);
+        assert_eq!(f.band(30.0), 1);
+        assert_eq!(f.factor(0), 1.0);
+        assert_eq!(f.factor(8), 0.0);
+        assert_eq!(f.factor(1_000), 0.0);
+        // Nearer bands never have a lower factor: approaching only adds points.
+        let mut last = f64::INFINITY;
+        for d in (0..1200).map(|i| i as f64 * 0.1) {
+            let factor = f.factor(f.band(d));
+            assert!(factor <= last && (0.0..=1.0).contains(&factor));
+            last = factor;
+        }
+        // A chunk's band is the one of its nearest viewer.
+        let viewers = [
+            Viewer::omni(DVec2::new(500.0, 0.0)),
+            Viewer::omni(DVec2::new(-45.0, 5.0)),
+        ];
+        let chunk = ChunkCoord { x: 0, y: 0 };
+        assert_eq!(f.chunk_band(chunk, 10.0, &viewers), f.band(45.0));
+        // Degenerate settings stay finite.
+        let flat = Falloff {
+            near: 50.0,
+            far: 50.0,
+        };
+        assert!(flat.factor(flat.band(60.0)).is_finite());
+        assert_eq!(
+            nearest_first(
+                [ChunkCoord { x: 5, y: 0 }, ChunkCoord { x: 0, y: 0 }],
+                10.0,
+                &[Viewer::omni(DVec2::ZERO)]
+            ),
+            [ChunkCoord { x: 0, y: 0 }, ChunkCoord { x: 5, y: 0 }]
+        );
+    }
+
+    #[test]
     fn approaching_adds_instances_and_moves_none() {
         // Level of detail by density: far, the chunk holds few instances; nearer, more, and
         // the diff only adds.
@@ -365,13 +477,19 @@ mod tests {
         sampler
             .query(rect, &lod(DVec2::new(10.0, 0.0)), &mut near)
             .unwrap();
-        let d = diff_instances(far.iter().map(|p| &p.id), &near);
+        let d = diff_instances(far.iter().map(|p| (p.id, p.class)), &near);
         assert!(d.removed.is_empty());
         assert_eq!(d.added.len(), near.len() - far.len());
         assert!(far.len() > 50 && near.len() > far.len() + 500);
         // Going back removes exactly the added ones.
-        let back = diff_instances(near.iter().map(|p| &p.id), &far);
+        let back = diff_instances(near.iter().map(|p| (p.id, p.class)), &far);
         assert!(back.added.is_empty());
         assert_eq!(back.removed.len(), d.added.len());
+        // A point shown with another class is replaced, not kept.
+        let mut recoloured = near.clone();
+        recoloured[0].class = 1;
+        let swap = diff_instances(near.iter().map(|p| (p.id, p.class)), &recoloured);
+        assert_eq!(swap.removed, [near[0].id]);
+        assert_eq!(swap.added, [recoloured[0]]);
     }
 }

@@ -132,6 +132,28 @@ impl TileSet {
     /// Checks every structural invariant: sizes, colours, subdivision rules that match at the
     /// borders and inside, rank lists that are permutations, and the exact subset property.
     pub fn validate(&self) -> Result<(), TileSetError> {
+        self.validate_header()?;
+        self.validate_sequences()?;
+        for (t, tile) in self.tiles.iter().enumerate() {
+            self.validate_tile(t, tile)?;
+        }
+        let violations = self.rule_violations();
+        if violations > 0 {
+            return Err(TileSetError::Header(format!(
+                "{violations} edge colour mismatches in subdivision rules"
+            )));
+        }
+        if let Some((t, k)) = self.first_subset_violation() {
+            return Err(tile_err(
+                t,
+                format!("base point {k} is not exactly its subdivision point"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Format version, colours, subdivision factor, points per tile and tile count.
+    fn validate_header(&self) -> Result<(), TileSetError> {
         if self.format != FORMAT_VERSION {
             return Err(TileSetError::Format {
                 found: self.format,
@@ -141,26 +163,29 @@ impl TileSet {
         let k = self.colors;
         let n = self.subdivision as usize;
         let big_n = self.points_per_tile as usize;
+        let header = |msg: String| Err(TileSetError::Header(msg));
         if !(1..=8).contains(&k) {
-            return Err(TileSetError::Header(format!("colors {k} not in 1..=8")));
+            return header(format!("colors {k} not in 1..=8"));
         }
         if !n.is_power_of_two() || !(2..=8).contains(&n) {
-            return Err(TileSetError::Header(format!(
-                "subdivision {n} must be a power of two in 2..=8"
-            )));
+            return header(format!("subdivision {n} must be a power of two in 2..=8"));
         }
         if big_n == 0 || big_n > 65_536 {
-            return Err(TileSetError::Header(format!(
-                "points per tile {big_n} not in 1..=65536"
-            )));
+            return header(format!("points per tile {big_n} not in 1..=65536"));
         }
         if self.tiles.len() != complete_set_size(k) {
-            return Err(TileSetError::Header(format!(
+            return header(format!(
                 "{} tiles, a complete set of {k} colours has {}",
                 self.tiles.len(),
                 complete_set_size(k)
-            )));
+            ));
         }
+        Ok(())
+    }
+
+    /// One unique sequence of `n` colours per edge colour and orientation.
+    fn validate_sequences(&self) -> Result<(), TileSetError> {
+        let (k, n) = (self.colors, self.subdivision as usize);
         for (name, seqs) in [
             ("horizontal", &self.horizontal_sequences),
             ("vertical", &self.vertical_sequences),
@@ -182,70 +207,64 @@ impl TileSet {
                 }
             }
         }
-        let sub_len = self.subdivision_len();
-        for (t, tile) in self.tiles.iter().enumerate() {
-            if tile.edges.complete_index(k) != t
-                || [
-                    tile.edges.north,
-                    tile.edges.east,
-                    tile.edges.south,
-                    tile.edges.west,
-                ]
-                .iter()
-                .any(|&c| c >= k)
-            {
-                return Err(tile_err(t, "edge colours do not match its index"));
-            }
-            if tile.points.len() != big_n || tile.origins.len() != big_n {
-                return Err(tile_err(
-                    t,
-                    format!("has {} points, expected {big_n}", tile.points.len()),
-                ));
-            }
-            if tile.children.len() != n * n {
-                return Err(tile_err(
-                    t,
-                    format!("subdivision rule has {} children", tile.children.len()),
-                ));
-            }
-            if let Some(&c) = tile
-                .children
-                .iter()
-                .find(|&&c| c as usize >= self.tiles.len())
-            {
-                return Err(tile_err(t, format!("child {c} does not exist")));
-            }
-            if tile.subdivision.len() != sub_len {
-                return Err(tile_err(
-                    t,
-                    format!(
-                        "subdivision lists {} points, expected {sub_len}",
-                        tile.subdivision.len()
-                    ),
-                ));
-            }
-            let mut seen = vec![false; sub_len];
-            for &e in &tile.subdivision {
-                let (cell, idx) = ((e >> 16) as usize, (e & 0xffff) as usize);
-                if cell >= n * n
-                    || idx >= big_n
-                    || std::mem::replace(&mut seen[cell * big_n + idx], true)
-                {
-                    return Err(tile_err(t, "subdivision ranking is not a permutation"));
-                }
-            }
+        Ok(())
+    }
+
+    /// One tile's colours, point count, children and subdivision ranking.
+    fn validate_tile(&self, t: usize, tile: &Tile) -> Result<(), TileSetError> {
+        let (k, n, big_n) = (
+            self.colors,
+            self.subdivision as usize,
+            self.points_per_tile as usize,
+        );
+        let e = &tile.edges;
+        if e.complete_index(k) != t || [e.north, e.east, e.south, e.west].iter().any(|&c| c >= k) {
+            return Err(tile_err(t, "edge colours do not match its index"));
         }
-        let violations = self.rule_violations();
-        if violations > 0 {
-            return Err(TileSetError::Header(format!(
-                "{violations} edge colour mismatches in subdivision rules"
-            )));
-        }
-        if let Some((t, k)) = self.first_subset_violation() {
+        if tile.points.len() != big_n || tile.origins.len() != big_n {
             return Err(tile_err(
                 t,
-                format!("base point {k} is not exactly its subdivision point"),
+                format!("has {} points, expected {big_n}", tile.points.len()),
             ));
+        }
+        if tile.children.len() != n * n {
+            return Err(tile_err(
+                t,
+                format!("subdivision rule has {} children", tile.children.len()),
+            ));
+        }
+        if let Some(&c) = tile
+            .children
+            .iter()
+            .find(|&&c| c as usize >= self.tiles.len())
+        {
+            return Err(tile_err(t, format!("child {c} does not exist")));
+        }
+        self.validate_ranking(t, tile)
+    }
+
+    /// The subdivision ranking lists each of the `n^2 N` subdivision points exactly once.
+    fn validate_ranking(&self, t: usize, tile: &Tile) -> Result<(), TileSetError> {
+        let (n, big_n) = (self.subdivision as usize, self.points_per_tile as usize);
+        let sub_len = self.subdivision_len();
+        if tile.subdivision.len() != sub_len {
+            return Err(tile_err(
+                t,
+                format!(
+                    "subdivision lists {} points, expected {sub_len}",
+                    tile.subdivision.len()
+                ),
+            ));
+        }
+        let mut seen = vec![false; sub_len];
+        for &e in &tile.subdivision {
+            let (cell, idx) = ((e >> 16) as usize, (e & 0xffff) as usize);
+            if cell >= n * n
+                || idx >= big_n
+                || std::mem::replace(&mut seen[cell * big_n + idx], true)
+            {
+                return Err(tile_err(t, "subdivision ranking is not a permutation"));
+            }
         }
         Ok(())
     }

@@ -2,7 +2,7 @@
 
 use glam::DVec2;
 use proptest::prelude::*;
-use rwt_core::density::{Constant, DistanceFalloff, NoiseDensity, from_fn};
+use rwt_core::density::{Constant, DistanceFalloff, NoiseDensity, NoiseParams, from_fn};
 use rwt_core::query::{Point, Rect, Sampler};
 use rwt_core::tileset::TileSet;
 use std::collections::HashMap;
@@ -25,7 +25,7 @@ proptest! {
     fn monotone(seed in 0u64..1000, x in -50.0f64..50.0, y in -50.0f64..50.0, base in 10.0f64..3000.0, extra in 0.0f64..20000.0, cx in 0.0f64..1.0) {
         let s = Sampler::new(set(), seed);
         let rect = Rect::new(DVec2::new(x, y), DVec2::new(x + 1.5, y + 1.2)).unwrap();
-        let low = NoiseDensity::new(seed as u32, 0.7, 3, 0.5, 0.5, base);
+        let low = NoiseDensity::new(NoiseParams { seed: seed as u32, frequency: 0.7, octaves: 3, base: 0.5, amplitude: 0.5, scale: base });
         let bump = DistanceFalloff { inner: Constant(extra), centre: DVec2::new(x + cx * 1.5, y + 0.6), near: 0.1, far: 0.6 };
         let high = rwt_core::density::Sum(low.clone(), bump);
         let (mut a, mut b) = (Vec::new(), Vec::new());
@@ -43,8 +43,8 @@ proptest! {
         let s = Sampler::new(set(), seed).with_tile_size(tile);
         let whole = Rect::new(DVec2::new(x, y), DVec2::new(x + w, y + h)).unwrap();
         let mid = x + cut * w;
-        let left = Rect::new(whole.min, DVec2::new(mid, y + h)).unwrap();
-        let right = Rect::new(DVec2::new(mid, y), whole.max).unwrap();
+        let left = Rect::new(whole.min(), DVec2::new(mid, y + h)).unwrap();
+        let right = Rect::new(DVec2::new(mid, y), whole.max()).unwrap();
         let density = Constant(d / (tile * tile).max(1.0));
         let (mut all, mut parts) = (Vec::new(), Vec::new());
         s.query(whole, &density, &mut all).unwrap();

@@ -3,7 +3,7 @@
 
 use glam::DVec2;
 use rwt_core::analysis::{Spectrum, reference, rho};
-use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity, Sum, from_fn};
+use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity, NoiseParams, Sum, from_fn};
 use rwt_core::query::{Point, QueryError, Rect, Sampler};
 use rwt_core::tileset::TileSet;
 use std::sync::OnceLock;
@@ -165,7 +165,14 @@ fn periodic_tiling_has_anisotropy_spikes_and_ours_has_not() {
 fn raising_density_only_adds_points() {
     let s = sampler(21);
     let rect = square(-3.1, 6.2);
-    let low = NoiseDensity::new(4, 0.4, 4, 0.4, 0.6, 3_000.0);
+    let low = NoiseDensity::new(NoiseParams {
+        seed: 4,
+        frequency: 0.4,
+        octaves: 4,
+        base: 0.4,
+        amplitude: 0.6,
+        scale: 3_000.0,
+    });
     let high = Sum(
         low.clone(),
         from_fn(|p: DVec2| if p.x > 0.0 { 5_000.0 } else { 0.0 }, 5_000.0),
@@ -188,7 +195,14 @@ fn raising_density_only_adds_points() {
 #[test]
 fn chunks_union_is_the_whole_query() {
     let s = sampler(8);
-    let d = NoiseDensity::new(9, 0.3, 3, 0.5, 0.5, 20_000.0);
+    let d = NoiseDensity::new(NoiseParams {
+        seed: 9,
+        frequency: 0.3,
+        octaves: 3,
+        base: 0.5,
+        amplitude: 0.5,
+        scale: 20_000.0,
+    });
     let whole = Rect::new(DVec2::new(-1.3, 0.4), DVec2::new(2.9, 3.1)).unwrap();
     let mut all = Vec::new();
     s.query(whole, &d, &mut all).unwrap();
@@ -212,7 +226,14 @@ fn chunks_union_is_the_whole_query() {
 
 #[test]
 fn queries_are_deterministic() {
-    let d = NoiseDensity::new(1, 0.5, 3, 0.3, 0.7, 8_000.0);
+    let d = NoiseDensity::new(NoiseParams {
+        seed: 1,
+        frequency: 0.5,
+        octaves: 3,
+        base: 0.3,
+        amplitude: 0.7,
+        scale: 8_000.0,
+    });
     let run = |seed| {
         let mut out = Vec::new();
         sampler(seed).query(square(0.5, 2.0), &d, &mut out).unwrap();
@@ -323,7 +344,14 @@ fn classes_share_one_point_set_and_the_first_is_blue_noise_alone() {
     let s = sampler(4);
     let rect = square(0.0, 3.0);
     let grass = Constant(3_000.0);
-    let bushes = NoiseDensity::new(2, 0.5, 3, 0.5, 0.5, 2_000.0);
+    let bushes = NoiseDensity::new(NoiseParams {
+        seed: 2,
+        frequency: 0.5,
+        octaves: 3,
+        base: 0.5,
+        amplitude: 0.5,
+        scale: 2_000.0,
+    });
     let classes: Vec<Box<dyn Density>> = vec![Box::new(grass), Box::new(bushes.clone())];
     let mut mixed = Vec::new();
     s.query_classes(rect, &classes, |p| mixed.push(p)).unwrap();
@@ -482,7 +510,14 @@ fn lower_bounds_skip_evaluations_without_changing_any_point() {
         3.0 * n,
     )
     .unwrap();
-    let noise = NoiseDensity::new(4, 0.4, 3, 0.6, 0.5, 2.0 * n);
+    let noise = NoiseDensity::new(NoiseParams {
+        seed: 4,
+        frequency: 0.4,
+        octaves: 3,
+        base: 0.6,
+        amplitude: 0.5,
+        scale: 2.0 * n,
+    });
     let s = sampler(12);
     let rect = Rect::new(DVec2::new(-0.3, 0.2), DVec2::new(6.3, 5.7)).unwrap();
     let compare = |name: &str, d: &dyn Density| {

@@ -2,9 +2,9 @@
 //! at every level, the exact subset property, progressive spacing and loader errors.
 
 use glam::DVec2;
-use rwt_core::check::{base_prefix_rho, edge_violations, subdivision_prefix_rho};
+use rwt_core::analysis::check::{base_prefix_rho, edge_violations, subdivision_prefix_rho};
+use rwt_core::analysis::hex_spacing;
 use rwt_core::construction::{BuildConfig, NoProgress, build};
-use rwt_core::geometry::hex_spacing;
 use rwt_core::tileset::{TileSet, TileSetError, fixed_to_unit};
 use rwt_core::tiling::Tiling;
 
@@ -152,16 +152,17 @@ fn seams_are_no_worse_than_interiors() {
     // come from the same source: a fair sample of both kinds, unlike nearest neighbours.
     let h = hex_spacing(set.points_per_tile as f64);
     let radius = 1.25 * h;
-    let mut grid = rwt_core::geometry::BucketGrid::new(DVec2::ZERO, DVec2::splat(6.0), radius);
-    for (i, p) in pts.iter().enumerate() {
-        grid.insert(*p, i as u32);
-    }
+    // A sweep along x: each point meets only those within `radius` to its right.
+    let mut by_x: Vec<usize> = (0..pts.len()).collect();
+    by_x.sort_by(|&a, &b| pts[a].x.total_cmp(&pts[b].x));
     let (mut cross, mut same) = (Vec::new(), Vec::new());
-    for (i, p) in pts.iter().enumerate() {
-        grid.for_each_near(*p, radius, |j| {
-            let j = j as usize;
-            let d = (pts[j] - *p).length();
-            if j > i && d < radius {
+    for (n, &i) in by_x.iter().enumerate() {
+        for &j in by_x[n + 1..]
+            .iter()
+            .take_while(|&&j| pts[j].x - pts[i].x < radius)
+        {
+            let d = (pts[j] - pts[i]).length();
+            if d < radius {
                 if source[i] == source[j] {
                     &mut same
                 } else {
@@ -169,7 +170,7 @@ fn seams_are_no_worse_than_interiors() {
                 }
                 .push(d / h);
             }
-        });
+        }
     }
     let close = |v: &[f64]| v.iter().filter(|&&d| d < 0.75).count() as f64 / v.len() as f64;
     let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);

@@ -11,8 +11,8 @@
 //! the fixed point of a monotone contraction on integers, found by iteration, and every other
 //! point follows from its successor. The result satisfies the subset property bit for bit.
 
+use super::progressive::{Neighbours, Placed};
 use crate::geometry::BucketGrid;
-use crate::progressive::{Neighbours, Placed};
 use glam::DVec2;
 use rayon::prelude::*;
 

@@ -1,7 +1,10 @@
 //! Optional debug drawing: loaded chunks and, inside them, the base Wang tiles.
 
-use crate::layer::ScatterLayer;
-use crate::streaming::LayerState;
+mod plugin;
+
+pub use plugin::RwtGizmosPlugin;
+
+use crate::layers::{GroundPlane, ScatterLayer, ScatterLayerStatus};
 use bevy::prelude::*;
 
 /// What [`RwtGizmosPlugin`] draws.
@@ -25,23 +28,16 @@ impl Default for RwtGizmos {
     }
 }
 
-/// Draws chunk and tile bounds with gizmos. Needs Bevy's gizmo plugin (part of
-/// `DefaultPlugins`).
-pub struct RwtGizmosPlugin;
-
-impl Plugin for RwtGizmosPlugin {
-    fn build(&self, app: &mut App) {
-        app.init_resource::<RwtGizmos>()
-            .add_systems(PostUpdate, draw);
-    }
-}
-
-fn square(gizmos: &mut Gizmos, min: Vec2, size: f32, y: f32, color: Color) {
+fn square(gizmos: &mut Gizmos, plane: GroundPlane, min: Vec2, size: f32, lift: f32, color: Color) {
+    let corner = |u: f32, v: f32| match plane {
+        GroundPlane::Xz => Vec3::new(u, lift, v),
+        GroundPlane::Xy => Vec3::new(u, v, lift),
+    };
     let corners = [
-        Vec3::new(min.x, y, min.y),
-        Vec3::new(min.x + size, y, min.y),
-        Vec3::new(min.x + size, y, min.y + size),
-        Vec3::new(min.x, y, min.y + size),
+        corner(min.x, min.y),
+        corner(min.x + size, min.y),
+        corner(min.x + size, min.y + size),
+        corner(min.x, min.y + size),
     ];
     for i in 0..4 {
         gizmos.line(corners[i], corners[(i + 1) % 4], color);
@@ -51,24 +47,30 @@ fn square(gizmos: &mut Gizmos, min: Vec2, size: f32, y: f32, color: Color) {
 /// Squares to outline for one layer: `(min corner (x, z), side, is_tile)`.
 pub fn outlines(
     layer: &ScatterLayer,
-    state: &LayerState,
+    status: &ScatterLayerStatus,
     settings: &RwtGizmos,
 ) -> Vec<(Vec2, f32, bool)> {
     let mut out = Vec::new();
     let size = layer.streaming.chunk_size;
-    for chunk in state.loaded_chunks() {
+    for chunk in &status.loaded_chunks {
         let r = chunk.rect(size);
         if settings.chunks {
             out.push((
-                Vec2::new(r.min.x as f32, r.min.y as f32),
+                Vec2::new(r.min().x as f32, r.min().y as f32),
                 size as f32,
                 false,
             ));
         }
         if settings.tiles && layer.tile_size > 0.0 {
             let t = layer.tile_size;
-            let (i0, i1) = ((r.min.x / t).floor() as i64, (r.max.x / t).ceil() as i64);
-            let (j0, j1) = ((r.min.y / t).floor() as i64, (r.max.y / t).ceil() as i64);
+            let (i0, i1) = (
+                (r.min().x / t).floor() as i64,
+                (r.max().x / t).ceil() as i64,
+            );
+            let (j0, j1) = (
+                (r.min().y / t).floor() as i64,
+                (r.max().y / t).ceil() as i64,
+            );
             // Only chunks holding a handful of tiles are worth outlining.
             if (i1 - i0).saturating_mul(j1 - j0) <= 256 {
                 for j in j0..j1 {
@@ -86,15 +88,19 @@ pub fn outlines(
     out
 }
 
-fn draw(mut gizmos: Gizmos, settings: Res<RwtGizmos>, layers: Query<(&ScatterLayer, &LayerState)>) {
-    for (layer, state) in &layers {
-        for (min, side, tile) in outlines(layer, state, &settings) {
+fn draw(
+    mut gizmos: Gizmos,
+    settings: Res<RwtGizmos>,
+    layers: Query<(&ScatterLayer, &ScatterLayerStatus)>,
+) {
+    for (layer, status) in &layers {
+        for (min, side, tile) in outlines(layer, status, &settings) {
             let color = if tile {
                 Color::srgb(0.2, 0.7, 1.0)
             } else {
                 Color::srgb(1.0, 0.8, 0.1)
             };
-            square(&mut gizmos, min, side, settings.lift, color);
+            square(&mut gizmos, layer.plane, min, side, settings.lift, color);
         }
     }
 }

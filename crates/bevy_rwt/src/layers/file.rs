@@ -1,4 +1,4 @@
-//! Scatter layers described in RON files (`*.layer.ron`), loaded as assets and hot-reloaded:
+//! Layer files: scatter layers described in RON files (`*.layer.ron`), loaded as assets and hot-reloaded:
 //! an entity with a [`ScatterLayerSource`] gets the file's [`ScatterLayer`], and gets it
 //! again, restreamed, whenever the file changes (with Bevy's `file_watcher` feature).
 //!
@@ -20,10 +20,11 @@
 //! )
 //! ```
 
-use crate::layer::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+use super::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
 use bevy::asset::{AssetLoader, LoadContext, io::Reader};
 use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
+use rwt_core::streaming::Falloff;
 use rwt_core::streaming::StreamingConfig;
 use serde::Deserialize;
 
@@ -32,8 +33,10 @@ use serde::Deserialize;
 pub struct ScatterLayerAsset(pub ScatterLayer);
 
 /// Puts the layer of a `.layer.ron` asset on this entity, and updates it when the file
-/// changes.
+/// changes. Until the file loads, the entity's [`super::ScatterLayerStatus`] says whether it
+/// is waiting for it or why it failed.
 #[derive(Component, Clone, Debug)]
+#[require(super::ScatterLayerStatus)]
 pub struct ScatterLayerSource(pub Handle<ScatterLayerAsset>);
 
 /// A density in a layer file.
@@ -160,9 +163,7 @@ impl DensityDescription {
     fn to_density(&self, image: &mut impl FnMut(&str) -> Handle<Image>) -> LayerDensity {
         match self {
             DensityDescription::Constant(v) => LayerDensity::Constant(*v),
-            DensityDescription::Noise(params) => {
-                LayerDensity::Noise(NoiseDensity::from_params(*params))
-            }
+            DensityDescription::Noise(params) => LayerDensity::Noise(NoiseDensity::new(*params)),
             DensityDescription::Image {
                 path,
                 min,
@@ -281,7 +282,7 @@ impl LayerDescription {
                 near_distance: defaults.near_distance,
             })
             .with_height(HeightSource::Constant(self.height));
-        layer.falloff = self.falloff;
+        layer.falloff = self.falloff.map(|(near, far)| Falloff { near, far });
         layer.exclusion = self.exclusion.as_ref().map(|e| e.to_density(&mut image));
         layer.height_range = self.height_range;
         layer.max_slope = self.max_slope;
@@ -365,31 +366,6 @@ impl AssetLoader for ScatterLayerLoader {
     }
 }
 
-/// Gives entities the layer of their source file when it loads, and again when it changes.
-pub fn apply_layer_assets(
-    mut events: MessageReader<AssetEvent<ScatterLayerAsset>>,
-    sources: Query<(Entity, &ScatterLayerSource)>,
-    added: Query<(Entity, &ScatterLayerSource), Added<ScatterLayerSource>>,
-    assets: Res<Assets<ScatterLayerAsset>>,
-    mut commands: Commands,
-) {
-    let changed: Vec<AssetId<ScatterLayerAsset>> = events
-        .read()
-        .filter_map(|e| match e {
-            AssetEvent::Added { id } | AssetEvent::Modified { id } => Some(*id),
-            _ => None,
-        })
-        .collect();
-    for (entity, source) in &sources {
-        let fresh = added.contains(entity);
-        if (fresh || changed.contains(&source.0.id()))
-            && let Some(asset) = assets.get(&source.0)
-        {
-            commands.entity(entity).insert(asset.0.clone());
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -421,7 +397,13 @@ mod tests {
         );
         assert_eq!(layer.tile_size, 4.0);
         assert_eq!(layer.streaming.load_distance, 48.0);
-        assert_eq!(layer.falloff, Some((20.0, 60.0)));
+        assert_eq!(
+            layer.falloff,
+            Some(Falloff {
+                near: 20.0,
+                far: 60.0
+            })
+        );
         assert!(layer.exclusion.is_none());
         let excluded = MEADOW.replace(
             "falloff: (20.0, 60.0),",

@@ -2,12 +2,15 @@
 //! every frame for duplicate identities and every few hundred frames for bounded entity,
 //! task and memory counts; back at the start, the world is as it was.
 
-use super::tests::{layer, move_viewer, paint_square, solid_image, spawn_viewer, tick_app};
-use super::*;
-use crate::layer::LayerDensity;
-use crate::{RwtPlugin, RwtStats};
+mod common;
+
 use bevy::asset::AssetPlugin;
-use rwt_core::rng::Rng;
+use bevy::prelude::*;
+use bevy_rwt::prelude::*;
+use bevy_rwt::rwt_core::query::PointId;
+use bevy_rwt::rwt_core::rng::Rng;
+use common::{layer, move_viewer, paint_square, solid_image, spawn_viewer, tick_app};
+use std::collections::HashMap;
 
 /// Frames of the walk (each one `app.update()`, without waiting for streaming to settle).
 const FRAMES: usize = 10_000;

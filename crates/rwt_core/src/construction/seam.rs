@@ -301,8 +301,8 @@ pub fn seam_path(points: &[SourcedPoint], side: Side, strip: f64) -> Vec<DVec2> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::construction::source_tile::DartThrowing;
     use crate::rng::Rng;
-    use crate::source_tile::DartThrowing;
 
     fn source(seed: u64, origin: Origin) -> Vec<SourcedPoint> {
         DartThrowing::new(400)

@@ -11,7 +11,7 @@
 //! darts with a failure counter only approximate: every prefix then stays close to the
 //! jamming limit of random packing (normalized minimum distance about 0.75).
 
-use crate::geometry::{BucketGrid, hex_spacing, torus_delta};
+use crate::geometry::{BucketGrid, hex_spacing, torus_delta, torus_shifts};
 use crate::rng::Rng;
 use glam::DVec2;
 
@@ -96,27 +96,6 @@ impl DartThrowing {
         }
         points
     }
-}
-
-/// The translations under which a disc of radius `r` around `p` overlaps the unit square
-/// (the identity first), for toroidal neighbour searches.
-pub fn torus_shifts(p: DVec2, r: f64) -> impl Iterator<Item = DVec2> {
-    let xs: &[f64] = if p.x < r {
-        &[0.0, 1.0]
-    } else if p.x > 1.0 - r {
-        &[0.0, -1.0]
-    } else {
-        &[0.0]
-    };
-    let ys: &[f64] = if p.y < r {
-        &[0.0, 1.0]
-    } else if p.y > 1.0 - r {
-        &[0.0, -1.0]
-    } else {
-        &[0.0]
-    };
-    xs.iter()
-        .flat_map(move |&x| ys.iter().map(move |&y| DVec2::new(x, y)))
 }
 
 #[cfg(test)]

@@ -1,9 +1,23 @@
-//! Scatter layers: what to place, where, how densely, and how it looks.
+//! Scatter layers: what to place, where, how densely, and how it looks; layer files; the
+//! status the plugin reports for each layer.
+
+pub mod file;
+mod image;
+mod plugin;
+mod status;
+
+pub use image::from_bevy_image;
+pub use plugin::RwtLayersPlugin;
+pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
+pub use status::{AssetStatus, ScatterLayerStatus};
 
 use bevy::prelude::*;
 use rwt_core::density::{Constant, Density, NoiseDensity};
-use rwt_core::streaming::StreamingConfig;
+use rwt_core::streaming::{Falloff, StreamingConfig};
 use std::sync::Arc;
+
+/// A density shared with generation tasks.
+pub(crate) type SharedDensity = Arc<dyn Density + Send + Sync>;
 
 /// A density of a layer or class, in instances per square world unit on the ground (x, z).
 #[derive(Clone)]
@@ -50,8 +64,16 @@ impl LayerDensity {
         }
     }
 
+    /// The ground rectangle a painted map covers, if this density is one.
+    pub(crate) fn image_rect(&self) -> Option<rwt_core::Rect> {
+        match self {
+            LayerDensity::Image { min, size, .. } => ground_rect(*min, *size),
+            _ => None,
+        }
+    }
+
     /// A thread-safe snapshot for generation tasks; `None` while a painted map is loading.
-    pub fn resolve(&self, images: &Assets<Image>) -> Option<Arc<dyn Density + Send + Sync>> {
+    pub fn resolve(&self, images: &Assets<Image>) -> Option<SharedDensity> {
         Some(match self {
             LayerDensity::Constant(v) => Arc::new(Constant(*v)),
             LayerDensity::Noise(n) => Arc::new(n.clone()),
@@ -62,9 +84,7 @@ impl LayerDensity {
                 scale,
             } => {
                 let img = images.get(image)?;
-                Arc::new(crate::image_density::from_bevy_image(
-                    img, *min, *size, *scale,
-                )?)
+                Arc::new(image::from_bevy_image(img, *min, *size, *scale)?)
             }
             LayerDensity::Custom(d) => d.clone(),
         })
@@ -188,7 +208,24 @@ impl std::fmt::Debug for HeightSource {
     }
 }
 
+/// The ground rectangle `min..min + size`, when it is finite and not inverted.
+fn ground_rect(min: Vec2, size: Vec2) -> Option<rwt_core::Rect> {
+    let min = glam::DVec2::new(min.x as f64, min.y as f64);
+    let size = glam::DVec2::new(size.x as f64, size.y as f64);
+    rwt_core::Rect::new(min, min + size).ok()
+}
+
 impl HeightSource {
+    /// The image this height source reads, with the ground rectangle it covers.
+    pub(crate) fn image(&self) -> Option<(&Handle<Image>, Option<rwt_core::Rect>)> {
+        match self {
+            HeightSource::Image {
+                image, min, size, ..
+            } => Some((image, ground_rect(*min, *size))),
+            _ => None,
+        }
+    }
+
     /// A thread-safe snapshot; `None` while a heightmap is loading.
     pub fn resolve(&self, images: &Assets<Image>) -> Option<HeightFn> {
         Some(match self {
@@ -203,8 +240,7 @@ impl HeightSource {
                 size,
                 scale,
             } => {
-                let map =
-                    crate::image_density::from_bevy_image(images.get(image)?, *min, *size, 1.0)?;
+                let map = image::from_bevy_image(images.get(image)?, *min, *size, 1.0)?;
                 let scale = *scale;
                 Arc::new(move |p: Vec2| {
                     map.value(glam::DVec2::new(p.x as f64, p.y as f64)) as f32 * scale
@@ -215,7 +251,7 @@ impl HeightSource {
 }
 
 /// Slope (rise over run) of `height` at `p`, by central differences over `step`.
-pub fn slope(height: &HeightFn, p: Vec2, step: f32) -> f32 {
+pub(crate) fn slope(height: &HeightFn, p: Vec2, step: f32) -> f32 {
     let dx = height(p + Vec2::X * step) - height(p - Vec2::X * step);
     let dz = height(p + Vec2::Y * step) - height(p - Vec2::Y * step);
     Vec2::new(dx, dz).length() / (2.0 * step)
@@ -224,7 +260,7 @@ pub fn slope(height: &HeightFn, p: Vec2, step: f32) -> f32 {
 /// A scatter layer: instances of its classes, streamed around every [`crate::RwtViewer`].
 /// Removing the component (or despawning its entity) despawns all its instances.
 #[derive(Component, Clone, Debug)]
-#[require(Transform, Visibility)]
+#[require(Transform, Visibility, ScatterLayerStatus)]
 pub struct ScatterLayer {
     /// Classes sharing the layer's point set.
     pub classes: Vec<ScatterClass>,
@@ -235,9 +271,12 @@ pub struct ScatterLayer {
     pub seed: u64,
     /// Chunk size and load / unload distances.
     pub streaming: StreamingConfig,
-    /// Level of detail by density: full density up to `near`, fading to none at `far` from
-    /// the nearest viewer. Approaching adds instances between the existing ones.
-    pub falloff: Option<(f64, f64)>,
+    /// Level of detail by density: full density near the viewers, fading to none farther
+    /// away. Approaching adds instances between the existing ones.
+    pub falloff: Option<Falloff>,
+    /// The plane the layer lies on: the x-z ground of a 3-D world (default) or the x-y plane
+    /// of a 2-D one.
+    pub plane: GroundPlane,
     /// Ground height.
     pub height: HeightSource,
     /// Instances only where the ground height is within this range.
@@ -258,6 +297,7 @@ impl ScatterLayer {
             seed: 0,
             streaming: StreamingConfig::default(),
             falloff: None,
+            plane: GroundPlane::Xz,
             height: HeightSource::Constant(0.0),
             height_range: None,
             max_slope: None,
@@ -285,7 +325,13 @@ impl ScatterLayer {
 
     /// Sets the density fall-off with distance.
     pub fn with_falloff(mut self, near: f64, far: f64) -> Self {
-        self.falloff = Some((near, far));
+        self.falloff = Some(Falloff { near, far });
+        self
+    }
+
+    /// Sets the plane the layer lies on.
+    pub fn on_plane(mut self, plane: GroundPlane) -> Self {
+        self.plane = plane;
         self
     }
 
@@ -319,6 +365,45 @@ impl ScatterLayer {
             .iter()
             .map(|c| &c.density)
             .chain(self.exclusion.iter())
+    }
+}
+
+/// The plane a layer lies on. Ground positions `(u, v)` of the point set and the height
+/// `h` of the [`HeightSource`] become these world positions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum GroundPlane {
+    /// A 3-D world with y up: `(u, h, v)`, instances turned about y.
+    #[default]
+    Xz,
+    /// A 2-D world (sprites): `(u, v, h + depth)`, instances turned about z. `depth` is a
+    /// hash of the point in `[0, 0.001)`, so that overlapping sprites keep a stable order.
+    Xy,
+}
+
+impl GroundPlane {
+    /// An instance's transform: at ground position `ground` and height `height`, turned by
+    /// `yaw` about the plane's normal, scaled by `scale`.
+    pub fn transform(
+        self,
+        ground: Vec2,
+        height: f32,
+        yaw: f32,
+        scale: f32,
+        depth: f32,
+    ) -> Transform {
+        let (translation, rotation) = match self {
+            GroundPlane::Xz => (
+                Vec3::new(ground.x, height, ground.y),
+                Quat::from_rotation_y(yaw),
+            ),
+            GroundPlane::Xy => (
+                Vec3::new(ground.x, ground.y, height + depth * 1e-3),
+                Quat::from_rotation_z(yaw),
+            ),
+        };
+        Transform::from_translation(translation)
+            .with_rotation(rotation)
+            .with_scale(Vec3::splat(scale))
     }
 }
 

@@ -18,6 +18,7 @@
 //! set, where every point must be present anyway).
 
 use crate::geometry::BucketGrid;
+use crate::wang::EdgeColors;
 use glam::DVec2;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -290,6 +291,31 @@ pub fn order_by_threshold(cands: &[Candidate], tau: &[f64]) -> Vec<usize> {
             .then(a.cmp(&b))
     });
     order
+}
+
+/// Which tiles may lie at each neighbour offset of each tile, for a complete set with
+/// independent edge hashing: edge neighbours share the colour, diagonal ones are free.
+pub fn complete_set_neighbours(tiles: &[EdgeColors]) -> Neighbours {
+    tiles
+        .iter()
+        .map(|t| {
+            std::array::from_fn(|o| {
+                let (dx, dy) = OFFSETS[o];
+                (0..tiles.len() as u16)
+                    .filter(|&u| {
+                        let u = &tiles[u as usize];
+                        match (dx, dy) {
+                            (1, 0) => u.west == t.east,
+                            (-1, 0) => u.east == t.west,
+                            (0, 1) => u.south == t.north,
+                            (0, -1) => u.north == t.south,
+                            _ => true,
+                        }
+                    })
+                    .collect()
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]

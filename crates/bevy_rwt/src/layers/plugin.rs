@@ -1,0 +1,136 @@
+//! The layers feature plugin: the layer file asset and its loader, layer files applied to
+//! their entities, and the asset status of every layer.
+
+use super::file::{ScatterLayerAsset, ScatterLayerLoader, ScatterLayerSource};
+use super::{AssetStatus, ScatterLayer, ScatterLayerStatus};
+use crate::settings::RwtSystems;
+use bevy::asset::{LoadState, UntypedAssetId};
+use bevy::ecs::schedule::InternedScheduleLabel;
+use bevy::prelude::*;
+
+/// Layer files and asset status (part of [`crate::RwtPlugin`]).
+pub struct RwtLayersPlugin {
+    /// Schedule of the systems.
+    pub schedule: InternedScheduleLabel,
+}
+
+impl Plugin for RwtLayersPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            self.schedule,
+            (apply_layer_assets, watch_layer_files)
+                .chain()
+                .in_set(RwtSystems::Viewers),
+        );
+    }
+
+    fn finish(&self, app: &mut App) {
+        // Painted maps are `Image` assets; headless apps without the image plugin still get
+        // the asset type (registering it twice would duplicate its systems).
+        if !app.world().contains_resource::<Assets<Image>>() {
+            app.init_asset::<Image>();
+        }
+        app.init_asset::<ScatterLayerAsset>()
+            .register_asset_loader(ScatterLayerLoader);
+    }
+}
+
+/// Why an asset a layer reads is not there: `None` when it is loaded, else whether it is
+/// still loading or failed, named by its path (or its id for assets made in code).
+pub(crate) fn missing_asset(
+    id: UntypedAssetId,
+    path: Option<String>,
+    loaded: bool,
+    server: Option<&AssetServer>,
+) -> Option<AssetStatus> {
+    if loaded {
+        return None;
+    }
+    let name = path.unwrap_or_else(|| format!("{id:?}"));
+    Some(match server.and_then(|s| s.get_load_state(id)) {
+        Some(LoadState::Failed(err)) => AssetStatus::Failed(vec![format!("{name}: {err}")]),
+        _ => AssetStatus::Waiting(vec![name]),
+    })
+}
+
+/// Sets a layer's asset status, logging an error naming the layer and its assets when they
+/// fail (once per failure).
+pub(crate) fn report_assets(entity: Entity, status: &mut ScatterLayerStatus, assets: AssetStatus) {
+    if status.assets == assets {
+        return;
+    }
+    if let AssetStatus::Failed(failed) = &assets {
+        error!(
+            "rwt: layer {entity} shows nothing: cannot load {}",
+            failed.join("; ")
+        );
+    }
+    status.assets = assets;
+}
+
+/// Merges the reasons several assets are missing: any failure makes the layer failed.
+pub(crate) fn merge_missing(missing: impl IntoIterator<Item = AssetStatus>) -> AssetStatus {
+    let (mut waiting, mut failed) = (Vec::new(), Vec::new());
+    for m in missing {
+        match m {
+            AssetStatus::Waiting(w) => waiting.extend(w),
+            AssetStatus::Failed(f) => failed.extend(f),
+            AssetStatus::Ready => {}
+        }
+    }
+    if !failed.is_empty() {
+        AssetStatus::Failed(failed)
+    } else if !waiting.is_empty() {
+        AssetStatus::Waiting(waiting)
+    } else {
+        AssetStatus::Ready
+    }
+}
+
+/// Reports layer files that are still loading or failed to load on entities that have no
+/// layer yet.
+fn watch_layer_files(
+    mut sources: Query<
+        (Entity, &ScatterLayerSource, &mut ScatterLayerStatus),
+        Without<ScatterLayer>,
+    >,
+    assets: Res<Assets<ScatterLayerAsset>>,
+    server: Option<Res<AssetServer>>,
+) {
+    for (entity, source, mut status) in &mut sources {
+        let handle = &source.0;
+        let path = handle.path().map(|p| p.to_string());
+        let missing = missing_asset(
+            handle.id().untyped(),
+            path,
+            assets.contains(handle),
+            server.as_deref(),
+        );
+        report_assets(entity, &mut status, missing.unwrap_or_default());
+    }
+}
+
+/// Gives entities the layer of their source file when it loads, and again when it changes.
+fn apply_layer_assets(
+    mut events: MessageReader<AssetEvent<ScatterLayerAsset>>,
+    sources: Query<(Entity, &ScatterLayerSource)>,
+    added: Query<(Entity, &ScatterLayerSource), Added<ScatterLayerSource>>,
+    assets: Res<Assets<ScatterLayerAsset>>,
+    mut commands: Commands,
+) {
+    let changed: Vec<AssetId<ScatterLayerAsset>> = events
+        .read()
+        .filter_map(|e| match e {
+            AssetEvent::Added { id } | AssetEvent::Modified { id } => Some(*id),
+            _ => None,
+        })
+        .collect();
+    for (entity, source) in &sources {
+        let fresh = added.contains(entity);
+        if (fresh || changed.contains(&source.0.id()))
+            && let Some(asset) = assets.get(&source.0)
+        {
+            commands.entity(entity).insert(asset.0.clone());
+        }
+    }
+}

@@ -1,0 +1,35 @@
+//! What the plugin reports about each layer: its assets, chunks and instances.
+
+use bevy::platform::collections::HashSet;
+use bevy::prelude::*;
+use rwt_core::streaming::ChunkCoord;
+
+/// Whether the assets a layer reads (its layer file, density maps, heightmap) are there.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum AssetStatus {
+    /// Every asset is loaded: the layer streams.
+    #[default]
+    Ready,
+    /// Waiting for these assets (paths, or handles of assets made in code) to load.
+    Waiting(Vec<String>),
+    /// These assets failed to load (`asset: reason`): the layer shows nothing until they
+    /// are fixed (a file watcher reloads them).
+    Failed(Vec<String>),
+}
+
+/// The state of a layer, kept up to date by the plugin on every entity with a
+/// [`super::ScatterLayer`] or a [`super::file::ScatterLayerSource`]: read it for a HUD, or
+/// to tell a player why a layer is empty.
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct ScatterLayerStatus {
+    /// Its assets.
+    pub assets: AssetStatus,
+    /// Chunks loaded.
+    pub loaded_chunks: HashSet<ChunkCoord>,
+    /// Instances alive (spawned and not yet despawned).
+    pub live_instances: usize,
+    /// Chunks being generated or waiting to be.
+    pub pending_tasks: usize,
+    /// Instances waiting for the spawn budget.
+    pub queued_spawns: usize,
+}

@@ -1,0 +1,43 @@
+//! What every feature plugin shares: the budgets and the system sets.
+
+use bevy::prelude::*;
+
+/// Budgets of the streaming systems.
+#[derive(Resource, Clone, Debug)]
+pub struct RwtSettings {
+    /// Most instances spawned per frame (all layers).
+    pub spawn_budget: usize,
+    /// Most instances despawned per frame (all layers).
+    pub despawn_budget: usize,
+    /// Most chunk generation tasks in flight per layer.
+    pub max_tasks_in_flight: usize,
+    /// Length of the view wedge drawn from a viewer on the ground.
+    pub footprint_reach: f64,
+}
+
+impl Default for RwtSettings {
+    fn default() -> Self {
+        Self {
+            spawn_budget: 5_000,
+            despawn_budget: 10_000,
+            max_tasks_in_flight: 8,
+            footprint_reach: 1.0e4,
+        }
+    }
+}
+
+/// The plugin's system sets, in order; each feature plugin adds its systems to one.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum RwtSystems {
+    /// Viewers to ground positions; layer files to layers.
+    Viewers,
+    /// Chunk planning and task start.
+    Plan,
+    /// Finished tasks to spawn and despawn queues.
+    Collect,
+    /// Budgeted spawning and despawning.
+    Apply,
+    /// Each layer's [`crate::ScatterLayerStatus`] (the plugin-wide [`crate::RwtStats`] are
+    /// summed right after).
+    Stats,
+}

@@ -1,0 +1,164 @@
+//! Planning: which chunks each layer loads and unloads, which need regenerating, and the
+//! generation tasks for the nearest of them.
+
+use super::resolve::Sources;
+use super::{ChunkTask, ChunkUnloaded, LayerState, RwtTileSet};
+use crate::layers::{AssetStatus, ScatterLayer, ScatterLayerStatus, report_assets, slope};
+use crate::settings::RwtSettings;
+use crate::viewers::Viewers;
+use bevy::prelude::*;
+use bevy::tasks::AsyncComputeTaskPool;
+use rwt_core::density::Scale;
+use rwt_core::query::Sampler;
+use rwt_core::streaming::{ChunkCoord, Viewer, nearest_first};
+use std::sync::Arc;
+
+/// The resources planning reads.
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct PlanInputs<'w> {
+    viewers: Res<'w, Viewers>,
+    images: Res<'w, Assets<Image>>,
+    server: Option<Res<'w, AssetServer>>,
+    tile_set: Res<'w, RwtTileSet>,
+    settings: Res<'w, RwtSettings>,
+}
+
+/// Plans chunks for every layer whose assets are there and starts the generation tasks
+/// that are needed; layers still waiting for assets report why.
+pub(super) fn plan_chunks(
+    mut layers: Query<(
+        Entity,
+        &ScatterLayer,
+        &mut LayerState,
+        &mut ScatterLayerStatus,
+    )>,
+    inputs: PlanInputs,
+    mut unloaded: MessageWriter<ChunkUnloaded>,
+) {
+    for (entity, layer, mut state, mut status) in &mut layers {
+        let state = &mut *state;
+        let sources = match state
+            .sources
+            .sources(layer, &inputs.images, inputs.server.as_deref())
+        {
+            Ok(sources) => sources,
+            Err(missing) => {
+                report_assets(entity, &mut status, missing);
+                continue;
+            }
+        };
+        report_assets(entity, &mut status, AssetStatus::Ready);
+        let sampler = state
+            .sampler
+            .get_or_insert_with(|| {
+                let sampler = Sampler::new(&inputs.tile_set.0, layer.seed);
+                Arc::new(sampler.with_tile_size(layer.tile_size))
+            })
+            .clone();
+        let viewers = inputs.viewers.on(layer.plane);
+        update_chunks(entity, layer, state, viewers, &mut unloaded);
+        mark_band_changes(layer, state, viewers);
+        let free = inputs
+            .settings
+            .max_tasks_in_flight
+            .saturating_sub(state.in_flight());
+        start_tasks(layer, state, viewers, &sampler, &sources, free);
+    }
+}
+
+/// Loads and unloads chunks for the viewers: unloaded chunks queue their instances for
+/// despawning, loaded ones wait for generation.
+fn update_chunks(
+    entity: Entity,
+    layer: &ScatterLayer,
+    state: &mut LayerState,
+    viewers: &[Viewer],
+    unloaded: &mut MessageWriter<ChunkUnloaded>,
+) {
+    let changes = state.chunks.update(&layer.streaming, viewers);
+    for chunk in changes.unload {
+        if let Some(c) = state.states.remove(&chunk) {
+            state.despawn.extend(c.instances.values().map(|(e, _)| *e));
+        }
+        // Its queued points go with it; its place in the spawn order is skipped later.
+        unloaded.write(ChunkUnloaded {
+            layer: entity,
+            chunk,
+        });
+    }
+    for chunk in changes.load {
+        state.states.entry(chunk).or_default().stale = true;
+    }
+}
+
+/// Chunks whose level-of-detail band moved with the viewers need regenerating.
+fn mark_band_changes(layer: &ScatterLayer, state: &mut LayerState, viewers: &[Viewer]) {
+    let Some(falloff) = layer.falloff else {
+        return;
+    };
+    let size = layer.streaming.chunk_size;
+    for (chunk, c) in state.states.iter_mut() {
+        if falloff.chunk_band(*chunk, size, viewers) != c.lod {
+            c.stale = true;
+        }
+    }
+}
+
+/// Starts generation tasks for up to `free` stale chunks without one, nearest first.
+fn start_tasks(
+    layer: &ScatterLayer,
+    state: &mut LayerState,
+    viewers: &[Viewer],
+    sampler: &Arc<Sampler>,
+    sources: &Sources,
+    free: usize,
+) {
+    let size = layer.streaming.chunk_size;
+    let stale = state
+        .states
+        .iter()
+        .filter(|(_, c)| c.stale && c.task.is_none())
+        .map(|(chunk, _)| *chunk);
+    for chunk in nearest_first(stale, size, viewers).into_iter().take(free) {
+        let band = layer
+            .falloff
+            .map_or(0, |f| f.chunk_band(chunk, size, viewers));
+        let c = state.states.get_mut(&chunk).expect("listed above");
+        c.stale = false;
+        c.task = Some((
+            start_task(layer, sampler.clone(), sources, chunk, band),
+            band,
+        ));
+    }
+}
+
+/// Starts a generation task for a chunk: the query at the band's density, then the height
+/// and slope filters.
+fn start_task(
+    layer: &ScatterLayer,
+    sampler: Arc<Sampler>,
+    sources: &Sources,
+    chunk: ChunkCoord,
+    band: i64,
+) -> ChunkTask {
+    let rect = chunk.rect(layer.streaming.chunk_size);
+    let factor = layer.falloff.map_or(1.0, |f| f.factor(band));
+    let (range, max_slope) = (layer.height_range, layer.max_slope);
+    let densities = sources.densities.clone();
+    let height = sources.height.clone();
+    AsyncComputeTaskPool::get().spawn(async move {
+        let scaled: Vec<_> = densities.iter().map(|d| Scale(d.clone(), factor)).collect();
+        let mut out = Vec::new();
+        sampler
+            .query_classes(rect, &scaled, |p| {
+                let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+                let in_range = range.is_none_or(|(lo, hi)| (lo..=hi).contains(&height(ground)));
+                let flat_enough = max_slope.is_none_or(|m| slope(&height, ground, 0.25) <= m);
+                if in_range && flat_enough {
+                    out.push(p);
+                }
+            })
+            .ok()
+            .map(|_| out)
+    })
+}

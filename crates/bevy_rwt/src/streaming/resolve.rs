@@ -1,0 +1,153 @@
+//! A layer's densities and height source as thread-safe snapshots for generation tasks.
+//! Each is made once and kept; repainting a map forgets only the snapshots that read it.
+
+use crate::layers::{AssetStatus, HeightFn, LayerDensity, ScatterLayer, SharedDensity};
+use crate::layers::{merge_missing, missing_asset};
+use bevy::prelude::*;
+use rwt_core::density::Exclude;
+use std::sync::Arc;
+
+/// The snapshots of one layer.
+#[derive(Default)]
+pub(super) struct Resolved {
+    /// One per class, `None` until made.
+    classes: Vec<Option<SharedDensity>>,
+    /// The exclusion mask, when the layer has one.
+    exclusion: Option<SharedDensity>,
+    height: Option<HeightFn>,
+}
+
+/// What generation tasks read: every class's density (exclusion applied) and the height.
+pub(super) struct Sources {
+    pub densities: Vec<SharedDensity>,
+    pub height: HeightFn,
+}
+
+/// The snapshot of `density`, or why it cannot be made yet.
+fn snapshot(
+    density: &LayerDensity,
+    images: &Assets<Image>,
+    server: Option<&AssetServer>,
+) -> Result<SharedDensity, AssetStatus> {
+    if let Some(d) = density.resolve(images) {
+        return Ok(d);
+    }
+    let image = density.image().expect("only image densities wait");
+    Err(unreadable(image, images, server))
+}
+
+/// Why an image that a layer reads gives no snapshot: loading, failed, or not readable.
+fn unreadable(
+    image: &Handle<Image>,
+    images: &Assets<Image>,
+    server: Option<&AssetServer>,
+) -> AssetStatus {
+    let path = image.path().map(|p| p.to_string());
+    match missing_asset(
+        image.id().untyped(),
+        path.clone(),
+        images.contains(image),
+        server,
+    ) {
+        Some(missing) => missing,
+        None => AssetStatus::Failed(vec![format!(
+            "{}: pixels not readable on the CPU (compressed or GPU-only format)",
+            path.unwrap_or_else(|| format!("{:?}", image.id()))
+        )]),
+    }
+}
+
+impl Resolved {
+    /// Forgets the snapshots that read `image`; returns the ground regions they covered
+    /// (`None` for a region: the whole plane).
+    pub fn forget_image(
+        &mut self,
+        layer: &ScatterLayer,
+        image: AssetId<Image>,
+    ) -> Vec<Option<rwt_core::Rect>> {
+        let mut covered = Vec::new();
+        let reads = |d: &LayerDensity| d.image().is_some_and(|h| h.id() == image);
+        for (slot, class) in self.classes.iter_mut().zip(&layer.classes) {
+            if reads(&class.density) {
+                *slot = None;
+                covered.push(class.density.image_rect());
+            }
+        }
+        if let Some(mask) = layer.exclusion.as_ref().filter(|m| reads(m)) {
+            self.exclusion = None;
+            covered.push(mask.image_rect());
+        }
+        if let Some((handle, rect)) = layer.height.image()
+            && handle.id() == image
+        {
+            self.height = None;
+            covered.push(rect);
+        }
+        covered
+    }
+
+    /// Makes what is missing; returns the task inputs, or why the layer must wait.
+    pub fn sources(
+        &mut self,
+        layer: &ScatterLayer,
+        images: &Assets<Image>,
+        server: Option<&AssetServer>,
+    ) -> Result<Sources, AssetStatus> {
+        self.classes.resize(layer.classes.len(), None);
+        let mut missing = Vec::new();
+        for (slot, class) in self.classes.iter_mut().zip(&layer.classes) {
+            if slot.is_none() {
+                snapshot(&class.density, images, server)
+                    .map(|d| *slot = Some(d))
+                    .unwrap_or_else(|m| missing.push(m));
+            }
+        }
+        if let Some(mask) = layer
+            .exclusion
+            .as_ref()
+            .filter(|_| self.exclusion.is_none())
+        {
+            snapshot(mask, images, server)
+                .map(|d| self.exclusion = Some(d))
+                .unwrap_or_else(|m| missing.push(m));
+        }
+        if self.height.is_none() {
+            match layer.height.resolve(images) {
+                Some(h) => self.height = Some(h),
+                None => {
+                    let (image, _) = layer.height.image().expect("only heightmaps wait");
+                    missing.push(unreadable(image, images, server));
+                }
+            }
+        }
+        if !missing.is_empty() {
+            return Err(merge_missing(missing));
+        }
+        Ok(Sources {
+            densities: self.densities(),
+            height: self.height.clone().expect("made above"),
+        })
+    }
+
+    /// The height snapshot, once made.
+    pub fn height(&self) -> Option<&HeightFn> {
+        self.height.as_ref()
+    }
+
+    /// Every class's density with the exclusion mask applied.
+    fn densities(&self) -> Vec<SharedDensity> {
+        let classes = self.classes.iter().map(|c| c.clone().expect("made above"));
+        match &self.exclusion {
+            None => classes.collect(),
+            Some(mask) => classes
+                .map(|inner| {
+                    Arc::new(Exclude {
+                        inner,
+                        mask: mask.clone(),
+                        threshold: 0.5,
+                    }) as SharedDensity
+                })
+                .collect(),
+        }
+    }
+}

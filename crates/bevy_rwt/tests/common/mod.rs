@@ -1,0 +1,125 @@
+//! Helpers shared by the plugin's integration tests: a headless app (`MinimalPlugins` and
+//! assets, no renderer), frame stepping until streaming settles, viewers, layers, painting.
+#![allow(dead_code)] // each test file uses some of them
+
+use bevy::asset::AssetPlugin;
+use bevy::prelude::*;
+use bevy_rwt::prelude::*;
+use bevy_rwt::rwt_core::query::PointId;
+use std::collections::HashMap;
+use std::time::Duration;
+
+pub fn create_app() -> App {
+    create_app_with(|_| {})
+}
+
+/// A headless app; `extra` adds plugins before the app is finished.
+pub fn create_app_with(extra: impl FnOnce(&mut App)) -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        RwtPlugin::default().with_spawn_budget(50_000),
+    ));
+    extra(&mut app);
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// Runs frames until nothing is pending or queued (or `max` frames).
+pub fn tick_app(app: &mut App, max: usize) {
+    for _ in 0..max {
+        app.update();
+        let s = app.world().resource::<RwtStats>();
+        if s.pending_tasks == 0 && s.queued_spawns == 0 {
+            app.update();
+            let s = app.world().resource::<RwtStats>();
+            if s.pending_tasks == 0 && s.queued_spawns == 0 {
+                return;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    panic!("streaming did not settle in {max} frames");
+}
+
+/// A `size x size` image of one colour.
+pub fn solid_image(size: u32, rgba: [u8; 4]) -> Image {
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+    Image::new_fill(
+        Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        &rgba,
+        TextureFormat::Rgba8Unorm,
+        Default::default(),
+    )
+}
+
+/// Paints texels `[x0, x0 + 8) x [y0, y0 + 8)` of `image` with `color`.
+pub fn paint_square(app: &mut App, image: &Handle<Image>, x0: u32, y0: u32, color: Color) {
+    let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+    let mut img = images.get_mut(image).unwrap();
+    for y in y0..y0 + 8 {
+        for x in x0..x0 + 8 {
+            img.set_color_at(x, y, color).unwrap();
+        }
+    }
+}
+
+/// Whether `p` lies where texels 40..48 of a 64-texel map over -64..64 reach: x in 16..32,
+/// z in -32..-16 (rows count from the top, max z = 64), widened by half a texel by bilinear
+/// blending.
+pub fn in_painted_square(p: &Vec3) -> bool {
+    p.x > 15.0 && p.x < 33.0 && p.z > -33.0 && p.z < -15.0
+}
+
+pub fn streaming() -> StreamingConfig {
+    StreamingConfig {
+        chunk_size: 16.0,
+        load_distance: 48.0,
+        unload_distance: 64.0,
+        near_distance: 20.0,
+    }
+}
+
+pub fn layer(density: LayerDensity) -> ScatterLayer {
+    let class = ScatterClass::new(density, Handle::default(), Handle::default());
+    ScatterLayer::new(vec![class])
+        .with_tile_size(8.0)
+        .with_seed(3)
+        .with_streaming(streaming())
+}
+
+pub fn spawn_viewer(app: &mut App, at: Vec3) -> Entity {
+    app.world_mut()
+        .spawn((
+            RwtViewer::all_around(),
+            Transform::from_translation(at),
+            GlobalTransform::from_translation(at),
+        ))
+        .id()
+}
+
+pub fn move_viewer(app: &mut App, viewer: Entity, at: Vec3) {
+    let mut e = app.world_mut().entity_mut(viewer);
+    *e.get_mut::<Transform>().unwrap() = Transform::from_translation(at);
+    *e.get_mut::<GlobalTransform>().unwrap() = GlobalTransform::from_translation(at);
+}
+
+pub fn instances(app: &mut App) -> HashMap<PointId, Vec3> {
+    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut out = HashMap::new();
+    for (i, t) in q.iter(app.world()) {
+        assert!(
+            out.insert(i.id, t.translation).is_none(),
+            "two live instances share {:?}",
+            i.id
+        );
+    }
+    out
+}

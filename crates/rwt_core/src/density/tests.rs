@@ -1,0 +1,184 @@
+//! Bounds and sanitizing of every shipped density.
+
+use super::*;
+use crate::rng::Rng;
+
+/// Upper bounds hold within rounding; lower bounds exactly (queries take points below
+/// them without evaluating). Returns the share of rectangles with a positive lower bound.
+fn check_bound(d: &impl Density, rng: &mut Rng, world: f64) -> f64 {
+    let mut useful = 0;
+    for _ in 0..300 {
+        let a = DVec2::new(rng.next_f64(), rng.next_f64()) * world;
+        let ext = DVec2::new(rng.next_f64(), rng.next_f64()) * world * 0.2 * rng.next_f64();
+        let b = a + ext;
+        let bound = d.max_over(a, b);
+        let low = sanitize(d.min_over(a, b));
+        useful += usize::from(low > 0.0);
+        for k in 0..40 {
+            // Corners and edges too: bilinear blending is least exact there.
+            let t = match k {
+                0 => DVec2::ZERO,
+                1 => DVec2::ONE,
+                2 => DVec2::X,
+                3 => DVec2::Y,
+                _ => DVec2::new(rng.next_f64(), rng.next_f64()),
+            };
+            let p = a + t * ext;
+            let v = d.density(p);
+            assert!(
+                bound >= v - 1e-9,
+                "bound {bound} < value {v} at {p:?} in {a:?}..{b:?}"
+            );
+            assert!(
+                low <= sanitize(v),
+                "lower bound {low} > value {v} at {p:?} in {a:?}..{b:?}"
+            );
+        }
+    }
+    useful as f64 / 300.0
+}
+
+#[test]
+fn image_maximum_is_conservative_and_sees_thin_strokes() {
+    let (w, h) = (64u32, 48u32);
+    let mut values = vec![0.0f32; (w * h) as usize];
+    // A one-pixel vertical stroke.
+    for y in 0..h {
+        values[(y * w + 37) as usize] = 1.0;
+    }
+    let mut rng = Rng::new(1, 2);
+    for v in values.iter_mut().filter(|v| **v == 0.0) {
+        *v = (rng.next_f64() * 0.3) as f32;
+    }
+    let d = ImageDensity::from_values(
+        w,
+        h,
+        &values,
+        DVec2::new(-3.0, 2.0),
+        DVec2::new(6.4, 4.8),
+        100.0,
+    )
+    .unwrap();
+    let useful = check_bound(&d, &mut rng, 6.0);
+    assert!(
+        useful > 0.2,
+        "lower bounds positive in {useful} of rectangles"
+    );
+    // The stroke is 0.1 world units wide; any rectangle containing it sees density 100.
+    let x = -3.0 + 6.4 * 37.5 / 64.0;
+    assert!(d.max_over(DVec2::new(x - 2.0, 2.5), DVec2::new(x + 2.0, 3.0)) >= 100.0);
+    assert!(d.max_over(DVec2::new(x - 0.01, 2.5), DVec2::new(x + 0.01, 2.6)) >= 100.0);
+    assert_eq!(
+        d.max_over(DVec2::new(100.0, 100.0), DVec2::new(101.0, 101.0)),
+        0.0
+    );
+    assert_eq!(d.density(DVec2::new(-5.0, 0.0)), 0.0);
+}
+
+#[test]
+fn noise_maximum_is_conservative() {
+    let d = NoiseDensity::new(NoiseParams {
+        seed: 7,
+        frequency: 0.37,
+        octaves: 5,
+        base: 0.3,
+        amplitude: 0.8,
+        scale: 50.0,
+    });
+    check_bound(&d, &mut Rng::new(2, 2), 40.0);
+    // Small rectangles get useful lower bounds.
+    let useful = check_bound(&d, &mut Rng::new(2, 3), 4.0);
+    assert!(
+        useful > 0.1,
+        "lower bounds positive in {useful} of rectangles"
+    );
+}
+
+#[test]
+fn combinators_keep_bounds() {
+    let img = ImageDensity::from_values(
+        2,
+        2,
+        &[0.0, 1.0, 0.5, 0.25],
+        DVec2::ZERO,
+        DVec2::splat(10.0),
+        20.0,
+    )
+    .unwrap();
+    let noise = NoiseDensity::new(NoiseParams {
+        seed: 3,
+        frequency: 0.2,
+        octaves: 3,
+        base: 0.5,
+        amplitude: 0.5,
+        scale: 10.0,
+    });
+    let mut rng = Rng::new(3, 3);
+    check_bound(&Sum(img.clone(), noise.clone()), &mut rng, 10.0);
+    check_bound(
+        &Product(img.clone(), Scale(noise.clone(), 0.1)),
+        &mut rng,
+        10.0,
+    );
+    check_bound(
+        &Mask {
+            inner: noise.clone(),
+            mask: img.clone(),
+            threshold: 5.0,
+        },
+        &mut rng,
+        10.0,
+    );
+    check_bound(
+        &Exclude {
+            inner: Sum(noise.clone(), Constant(3.0)),
+            mask: img.clone(),
+            threshold: 10.0,
+        },
+        &mut rng,
+        10.0,
+    );
+    check_bound(&Scale(Constant(-2.0), -1.5), &mut rng, 10.0);
+    check_bound(
+        &DistanceFalloff {
+            inner: Sum(noise.clone(), Constant(1.0)),
+            centre: DVec2::splat(5.0),
+            near: 1.0,
+            far: 4.0,
+        },
+        &mut rng,
+        10.0,
+    );
+    check_bound(
+        &DistanceFalloff {
+            inner: noise,
+            centre: DVec2::splat(5.0),
+            near: 1.0,
+            far: 4.0,
+        },
+        &mut rng,
+        10.0,
+    );
+}
+
+#[test]
+fn bad_values_are_sanitized_or_rejected() {
+    assert_eq!(sanitize(f64::NAN), 0.0);
+    assert_eq!(sanitize(-3.0), 0.0);
+    assert_eq!(sanitize(f64::INFINITY), f64::INFINITY);
+    let d =
+        ImageDensity::from_values(2, 1, &[f32::NAN, 7.0], DVec2::ZERO, DVec2::ONE, 1.0).unwrap();
+    assert!(d.max_over(DVec2::ZERO, DVec2::ONE) <= 1.0);
+    assert_eq!(
+        ImageDensity::from_values(0, 1, &[], DVec2::ZERO, DVec2::ONE, 1.0).unwrap_err(),
+        ImageDensityError::Size(0, 1)
+    );
+    assert_eq!(
+        ImageDensity::from_values(1, 1, &[0.5], DVec2::ZERO, DVec2::new(f64::NAN, 1.0), 1.0)
+            .unwrap_err(),
+        ImageDensityError::Rect
+    );
+    assert!(
+        ImageDensity::from_bytes(b"not an image", false, DVec2::ZERO, DVec2::ONE, 1.0).is_err()
+    );
+}

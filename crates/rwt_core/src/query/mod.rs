@@ -1,0 +1,233 @@
+//! Random-access blue-noise queries (paper sections 3 and 5.2).
+//!
+//! For a rectangle and a density, every base tile over the rectangle contributes its points
+//! whose rank plus the tile's offset is below `density x tile area`; where the density's maximum over a tile asks
+//! for more than the tile holds, the tile's subdivision ranking continues the sequence
+//! (ranks `N..n^2 N`), and where it asks for more than that, the children are visited in
+//! turn. Work and output are proportional to the integral of the density; nothing is
+//! allocated per tile (the recursion lives on the stack, results go to a callback).
+//!
+//! The offset is a number in `[0, 1)` hashed from the base tile's lattice position. Without
+//! it a tile's first point would appear at any positive density, so a density of 0.1
+//! points per tile would still put one point in every tile; with it, a tile's `k`-th point
+//! appears at `(k + offset) / area`, and the expected count is the integral at every
+//! density, however sparse.
+//!
+//! Every point is produced exactly once, at the coarsest level where it exists, with a
+//! stable [`PointId`]. A point is included exactly when the density at its position exceeds
+//! its [`Point::threshold`], so raising the density anywhere only adds points, and splitting
+//! a rectangle into pieces (half-open: `[min, max)`) yields exactly the union of the pieces.
+
+mod point;
+mod prepared;
+mod rect;
+mod traversal;
+mod work_bound;
+
+pub use point::{Point, PointId};
+pub use rect::Rect;
+
+use crate::density::{Density, SumOf, sanitize};
+use crate::tileset::TileSet;
+use prepared::PreparedTile;
+use std::sync::Arc;
+use traversal::Visit;
+
+/// Deepest subdivision level visited: `n^(2 * 24)` times the base density, far beyond any
+/// budget. Deeper requests are served at this level's density.
+pub const MAX_LEVEL: u32 = 24;
+
+/// Largest coordinate magnitude, in base tiles, a query may touch (keeps lattice indices of
+/// every level inside `i64`).
+pub const MAX_TILE_COORDINATE: f64 = 1.0e12;
+
+/// Hash stream of the per-base-tile rank offsets.
+const OFFSET_STREAM: u64 = 0x0ff5_e7a1_u64;
+
+/// Why a query was refused. Nothing is generated when a query is refused up front.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum QueryError {
+    /// A corner is NaN or infinite.
+    #[error("query rectangle is not finite")]
+    NonFiniteRect,
+    /// `max < min` on some axis.
+    #[error("query rectangle is inverted (max < min)")]
+    InvertedRect,
+    /// Coordinates beyond [`MAX_TILE_COORDINATE`] base tiles.
+    #[error(
+        "query rectangle reaches {tiles:e} tiles from the origin (limit {MAX_TILE_COORDINATE:e})"
+    )]
+    TooFar {
+        /// Distance in base tiles.
+        tiles: f64,
+    },
+    /// The query asks for more points, or spans more base tiles of positive density, than
+    /// the budget allows (see [`Sampler::work_bound`]).
+    #[error(
+        "query may produce up to {estimate:.0} points or tile visits, over the budget of {budget} \
+         (ask for a smaller rectangle, a lower density or larger tiles)"
+    )]
+    BudgetExceeded {
+        /// Bound of the points plus base tiles visited.
+        estimate: f64,
+        /// The budget.
+        budget: usize,
+    },
+}
+
+/// Generates points of a tile set's infinite point set: the run-time side of rwt.
+#[derive(Clone, Debug)]
+pub struct Sampler {
+    /// Shared: cloning a sampler (to reseed it, or to hand it to another thread) is cheap.
+    tiles: Arc<Vec<PreparedTile>>,
+    n: i64,
+    points_per_tile: usize,
+    sub_len: usize,
+    colors: u8,
+    seed: u64,
+    tile_size: f64,
+    budget: usize,
+}
+
+impl Sampler {
+    /// A sampler over `set`'s tiling for `seed`, with base tiles 1 world unit wide and a
+    /// budget of 50 million points per query.
+    pub fn new(set: &TileSet, seed: u64) -> Self {
+        let tiles = set
+            .tiles
+            .iter()
+            .map(|t| PreparedTile::new(set, t))
+            .collect();
+        Self {
+            tiles: Arc::new(tiles),
+            n: set.subdivision as i64,
+            points_per_tile: set.points_per_tile as usize,
+            sub_len: set.subdivision_len(),
+            colors: set.colors,
+            seed,
+            tile_size: 1.0,
+            budget: 50_000_000,
+        }
+    }
+
+    /// The same tiles with another tiling seed: another, independent point set. Cheap (the
+    /// prepared tiles are shared), unlike [`Sampler::new`].
+    pub fn with_seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// Base tiles `size` world units wide (finite, positive).
+    pub fn with_tile_size(mut self, size: f64) -> Self {
+        if size.is_finite() && size > 0.0 {
+            self.tile_size = size;
+        }
+        self
+    }
+
+    /// Largest number of points one query may produce.
+    pub fn with_budget(mut self, budget: usize) -> Self {
+        self.budget = budget;
+        self
+    }
+
+    /// Base tile size in world units.
+    pub fn tile_size(&self) -> f64 {
+        self.tile_size
+    }
+
+    /// The tiling seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Points per tile of the underlying set.
+    pub fn points_per_tile(&self) -> usize {
+        self.points_per_tile
+    }
+
+    fn check(&self, rect: &Rect) -> Result<(), QueryError> {
+        let far = rect.min().abs().max(rect.max().abs()).max_element() / self.tile_size;
+        if far > MAX_TILE_COORDINATE {
+            return Err(QueryError::TooFar { tiles: far });
+        }
+        Ok(())
+    }
+
+    /// Calls `emit` with every point of `rect` for `density`; returns how many.
+    pub fn query_with<D: Density + ?Sized>(
+        &self,
+        rect: Rect,
+        density: &D,
+        mut emit: impl FnMut(Point),
+    ) -> Result<usize, QueryError> {
+        self.check(&rect)?;
+        let estimate = self.work_bound(&rect, density);
+        if estimate.is_nan() || estimate > self.budget as f64 {
+            return Err(QueryError::BudgetExceeded {
+                estimate,
+                budget: self.budget,
+            });
+        }
+        let mut count = 0usize;
+        if rect.is_empty() {
+            return Ok(0);
+        }
+        let s = self.tile_size;
+        let (i0, i1) = (
+            (rect.min().x / s).floor() as i64,
+            (rect.max().x / s).ceil() as i64,
+        );
+        let (j0, j1) = (
+            (rect.min().y / s).floor() as i64,
+            (rect.max().y / s).ceil() as i64,
+        );
+        let mut visit = Visit {
+            sampler: self,
+            rect,
+            density,
+            emit: &mut |p: Point| {
+                count += 1;
+                emit(p)
+            },
+        };
+        visit.blocks(i0, i1, j0, j1, s);
+        Ok(count)
+    }
+
+    /// All points of `rect` for `density`, appended to `out`; returns how many.
+    pub fn query<D: Density + ?Sized>(
+        &self,
+        rect: Rect,
+        density: &D,
+        out: &mut Vec<Point>,
+    ) -> Result<usize, QueryError> {
+        self.query_with(rect, density, |p| out.push(p))
+    }
+
+    /// Several classes sharing one point set (paper section 6.3): points follow the sum of
+    /// the class densities, and a point of threshold `tau` at `p` belongs to the first class
+    /// `i` with `tau < d_0(p) + ... + d_i(p)`. So class 0 alone is exactly the point set of
+    /// `d_0` (blue noise by itself), classes `0..=i` together that of `d_0 + ... + d_i`, and
+    /// every class appears in proportion to its density.
+    pub fn query_classes<D: Density>(
+        &self,
+        rect: Rect,
+        classes: &[D],
+        mut emit: impl FnMut(Point),
+    ) -> Result<usize, QueryError> {
+        let total = SumOf(classes);
+        self.query_with(rect, &total, |mut p| {
+            let mut cumulative = 0.0;
+            p.class = (classes.len().saturating_sub(1)) as u16;
+            for (i, c) in classes.iter().enumerate() {
+                cumulative += sanitize(c.density(p.position));
+                if p.threshold < cumulative {
+                    p.class = i as u16;
+                    break;
+                }
+            }
+            emit(p)
+        })
+    }
+}

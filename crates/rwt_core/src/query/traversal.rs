@@ -1,0 +1,273 @@
+//! The traversal of a query: base tiles in blocks, then each tile's cells, its subdivision
+//! ranking and its children, where the density's bounds ask for them.
+
+use super::point::{Point, PointId};
+use super::prepared::CellPoint;
+use super::{MAX_LEVEL, OFFSET_STREAM, Rect, Sampler};
+use crate::density::{Density, sanitize};
+use crate::rng::{hash_words, unit_f64};
+use crate::tiling::base_tile;
+use glam::DVec2;
+
+/// Blocks of base tiles wider than this are bounded as a whole before they are split.
+const LEAF_BLOCK: i64 = 8;
+
+/// Most cells of a subdivision (`n = 8`).
+const MAX_CELLS: usize = 64;
+
+/// One query in progress: the rectangle, the density and where points go.
+pub(super) struct Visit<'a, D: ?Sized, F> {
+    pub sampler: &'a Sampler,
+    pub rect: Rect,
+    pub density: &'a D,
+    pub emit: &'a mut F,
+}
+
+/// A tile of some level at its lattice position.
+#[derive(Clone, Copy)]
+struct TileAt {
+    level: u32,
+    ix: i64,
+    iy: i64,
+    /// Side in world units.
+    side: f64,
+}
+
+impl TileAt {
+    fn rect(&self) -> Rect {
+        let s = self.side;
+        Rect::from_ordered(
+            DVec2::new(self.ix as f64 * s, self.iy as f64 * s),
+            DVec2::new((self.ix + 1) as f64 * s, (self.iy + 1) as f64 * s),
+        )
+    }
+}
+
+/// Upper and lower density bounds of each cell of a tile, times the tile's area: how many
+/// of the tile's ranks the cell may show, and how many it shows for sure.
+struct CellBounds {
+    limit: [f64; MAX_CELLS],
+    low: [f64; MAX_CELLS],
+}
+
+/// A run of ranked points of one cell to emit, with what they share.
+struct Run<'p> {
+    points: &'p [CellPoint],
+    /// Points whose rank is below this may appear.
+    limit: f64,
+    /// Points whose rank is below this appear without evaluating the density.
+    sure: f64,
+    /// Added to every rank (the base tile's hashed offset; 0 in subdivisions).
+    offset: f64,
+    /// The tile the points belong to (their identity and frame).
+    owner: TileAt,
+    /// Area of the tile whose ranking this is (thresholds are ranks per this area).
+    area: f64,
+}
+
+impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
+    /// Visits the base tiles `[i0, i1) x [j0, j1)`, halving the block while it is large and
+    /// skipping blocks where the density is zero: an empty region costs one bound however
+    /// many tiles it spans.
+    pub fn blocks(&mut self, i0: i64, i1: i64, j0: i64, j1: i64, s: f64) {
+        if i1 <= i0 || j1 <= j0 {
+            return;
+        }
+        // Sides compared separately: their product can overflow for huge rectangles.
+        if i1 - i0 > LEAF_BLOCK || j1 - j0 > LEAF_BLOCK {
+            let block = Rect::from_ordered(
+                DVec2::new(i0 as f64 * s, j0 as f64 * s),
+                DVec2::new(i1 as f64 * s, j1 as f64 * s),
+            );
+            let Some(block) = block.intersect(&self.rect) else {
+                return;
+            };
+            let bound = sanitize(self.density.max_over(block.min(), block.max()));
+            if bound.is_nan() || bound <= 0.0 {
+                return;
+            }
+            let (im, jm) = (i0 + (i1 - i0) / 2, j0 + (j1 - j0) / 2);
+            if i1 - i0 >= j1 - j0 {
+                self.blocks(i0, im, j0, j1, s);
+                self.blocks(im, i1, j0, j1, s);
+            } else {
+                self.blocks(i0, i1, j0, jm, s);
+                self.blocks(i0, i1, jm, j1, s);
+            }
+            return;
+        }
+        for iy in j0..j1 {
+            for ix in i0..i1 {
+                let t = base_tile(self.sampler.seed, self.sampler.colors, ix, iy);
+                let at = TileAt {
+                    level: 0,
+                    ix,
+                    iy,
+                    side: s,
+                };
+                self.tile(t, at, None);
+            }
+        }
+    }
+
+    /// The lower density bound over `rect` times `area`, at most `limit`; 0 when not finite.
+    fn low(&self, rect: &Rect, limit: f64, area: f64) -> f64 {
+        let low = sanitize(self.density.min_over(rect.min(), rect.max())) * area;
+        if low.is_finite() { low.min(limit) } else { 0.0 }
+    }
+
+    /// Visits tile `t` at `at`. `known` is the upper and lower density bounds over its part
+    /// of the query times its area, when the parent has them. Points ranked below the lower
+    /// bound are taken without evaluating the density (the bound guarantees the evaluation
+    /// would take them).
+    fn tile(&mut self, t: u16, at: TileAt, known: Option<(f64, f64)>) {
+        let tile_rect = at.rect();
+        let Some(clip) = tile_rect.intersect(&self.rect) else {
+            return;
+        };
+        let area = at.side * at.side;
+        let (limit, low) = known.unwrap_or_else(|| {
+            let limit = sanitize(self.density.max_over(clip.min(), clip.max())) * area;
+            (limit, self.low(&clip, limit, area))
+        });
+        if limit.is_nan() || limit <= 0.0 {
+            return;
+        }
+        let bounds = self.cell_bounds(at, limit, low, clip != tile_rect);
+        if at.level == 0 {
+            self.base_points(t, at, &bounds);
+        }
+        let big_n = self.sampler.points_per_tile as f64;
+        if limit <= big_n || at.level >= MAX_LEVEL {
+            return;
+        }
+        self.subdivision(t, at, &bounds);
+    }
+
+    /// Per-cell bounds pay off once the tile asks for more than a few points per cell, or
+    /// when it is only partly inside the query; otherwise the tile's bounds serve all cells.
+    fn cell_bounds(&self, at: TileAt, limit: f64, low: f64, clipped: bool) -> CellBounds {
+        let n = self.sampler.n;
+        let cells = (n * n) as usize;
+        let mut bounds = CellBounds {
+            limit: [limit; MAX_CELLS],
+            low: [low; MAX_CELLS],
+        };
+        if !(limit > 4.0 * cells as f64 || clipped) {
+            return bounds;
+        }
+        let area = at.side * at.side;
+        let child_s = at.side / n as f64;
+        let origin = at.rect().min();
+        for cell in 0..cells {
+            let (a, b) = ((cell as i64 % n) as f64, (cell as i64 / n) as f64);
+            let cell_rect = Rect::from_ordered(
+                origin + DVec2::new(a, b) * child_s,
+                origin + DVec2::new(a + 1.0, b + 1.0) * child_s,
+            );
+            (bounds.limit[cell], bounds.low[cell]) = match cell_rect.intersect(&self.rect) {
+                None => (0.0, 0.0),
+                Some(r) => {
+                    let max = sanitize(self.density.max_over(r.min(), r.max())) * area;
+                    let cell_max = max.min(limit);
+                    (cell_max, self.low(&r, cell_max, area).max(low))
+                }
+            };
+        }
+        bounds
+    }
+
+    /// The base tile's own points, each cell's run up to its bound.
+    fn base_points(&mut self, t: u16, at: TileAt, bounds: &CellBounds) {
+        let sampler = self.sampler;
+        let offset = unit_f64(hash_words(
+            sampler.seed ^ OFFSET_STREAM,
+            &[at.ix as u64, at.iy as u64],
+        ));
+        let area = at.side * at.side;
+        for (cell, points) in sampler.tiles[t as usize].base_cells.iter().enumerate() {
+            self.emit_run(Run {
+                points,
+                limit: bounds.limit[cell] - offset,
+                sure: bounds.low[cell],
+                offset,
+                owner: at,
+                area,
+            });
+        }
+    }
+
+    /// The tile's subdivision ranking past its base points (the points of its children that
+    /// appear at this level), then the children whose cells ask for more than all of it.
+    fn subdivision(&mut self, t: u16, at: TileAt, bounds: &CellBounds) {
+        let sampler = self.sampler;
+        let n = sampler.n;
+        // Child lattice indices, with room for the cell offset: never overflow, just stop.
+        let child = |v: i64| v.checked_mul(n).filter(|c| c.checked_add(n).is_some());
+        let (Some(cx0), Some(cy0)) = (child(at.ix), child(at.iy)) else {
+            return;
+        };
+        let big_n = sampler.points_per_tile as f64;
+        let area = at.side * at.side;
+        let tile = &sampler.tiles[t as usize];
+        let child_at = |cell: usize| TileAt {
+            level: at.level + 1,
+            ix: cx0 + cell as i64 % n,
+            iy: cy0 + cell as i64 / n,
+            side: at.side / n as f64,
+        };
+        for (cell, points) in tile.sub_cells.iter().enumerate() {
+            if bounds.limit[cell] > big_n {
+                self.emit_run(Run {
+                    points,
+                    limit: bounds.limit[cell],
+                    sure: bounds.low[cell],
+                    offset: 0.0,
+                    owner: child_at(cell),
+                    area,
+                });
+            }
+        }
+        let full = sampler.sub_len as f64;
+        // The cell's bounds in the child's own area units.
+        let cells = (n * n) as f64;
+        for (cell, &child_tile) in tile.children.iter().enumerate() {
+            let lim = bounds.limit[cell];
+            if lim > full {
+                let known = (lim / cells, bounds.low[cell] / cells);
+                self.tile(child_tile, child_at(cell), Some(known));
+            }
+        }
+    }
+
+    /// Emits the points of a run that lie in the query and whose rank the density reaches.
+    fn emit_run(&mut self, run: Run) {
+        let o = run.owner;
+        for cp in run
+            .points
+            .iter()
+            .take_while(|cp| (cp.rank as f64) < run.limit)
+        {
+            let p = DVec2::new(
+                (o.ix as f64 + cp.frac[0]) * o.side,
+                (o.iy as f64 + cp.frac[1]) * o.side,
+            );
+            let rank = cp.rank as f64 + run.offset;
+            if self.rect.contains(p)
+                && (rank < run.sure || sanitize(self.density.density(p)) * run.area > rank)
+            {
+                (self.emit)(Point {
+                    position: p,
+                    id: PointId {
+                        level: o.level as u8,
+                        x: o.ix,
+                        y: o.iy,
+                        index: cp.index,
+                    },
+                    threshold: rank / run.area,
+                    class: 0,
+                });
+            }
+        }
+    }
+}
