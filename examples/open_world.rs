@@ -36,7 +36,7 @@ fn main() {
             FlyCameraPlugin,
         ))
         .add_plugins((RwtPlugin::default(), RwtGizmosPlugin))
-        .add_systems(Startup, setup)
+        .add_systems(Startup, (setup_scene, setup_layers))
         .add_systems(
             Update,
             (
@@ -78,10 +78,10 @@ struct Ground {
 #[derive(Component)]
 struct Water;
 
-fn setup(
+/// The world around the layers: camera, sun, sky light, ground and water.
+fn setup_scene(
     mut commands: Commands,
     terrain: Res<Terrain>,
-    assets: Res<AssetServer>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut gizmos: ResMut<RwtGizmos>,
@@ -144,7 +144,17 @@ fn setup(
         })),
         Transform::from_xyz(0.0, WATER, 0.0),
     ));
+}
 
+/// The meshes and materials of the layers' classes.
+struct Looks {
+    conifer: (Handle<Mesh>, Handle<StandardMaterial>),
+    broadleaf: (Handle<Mesh>, Handle<StandardMaterial>),
+    bush: (Handle<Mesh>, Handle<StandardMaterial>),
+    blade: (Handle<Mesh>, Handle<StandardMaterial>),
+}
+
+fn looks(meshes: &mut Assets<Mesh>, materials: &mut Assets<StandardMaterial>) -> Looks {
     let mut solid = |color: Color| {
         materials.add(StandardMaterial {
             base_color: color,
@@ -173,7 +183,30 @@ fn setup(
     let blade = meshes
         .add(Mesh::from(Cone::new(0.12, 0.9).mesh().resolution(3)).translated_by(Vec3::Y * 0.45));
 
-    // Trees: two classes sharing one blue-noise set, forests from noise.
+    Looks {
+        conifer: (conifer, solid(Color::srgb(0.09, 0.24, 0.12))),
+        broadleaf: (broadleaf, solid(Color::srgb(0.2, 0.36, 0.12))),
+        bush: (bush, solid(Color::srgb(0.3, 0.42, 0.14))),
+        blade: (blade, solid(Color::srgb(0.38, 0.55, 0.2))),
+    }
+}
+
+/// The vegetation: trees, bushes and grass, each a layer streamed by the plugin.
+fn setup_layers(
+    mut commands: Commands,
+    terrain: Res<Terrain>,
+    assets: Res<AssetServer>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let looks = looks(&mut meshes, &mut materials);
+    commands.spawn((Name::new("trees"), trees(&terrain, &looks)));
+    commands.spawn((Name::new("bushes"), bushes(&terrain, &looks, &assets)));
+    commands.spawn((Name::new("grass"), grass(&terrain, &looks)));
+}
+
+/// Trees: two classes sharing one blue-noise set, forests from noise.
+fn trees(terrain: &Terrain, looks: &Looks) -> ScatterLayer {
     let forest = |seed| {
         NoiseDensity::new(NoiseParams {
             seed,
@@ -184,16 +217,16 @@ fn setup(
             scale: 0.012,
         })
     };
-    let trees = ScatterLayer::new(vec![
+    ScatterLayer::new(vec![
         ScatterClass::new(
             LayerDensity::Noise(forest(11)),
-            conifer,
-            solid(Color::srgb(0.09, 0.24, 0.12)),
+            looks.conifer.0.clone(),
+            looks.conifer.1.clone(),
         ),
         ScatterClass::new(
             LayerDensity::Noise(forest(12)),
-            broadleaf,
-            solid(Color::srgb(0.2, 0.36, 0.12)),
+            looks.broadleaf.0.clone(),
+            looks.broadleaf.1.clone(),
         ),
     ])
     .with_seed(1)
@@ -207,19 +240,20 @@ fn setup(
     .with_falloff(500.0, 1800.0)
     .with_height(terrain.source())
     .with_height_range(WATER + 1.0, 120.0)
-    .with_max_slope(0.7);
-    commands.spawn((Name::new("trees"), trees));
+    .with_max_slope(0.7)
+}
 
-    // Bushes: the painted map, 6 km across, up to 0.05 bushes per square metre.
-    let bushes = ScatterLayer::new(vec![ScatterClass::new(
+/// Bushes: the painted map, 6 km across, up to 0.05 bushes per square metre.
+fn bushes(terrain: &Terrain, looks: &Looks, assets: &AssetServer) -> ScatterLayer {
+    ScatterLayer::new(vec![ScatterClass::new(
         LayerDensity::Image {
             image: assets.load("images/meadows.png"),
             min: Vec2::splat(-3000.0),
             size: Vec2::splat(6000.0),
             scale: 0.05,
         },
-        bush,
-        solid(Color::srgb(0.3, 0.42, 0.14)),
+        looks.bush.0.clone(),
+        looks.bush.1.clone(),
     )])
     .with_seed(2)
     .with_tile_size(64.0)
@@ -231,11 +265,12 @@ fn setup(
     })
     .with_falloff(120.0, 500.0)
     .with_height(terrain.source())
-    .with_height_range(WATER + 0.5, 200.0);
-    commands.spawn((Name::new("bushes"), bushes));
+    .with_height_range(WATER + 0.5, 200.0)
+}
 
-    // Grass: dense noise patches close to the camera only.
-    let grass = ScatterLayer::new(vec![ScatterClass::new(
+/// Grass: dense noise patches close to the camera only.
+fn grass(terrain: &Terrain, looks: &Looks) -> ScatterLayer {
+    ScatterLayer::new(vec![ScatterClass::new(
         LayerDensity::Noise(NoiseDensity::new(NoiseParams {
             seed: 3,
             frequency: 1.0 / 120.0,
@@ -244,8 +279,8 @@ fn setup(
             amplitude: 0.9,
             scale: 1.2,
         })),
-        blade,
-        solid(Color::srgb(0.38, 0.55, 0.2)),
+        looks.blade.0.clone(),
+        looks.blade.1.clone(),
     )])
     .with_seed(3)
     .with_tile_size(16.0)
@@ -257,8 +292,7 @@ fn setup(
     })
     .with_falloff(30.0, 120.0)
     .with_height(terrain.source())
-    .with_height_range(WATER + 0.3, 90.0);
-    commands.spawn((Name::new("grass"), grass));
+    .with_height_range(WATER + 0.3, 90.0)
 }
 
 /// The smoke session's flight: 1.5 km along a gentle curve, 22 m above the ground.

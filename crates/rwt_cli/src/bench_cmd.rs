@@ -63,146 +63,177 @@ fn measure<D: Density>(
     (name.to_string(), count, t)
 }
 
+/// What every part of the benchmark shares: one sampler over one square world.
+struct Bench {
+    set: TileSet,
+    sampler: Sampler,
+    /// Side of the world in base tiles.
+    tiles: f64,
+    rect: Rect,
+    runs: usize,
+    /// The uniform density of the throughput table.
+    d_uniform: f64,
+    out: Vec<Point>,
+}
+
 /// `rwt bench`.
 pub fn run(quick: bool) -> Result<(), String> {
-    let set = TileSet::embedded();
-    let runs = if quick { 3 } else { 7 };
     let target = if quick { 400_000.0 } else { 2_000_000.0 };
     // A 32 x 32 tile world at about 1.5 N per tile, which uses levels 0 and 1.
     let tiles = 32.0;
-    let rect = Rect::new(DVec2::ZERO, DVec2::splat(tiles)).map_err(|e| e.to_string())?;
-    let d_uniform = target / (tiles * tiles);
+    let set = TileSet::embedded();
     let sampler = Sampler::new(&set, 1).with_budget(100_000_000);
-    let mut out: Vec<Point> = Vec::with_capacity(target as usize * 2);
-    let map = synthetic_map(1024);
-    let mean_map = map.iter().map(|&v| v as f64).sum::<f64>() / map.len() as f64;
-    let image = {
-        let scale = d_uniform / mean_map;
-        ImageDensity::from_values(1024, 1024, &map, DVec2::ZERO, DVec2::splat(tiles), scale)
-            .map_err(|e| e.to_string())?
+    let mut bench = Bench {
+        set,
+        sampler,
+        tiles,
+        rect: Rect::new(DVec2::ZERO, DVec2::splat(tiles)).map_err(|e| e.to_string())?,
+        runs: if quick { 3 } else { 7 },
+        d_uniform: target / (tiles * tiles),
+        out: Vec::with_capacity(target as usize * 2),
     };
-    let noise = NoiseDensity::new(NoiseParams {
-        seed: 3,
-        frequency: 0.15,
-        octaves: 4,
-        base: 0.5,
-        amplitude: 0.5,
-        scale: 2.0 * d_uniform,
-    });
-    let rows = vec![
-        measure(
-            &sampler,
-            rect,
-            runs,
-            &mut out,
-            "uniform",
-            &Constant(d_uniform),
-        ),
-        measure(&sampler, rect, runs, &mut out, "image (1024^2 map)", &image),
-        measure(
-            &sampler,
-            rect,
-            runs,
-            &mut out,
-            "noise (4-octave fBm)",
-            &noise,
-        ),
-    ];
-    // White-noise floor: hashed random points written to the same output type.
-    let floor_count = rows[0].1;
-    let floor = best_time(runs, || {
-        out.clear();
-        rwt_core::bench::white_noise_floor(floor_count, tiles, &mut out);
-        black_box(&out);
-    });
-    let floor_rate = floor_count as f64 / floor;
-    say!(
-        "one thread, best of {} runs each, {}x{} base tiles of {} points",
-        runs,
-        tiles,
-        tiles,
-        set.points_per_tile
-    );
-    say!(
-        "{:<24} {:>10} {:>12} {:>14} {:>12}",
-        "density",
-        "points",
-        "ms",
-        "M points/s",
-        "floor / this"
-    );
-    for (name, count, t) in &rows {
-        let rate = *count as f64 / t;
+    let uniform_time = bench.throughput()?;
+    bench.against_bridson(if quick { 50_000.0 } else { 200_000.0 });
+    bench.scaling(uniform_time)
+}
+
+impl Bench {
+    /// Times one density over the whole world: `(name, points, seconds)`.
+    fn measure<D: Density>(&mut self, name: &str, d: &D) -> (String, usize, f64) {
+        measure(&self.sampler, self.rect, self.runs, &mut self.out, name, d)
+    }
+
+    /// Uniform, image and noise densities against the white-noise floor; returns the time
+    /// of the uniform query.
+    fn throughput(&mut self) -> Result<f64, String> {
+        let (tiles, d_uniform) = (self.tiles, self.d_uniform);
+        let map = synthetic_map(1024);
+        let mean_map = map.iter().map(|&v| v as f64).sum::<f64>() / map.len() as f64;
+        let scale = d_uniform / mean_map;
+        let image =
+            ImageDensity::from_values(1024, 1024, &map, DVec2::ZERO, DVec2::splat(tiles), scale)
+                .map_err(|e| e.to_string())?;
+        let noise = NoiseDensity::new(NoiseParams {
+            seed: 3,
+            frequency: 0.15,
+            octaves: 4,
+            base: 0.5,
+            amplitude: 0.5,
+            scale: 2.0 * d_uniform,
+        });
+        let rows = vec![
+            self.measure("uniform", &Constant(d_uniform)),
+            self.measure("image (1024^2 map)", &image),
+            self.measure("noise (4-octave fBm)", &noise),
+        ];
+        // White-noise floor: hashed random points written to the same output type.
+        let floor_count = rows[0].1;
+        let out = &mut self.out;
+        let floor = best_time(self.runs, || {
+            out.clear();
+            rwt_core::bench::white_noise_floor(floor_count, tiles, out);
+            black_box(&out);
+        });
+        self.print_throughput(&rows, floor_count, floor);
+        Ok(rows[0].2)
+    }
+
+    fn print_throughput(&self, rows: &[(String, usize, f64)], floor_count: usize, floor: f64) {
+        let floor_rate = floor_count as f64 / floor;
         say!(
-            "{name:<24} {count:>10} {:>12.2} {:>14.1} {:>12.2}",
-            t * 1e3,
-            rate / 1e6,
-            floor_rate / rate
+            "one thread, best of {} runs each, {}x{} base tiles of {} points",
+            self.runs,
+            self.tiles,
+            self.tiles,
+            self.set.points_per_tile
+        );
+        say!(
+            "{:<24} {:>10} {:>12} {:>14} {:>12}",
+            "density",
+            "points",
+            "ms",
+            "M points/s",
+            "floor / this"
+        );
+        for (name, count, t) in rows {
+            let rate = *count as f64 / t;
+            say!(
+                "{name:<24} {count:>10} {:>12.2} {:>14.1} {:>12.2}",
+                t * 1e3,
+                rate / 1e6,
+                floor_rate / rate
+            );
+        }
+        say!(
+            "{:<24} {floor_count:>10} {:>12.2} {:>14.1} {:>12}",
+            "white-noise floor",
+            floor * 1e3,
+            floor_rate / 1e6,
+            "1.00"
         );
     }
-    say!(
-        "{:<24} {floor_count:>10} {:>12.2} {:>14.1} {:>12}",
-        "white-noise floor",
-        floor * 1e3,
-        floor_rate / 1e6,
-        "1.00"
-    );
 
-    // Bridson (fast_poisson) and this at the same number of points (Bridson is slow enough
-    // that the full-size count would dominate the run).
-    let n_target = if quick { 50_000.0 } else { 200_000.0 };
-    let radius = (0.69 * tiles * tiles / n_target).sqrt();
-    let mut bridson_count = 0;
-    let bridson = best_time(1, || {
-        let pts = Poisson2D::new()
-            .with_dimensions([tiles, tiles], radius)
-            .with_seed(1)
-            .generate();
-        bridson_count = pts.len();
-        black_box(pts);
-    });
-    let same = Constant(bridson_count as f64 / (tiles * tiles));
-    let (_, ours_count, ours_time) = measure(&sampler, rect, runs, &mut out, "", &same);
-    let ours_rate = ours_count as f64 / ours_time;
-    let bridson_rate = bridson_count as f64 / bridson;
-    say!(
-        "fast_poisson (Bridson)   {bridson_count:>10} {:>12.2} {:>14.3}   this, {ours_count} points: {:.2} ms, {:.0}x faster",
-        bridson * 1e3,
-        bridson_rate / 1e6,
-        ours_time * 1e3,
-        ours_rate / bridson_rate
-    );
+    /// Bridson (fast_poisson) and this at the same number of points (Bridson is slow enough
+    /// that the full-size count would dominate the run).
+    fn against_bridson(&mut self, n_target: f64) {
+        let tiles = self.tiles;
+        let radius = (0.69 * tiles * tiles / n_target).sqrt();
+        let mut bridson_count = 0;
+        let bridson = best_time(1, || {
+            let pts = Poisson2D::new()
+                .with_dimensions([tiles, tiles], radius)
+                .with_seed(1)
+                .generate();
+            bridson_count = pts.len();
+            black_box(pts);
+        });
+        let same = Constant(bridson_count as f64 / (tiles * tiles));
+        let (_, ours_count, ours_time) = self.measure("", &same);
+        let ours_rate = ours_count as f64 / ours_time;
+        let bridson_rate = bridson_count as f64 / bridson;
+        say!(
+            "fast_poisson (Bridson)   {bridson_count:>10} {:>12.2} {:>14.3}   this, {ours_count} points: {:.2} ms, {:.0}x faster",
+            bridson * 1e3,
+            bridson_rate / 1e6,
+            ours_time * 1e3,
+            ours_rate / bridson_rate
+        );
+    }
 
-    // Cost against area and density.
-    let time_of = |r: Rect, d: f64| {
-        let mut o: Vec<Point> = Vec::with_capacity((d * r.area() * 1.1) as usize);
-        best_time(runs, || {
-            o.clear();
-            black_box(sampler.query(r, &Constant(d), &mut o).ok());
-        })
-    };
-    let half = Rect::new(DVec2::ZERO, DVec2::new(tiles / 2.0, tiles)).map_err(|e| e.to_string())?;
-    let t_half = time_of(half, d_uniform);
-    let t_full = time_of(rect, d_uniform);
-    // Density doubling inside one subdivision level (3 N to 6 N per tile), on the half area.
-    let level_one = 3.0 * set.points_per_tile as f64;
-    let t_single = time_of(half, level_one);
-    let t_double = time_of(half, 2.0 * level_one);
-    let t_zero = best_time(runs, || {
-        black_box(sampler.query(rect, &Constant(0.0), &mut Vec::new()).ok());
-    });
-    say!(
-        "cost x area:    doubling the area takes {:.2}x the time",
-        t_full / t_half
-    );
-    say!(
-        "cost x density: doubling the density (3 N to 6 N per tile) takes {:.2}x the time",
-        t_double / t_single
-    );
-    say!(
-        "all-zero density over the whole world: {:.3} ms ({:.4} of the uniform query)",
-        t_zero * 1e3,
-        t_zero / rows[0].2
-    );
-    Ok(())
+    /// Cost against area and density, and of an all-zero density.
+    fn scaling(&self, uniform_time: f64) -> Result<(), String> {
+        let (sampler, runs, tiles, rect) = (&self.sampler, self.runs, self.tiles, self.rect);
+        let time_of = |r: Rect, d: f64| {
+            let mut o: Vec<Point> = Vec::with_capacity((d * r.area() * 1.1) as usize);
+            best_time(runs, || {
+                o.clear();
+                black_box(sampler.query(r, &Constant(d), &mut o).ok());
+            })
+        };
+        let half =
+            Rect::new(DVec2::ZERO, DVec2::new(tiles / 2.0, tiles)).map_err(|e| e.to_string())?;
+        let t_half = time_of(half, self.d_uniform);
+        let t_full = time_of(rect, self.d_uniform);
+        // Density doubling inside one subdivision level (3 N to 6 N per tile), on the half area.
+        let level_one = 3.0 * self.set.points_per_tile as f64;
+        let t_single = time_of(half, level_one);
+        let t_double = time_of(half, 2.0 * level_one);
+        let t_zero = best_time(runs, || {
+            black_box(sampler.query(rect, &Constant(0.0), &mut Vec::new()).ok());
+        });
+        say!(
+            "cost x area:    doubling the area takes {:.2}x the time",
+            t_full / t_half
+        );
+        say!(
+            "cost x density: doubling the density (3 N to 6 N per tile) takes {:.2}x the time",
+            t_double / t_single
+        );
+        say!(
+            "all-zero density over the whole world: {:.3} ms ({:.4} of the uniform query)",
+            t_zero * 1e3,
+            t_zero / uniform_time
+        );
+        Ok(())
+    }
 }

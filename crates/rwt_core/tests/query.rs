@@ -455,8 +455,8 @@ fn sparse_densities_give_their_integral_not_one_point_per_tile() {
 
 #[test]
 fn huge_sparse_or_thin_queries_are_refused_not_walked() {
-    // Found by the never-panics property in CI: a rectangle 10^11 tiles wide at a density
-    // whose integral fits the budget used to visit every one of its 10^22 tiles.
+    // A rectangle 10^11 tiles wide at a density whose integral fits the budget, yet whose
+    // traversal would visit every one of its 10^22 tiles: refused by the work bound.
     let s = sampler(1).with_budget(100_000);
     let huge = Rect::new(DVec2::splat(-5.0e10), DVec2::splat(5.0e10)).unwrap();
     let e = s.query(huge, &Constant(1.0e-18), &mut Vec::new());

@@ -101,8 +101,12 @@ pub fn relax(
     let big_n = points[0].len();
     let tiles = points.len();
     let hex = crate::geometry::hex_spacing(big_n as f64);
-    let r_min = min_spacing * hex;
-    let sub_spacing = 1.0 / (n as f64 * (big_n as f64).sqrt());
+    let setup = PassSetup {
+        neighbours,
+        r_min: min_spacing * hex,
+        hex,
+        sub_spacing: 1.0 / (n as f64 * (big_n as f64).sqrt()),
+    };
     let original = points.clone();
     let mut residual = 0.0f64;
     let mut partner: Vec<Vec<(u16, u16)>> = vec![vec![(0, 0); big_n]; tiles];
@@ -110,115 +114,28 @@ pub fn relax(
     let mut stable_passes = 0;
     let mut failed: Vec<(usize, usize)> = Vec::new();
     let mut worst_clearance = f64::INFINITY;
-    let mut candidates: Vec<(f64, u32)> = Vec::new();
     for it in 0..=iterations {
-        let subs: Vec<Vec<(DVec2, u16, u16)>> = (0..tiles)
-            .into_par_iter()
-            .map(|t| subdivision_points(&points, &children[t], n))
-            .collect();
-        let sub_grids: Vec<BucketGrid> = subs
-            .par_iter()
-            .map(|sub| {
-                let mut g = BucketGrid::new(DVec2::ZERO, DVec2::ONE, sub_spacing);
-                for (j, s) in sub.iter().enumerate() {
-                    g.insert(s.0, j as u32);
-                }
-                g
-            })
-            .collect();
+        let subs = Subdivisions::new(&points, children, n, setup.sub_spacing);
         if it == iterations || stable_passes >= 2 {
-            // Measure how far the pairing is from exact, then stop.
-            residual = 0.0;
-            for t in 0..tiles {
-                for k in 0..big_n {
-                    let (cell, kk) = partner[t][k];
-                    let s = subs[t][cell as usize * big_n + kk as usize].0;
-                    residual = residual.max((s - points[t][k]).length());
-                }
-            }
+            residual = subs.residual(&partner, &points);
             break;
         }
-        let previous = partner.clone();
-        let mut chosen = Placed::new(tiles, r_min);
-        let mut used: Vec<Vec<bool>> = subs.iter().map(|s| vec![false; s.len()]).collect();
-        let mut next = points.clone();
-        let mut was_failed = vec![vec![false; big_n]; tiles];
-        for &(t, k) in &failed {
-            was_failed[t][k] = true;
-        }
-        let order: Vec<(usize, usize)> = failed
-            .iter()
-            .copied()
-            .chain(
-                (0..big_n)
-                    .flat_map(|k| (0..tiles).map(move |t| (t, k)))
-                    .filter(|&(t, k)| !was_failed[t][k]),
-            )
-            .collect();
-        let mut failed_now = Vec::new();
-        worst_clearance = f64::INFINITY;
-        for (t, k) in order {
-            let p = points[t][k];
-            let clearance = |s: DVec2| chosen.clearance(neighbours, t, s, r_min);
-            let mut pick = None;
-            let mut best = (-1.0f64, 0u32);
-            for count in [NEAR_CANDIDATES, FAR_CANDIDATES] {
-                gather(
-                    p,
-                    count,
-                    &sub_grids[t],
-                    &subs[t],
-                    &used[t],
-                    1.5 * sub_spacing,
-                    &mut candidates,
-                );
-                for &(_, j) in &candidates {
-                    let c = clearance(subs[t][j as usize].0);
-                    if c >= r_min {
-                        pick = Some(j);
-                        break;
-                    }
-                    if c > best.0 {
-                        best = (c, j);
-                    }
-                }
-                if pick.is_some() {
-                    break;
-                }
-            }
-            if pick.is_none() {
-                failed_now.push((t, k));
-                worst_clearance = worst_clearance.min(best.0 / hex);
-            }
-            let j = pick.unwrap_or(best.1) as usize;
-            used[t][j] = true;
-            let (s, cell, kk) = subs[t][j];
-            partner[t][k] = (cell, kk);
-            next[t][k] = s;
-            chosen.insert(t, s);
-        }
-        stable_passes = if partner == previous {
+        let pass = setup.pass(&points, &subs, &failed);
+        stable_passes = if pass.partner == partner {
             stable_passes + 1
         } else {
             0
         };
-        failed = failed_now;
-        points = next;
+        (partner, points, failed) = (pass.partner, pass.points, pass.failed);
+        worst_clearance = pass.worst_clearance;
         on_iteration();
     }
     let positions = snap(&points, &partner, children, n);
-    let mut max_shift = 0.0f64;
-    for (t, tile) in positions.iter().enumerate() {
-        for (k, p) in tile.iter().enumerate() {
-            let q = DVec2::new(p[0] as f64, p[1] as f64) / crate::tileset::FIXED_ONE;
-            max_shift = max_shift.max((q - original[t][k]).length() / hex);
-        }
-    }
     Relaxed {
+        max_shift: max_shift(&positions, &original, hex),
         positions,
         partner,
         residual,
-        max_shift,
         crowded: failed.len(),
         crowded_clearance: if failed.is_empty() {
             min_spacing
@@ -226,6 +143,165 @@ pub fn relax(
             worst_clearance
         },
     }
+}
+
+/// Every tile's subdivision points at the current positions, with a grid over each.
+struct Subdivisions {
+    points: Vec<Vec<(DVec2, u16, u16)>>,
+    grids: Vec<BucketGrid>,
+}
+
+impl Subdivisions {
+    fn new(points: &[Vec<DVec2>], children: &[Vec<u16>], n: usize, spacing: f64) -> Self {
+        let subs: Vec<Vec<(DVec2, u16, u16)>> = (0..points.len())
+            .into_par_iter()
+            .map(|t| subdivision_points(points, &children[t], n))
+            .collect();
+        let grids = subs
+            .par_iter()
+            .map(|sub| {
+                let mut g = BucketGrid::new(DVec2::ZERO, DVec2::ONE, spacing);
+                for (j, s) in sub.iter().enumerate() {
+                    g.insert(s.0, j as u32);
+                }
+                g
+            })
+            .collect();
+        Self {
+            points: subs,
+            grids,
+        }
+    }
+
+    /// How far the pairing is from exact: the largest base-to-partner distance.
+    fn residual(&self, partner: &[Vec<(u16, u16)>], points: &[Vec<DVec2>]) -> f64 {
+        let big_n = points[0].len();
+        let mut residual = 0.0f64;
+        for (t, tile) in points.iter().enumerate() {
+            for (k, p) in tile.iter().enumerate() {
+                let (cell, kk) = partner[t][k];
+                let s = self.points[t][cell as usize * big_n + kk as usize].0;
+                residual = residual.max((s - *p).length());
+            }
+        }
+        residual
+    }
+}
+
+/// What every pass shares.
+struct PassSetup<'a> {
+    neighbours: &'a Neighbours,
+    /// Clearance asked of every pick.
+    r_min: f64,
+    /// Hexagonal spacing of `N` points.
+    hex: f64,
+    /// Spacing of the subdivision points.
+    sub_spacing: f64,
+}
+
+/// The result of one pass: the pairing, the moved points, the points without room.
+struct Pass {
+    partner: Vec<Vec<(u16, u16)>>,
+    points: Vec<Vec<DVec2>>,
+    failed: Vec<(usize, usize)>,
+    /// Smallest clearance among the failed points, in hexagonal spacings.
+    worst_clearance: f64,
+}
+
+/// Points in the order a pass places them: last pass's failures first, then the rest in
+/// progressive order with all tiles interleaved.
+fn placement_order(failed: &[(usize, usize)], tiles: usize, big_n: usize) -> Vec<(usize, usize)> {
+    let mut was_failed = vec![vec![false; big_n]; tiles];
+    for &(t, k) in failed {
+        was_failed[t][k] = true;
+    }
+    failed
+        .iter()
+        .copied()
+        .chain(
+            (0..big_n)
+                .flat_map(|k| (0..tiles).map(move |t| (t, k)))
+                .filter(|&(t, k)| !was_failed[t][k]),
+        )
+        .collect()
+}
+
+impl PassSetup<'_> {
+    /// One pass: every base point moves onto a distinct nearby subdivision point.
+    fn pass(&self, points: &[Vec<DVec2>], subs: &Subdivisions, failed: &[(usize, usize)]) -> Pass {
+        let (tiles, big_n) = (points.len(), points[0].len());
+        let mut chosen = Placed::new(tiles, self.r_min);
+        let mut used: Vec<Vec<bool>> = subs.points.iter().map(|s| vec![false; s.len()]).collect();
+        let mut out = Pass {
+            partner: vec![vec![(0, 0); big_n]; tiles],
+            points: points.to_vec(),
+            failed: Vec::new(),
+            worst_clearance: f64::INFINITY,
+        };
+        let mut candidates: Vec<(f64, u32)> = Vec::new();
+        for (t, k) in placement_order(failed, tiles, big_n) {
+            let (pick, best) = self.pick(t, points[t][k], subs, &used[t], &chosen, &mut candidates);
+            if pick.is_none() {
+                out.failed.push((t, k));
+                out.worst_clearance = out.worst_clearance.min(best.0 / self.hex);
+            }
+            let j = pick.unwrap_or(best.1) as usize;
+            used[t][j] = true;
+            let (s, cell, kk) = subs.points[t][j];
+            out.partner[t][k] = (cell, kk);
+            out.points[t][k] = s;
+            chosen.insert(t, s);
+        }
+        out
+    }
+
+    /// The nearest unused subdivision point of tile `t` with the requested clearance from
+    /// the points placed so far, if any, and the one with the most clearance.
+    fn pick(
+        &self,
+        t: usize,
+        p: DVec2,
+        subs: &Subdivisions,
+        used: &[bool],
+        chosen: &Placed,
+        candidates: &mut Vec<(f64, u32)>,
+    ) -> (Option<u32>, (f64, u32)) {
+        let mut best = (-1.0f64, 0u32);
+        for count in [NEAR_CANDIDATES, FAR_CANDIDATES] {
+            let (grid, sub) = (&subs.grids[t], &subs.points[t]);
+            gather(
+                p,
+                count,
+                grid,
+                sub,
+                used,
+                1.5 * self.sub_spacing,
+                candidates,
+            );
+            for &(_, j) in candidates.iter() {
+                let c = chosen.clearance(self.neighbours, t, sub[j as usize].0, self.r_min);
+                if c >= self.r_min {
+                    return (Some(j), best);
+                }
+                if c > best.0 {
+                    best = (c, j);
+                }
+            }
+        }
+        (None, best)
+    }
+}
+
+/// Largest distance a point moved, in hexagonal spacings.
+fn max_shift(positions: &[Vec<[u32; 2]>], original: &[Vec<DVec2>], hex: f64) -> f64 {
+    let mut max_shift = 0.0f64;
+    for (t, tile) in positions.iter().enumerate() {
+        for (k, p) in tile.iter().enumerate() {
+            let q = DVec2::new(p[0] as f64, p[1] as f64) / crate::tileset::FIXED_ONE;
+            max_shift = max_shift.max((q - original[t][k]).length() / hex);
+        }
+    }
+    max_shift
 }
 
 /// Solves `X_t[k] = floor((cell_offset * 2^32 + X_c[k']) / n)` for all points exactly.

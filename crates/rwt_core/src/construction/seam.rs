@@ -158,7 +158,25 @@ pub fn seam_path(points: &[SourcedPoint], side: Side, strip: f64) -> Vec<DVec2> 
     let inner = |c: DVec2| DVec2::new(c.x.clamp(lo, hi), c.y.clamp(lo, hi));
     let (start_in, end_in) = (inner(start_corner), inner(end_corner));
     let fallback = vec![start_corner, start_in, end_in, end_corner];
+    let Ok(tri) = DelaunayTriangulation::<Site>::bulk_load(toroidal_sites(points)) else {
+        return fallback;
+    };
+    let spacing = crate::geometry::hex_spacing(points.len() as f64 / 2.0);
+    let mut graph = voronoi_graph(&tri, lo, hi, spacing);
+    let start = graph.add_corner(start_in, lo, hi, 3.0 * spacing);
+    let end = graph.add_corner(end_in, lo, hi, 3.0 * spacing);
+    let Some(inner_path) = graph.shortest_path(start, end) else {
+        return fallback;
+    };
+    let mut path = vec![start_corner];
+    path.extend(inner_path);
+    path.push(end_corner);
+    path
+}
 
+/// The points and their copies one tile over, within a margin of the tile: a toroidal
+/// margin keeps the Voronoi cells at the border bounded.
+fn toroidal_sites(points: &[SourcedPoint]) -> Vec<Site> {
     const MARGIN: f64 = 0.12;
     let mut sites = Vec::with_capacity(points.len() * 2);
     for p in points {
@@ -173,15 +191,19 @@ pub fn seam_path(points: &[SourcedPoint], side: Side, strip: f64) -> Vec<DVec2> 
             }
         }
     }
-    let Ok(tri) = DelaunayTriangulation::<Site>::bulk_load(sites) else {
-        return fallback;
-    };
+    sites
+}
 
-    // Graph nodes: Voronoi vertices inside the inner square (by face), clip points on its
-    // border, and the two inner corners the seam must join.
-    let mut nodes: Vec<DVec2> = Vec::new();
-    let mut face_node: Vec<Option<usize>> = vec![None; tri.num_all_faces()];
-    let mut edges: Vec<(usize, usize, f64)> = Vec::new();
+/// The graph a seam runs on: Voronoi vertices inside the inner square (one node per
+/// Delaunay face), clip points on its border, and the inner corners the seam joins.
+struct SeamGraph {
+    nodes: Vec<DVec2>,
+    edges: Vec<(usize, usize, f64)>,
+}
+
+/// The Voronoi edges clipped to the inner square `[lo, hi]^2`, each costing
+/// `(1 - d/d_max)^r` (`d` the distance between the sites it separates) plus its length.
+fn voronoi_graph(tri: &DelaunayTriangulation<Site>, lo: f64, hi: f64, spacing: f64) -> SeamGraph {
     let mut raw: Vec<ClippedEdge> = Vec::new();
     let mut d_max = 0.0f64;
     for e in tri.undirected_edges() {
@@ -191,8 +213,7 @@ pub fn seam_path(points: &[SourcedPoint], side: Side, strip: f64) -> Vec<DVec2> 
         };
         let [pa, pb] = e.positions();
         let d = DVec2::new(pa.x - pb.x, pa.y - pb.y).length();
-        let c0 = f0.circumcenter();
-        let c1 = f1.circumcenter();
+        let (c0, c1) = (f0.circumcenter(), f1.circumcenter());
         let (c0, c1) = (DVec2::new(c0.x, c0.y), DVec2::new(c1.x, c1.y));
         let Some((a, b)) = clip(c0, c1, lo, hi) else {
             continue;
@@ -202,6 +223,11 @@ pub fn seam_path(points: &[SourcedPoint], side: Side, strip: f64) -> Vec<DVec2> 
         let b_inner = (b == c1).then_some(f1.fix().index());
         raw.push((a, b, a_inner, b_inner, d));
     }
+    let mut graph = SeamGraph {
+        nodes: Vec::new(),
+        edges: Vec::new(),
+    };
+    let mut face_node: Vec<Option<usize>> = vec![None; tri.num_all_faces()];
     let mut node_at = |p: DVec2, face: Option<usize>, nodes: &mut Vec<DVec2>| -> usize {
         if let Some(f) = face {
             if let Some(n) = face_node[f] {
@@ -214,88 +240,95 @@ pub fn seam_path(points: &[SourcedPoint], side: Side, strip: f64) -> Vec<DVec2> 
         }
         nodes.len() - 1
     };
-    let spacing = crate::geometry::hex_spacing(points.len() as f64 / 2.0);
     for &(a, b, fa, fb, d) in &raw {
-        let na = node_at(a, fa, &mut nodes);
-        let nb = node_at(b, fb, &mut nodes);
+        let na = node_at(a, fa, &mut graph.nodes);
+        let nb = node_at(b, fb, &mut graph.nodes);
         let mut cost = 1.0;
         let base = 1.0 - d / d_max;
         for _ in 0..SEAM_EXPONENT {
             cost *= base;
         }
-        edges.push((na, nb, cost + SEAM_LENGTH_COST * (b - a).length() / spacing));
+        graph
+            .edges
+            .push((na, nb, cost + SEAM_LENGTH_COST * (b - a).length() / spacing));
     }
-    nodes.push(start_in);
-    let start = nodes.len() - 1;
-    nodes.push(end_in);
-    let end = nodes.len() - 1;
-    // Along the inner square's border the seam may only hop from an inner corner to the
-    // first Voronoi edges next to it: running along the border separates nothing.
-    // A few point spacings: two hops must never meet, or the seam would skip the diagram.
-    let reach = 3.0 * crate::geometry::hex_spacing(points.len() as f64 / 2.0);
-    let on_border = |p: DVec2| {
-        const EPS: f64 = 1e-12;
-        (p.x - lo).abs() < EPS
-            || (p.x - hi).abs() < EPS
-            || (p.y - lo).abs() < EPS
-            || (p.y - hi).abs() < EPS
-    };
-    for corner in [start, end] {
-        let c = nodes[corner];
-        for (i, &p) in nodes.iter().enumerate() {
+    graph
+}
+
+impl SeamGraph {
+    /// Adds an inner corner of the square. Along the square's border the seam may only hop
+    /// from a corner to the first Voronoi edges next to it, within `reach` (a few point
+    /// spacings: two hops must never meet, or the seam would skip the diagram); running
+    /// along the border separates nothing.
+    fn add_corner(&mut self, c: DVec2, lo: f64, hi: f64, reach: f64) -> usize {
+        self.nodes.push(c);
+        let corner = self.nodes.len() - 1;
+        let on_border = |p: DVec2| {
+            const EPS: f64 = 1e-12;
+            (p.x - lo).abs() < EPS
+                || (p.x - hi).abs() < EPS
+                || (p.y - lo).abs() < EPS
+                || (p.y - hi).abs() < EPS
+        };
+        let mut hops = Vec::new();
+        for (i, &p) in self.nodes.iter().enumerate() {
             let same_line = (p.x - c.x).abs() < 1e-12 || (p.y - c.y).abs() < 1e-12;
             if i != corner && on_border(p) && same_line && (p - c).length() < reach {
-                edges.push((corner, i, 1.0));
+                hops.push((corner, i, 1.0));
             }
         }
+        self.edges.extend(hops);
+        corner
     }
 
-    let mut adjacency: Vec<Vec<(usize, f64)>> = vec![Vec::new(); nodes.len()];
-    for &(a, b, c) in &edges {
-        if a != b {
-            adjacency[a].push((b, c));
-            adjacency[b].push((a, c));
-        }
-    }
-    let mut dist = vec![f64::INFINITY; nodes.len()];
-    let mut prev = vec![usize::MAX; nodes.len()];
-    let mut heap = BinaryHeap::new();
-    dist[start] = 0.0;
-    heap.push(State {
-        cost: 0.0,
-        node: start,
-    });
-    while let Some(State { cost, node }) = heap.pop() {
-        if node == end {
-            break;
-        }
-        if cost > dist[node] {
-            continue;
-        }
-        for &(next, c) in &adjacency[node] {
-            let nc = cost + c;
-            if nc < dist[next] {
-                dist[next] = nc;
-                prev[next] = node;
-                heap.push(State {
-                    cost: nc,
-                    node: next,
-                });
+    /// The cheapest path from `start` to `end` (Dijkstra), as node positions.
+    fn shortest_path(&self, start: usize, end: usize) -> Option<Vec<DVec2>> {
+        let mut adjacency: Vec<Vec<(usize, f64)>> = vec![Vec::new(); self.nodes.len()];
+        for &(a, b, c) in &self.edges {
+            if a != b {
+                adjacency[a].push((b, c));
+                adjacency[b].push((a, c));
             }
         }
+        let mut dist = vec![f64::INFINITY; self.nodes.len()];
+        let mut prev = vec![usize::MAX; self.nodes.len()];
+        let mut heap = BinaryHeap::new();
+        dist[start] = 0.0;
+        heap.push(State {
+            cost: 0.0,
+            node: start,
+        });
+        while let Some(State { cost, node }) = heap.pop() {
+            if node == end {
+                break;
+            }
+            if cost > dist[node] {
+                continue;
+            }
+            for &(next, c) in &adjacency[node] {
+                let nc = cost + c;
+                if nc < dist[next] {
+                    dist[next] = nc;
+                    prev[next] = node;
+                    heap.push(State {
+                        cost: nc,
+                        node: next,
+                    });
+                }
+            }
+        }
+        if !dist[end].is_finite() {
+            return None;
+        }
+        let mut path = vec![self.nodes[end]];
+        let mut at = end;
+        while at != start {
+            at = prev[at];
+            path.push(self.nodes[at]);
+        }
+        path.reverse();
+        Some(path)
     }
-    if !dist[end].is_finite() {
-        return fallback;
-    }
-    let mut path = vec![end_corner, nodes[end]];
-    let mut at = end;
-    while at != start {
-        at = prev[at];
-        path.push(nodes[at]);
-    }
-    path.push(start_corner);
-    path.reverse();
-    path
 }
 
 #[cfg(test)]
