@@ -1,7 +1,8 @@
 //! Texton painting (paper figure 10): paint a density map per texton class and watch the
 //! textons appear as one blue-noise set shared by all classes, each with a rotation hashed
-//! from its point's identity. Repainting re-queries only the brushed region, so textons
-//! elsewhere never move.
+//! from its point's identity. The maps are Bevy images read by one `bevy_rwt` layer on the
+//! 2-D plane: a stroke tells the plugin its region (`DensityMapPainted`), so only the
+//! chunks under it re-scatter and textons elsewhere never move.
 //!
 //! `cargo run --release --example paint_density`
 //! - left mouse: paint the selected class, right mouse: erase it; 1-4 select the class,
@@ -10,29 +11,34 @@
 //! - S saves the maps (PNG) and the setup (RON) to `painted/` (or `RWT_PAINT_DIR`), L loads.
 
 use bevy::asset::RenderAssetUsages;
+use bevy::camera::ScalingMode;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use bevy_rwt::prelude::*;
 use glam::DVec2;
-use rwt_core::density::ImageDensity;
-use rwt_core::query::{PointId, Rect, Sampler};
+use rwt_core::query::Rect;
 use rwt_core::rng::{hash_words, unit_f64};
-use rwt_core::tileset::TileSet;
 use rwt_examples::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 fn main() {
     App::new()
         .insert_resource(ClearColor(Color::srgb(0.93, 0.91, 0.85)))
-        .add_plugins((example_plugins("rwt paint_density"), SmokePlugin, HudPlugin))
+        .add_plugins((
+            example_plugins("rwt paint_density"),
+            RwtPlugin::default().with_spawn_budget(20_000),
+            SmokePlugin,
+            HudPlugin,
+        ))
         .add_systems(Startup, setup)
         .add_systems(
             Update,
             (
                 paint_script.run_if(|s: Res<Smoke>| s.active()),
                 paint_input.run_if(|s: Res<Smoke>| !s.active()),
-                place,
+                upload_maps,
+                compare_with_random,
                 show_maps,
                 hud,
             )
@@ -89,16 +95,18 @@ impl Default for PaintSetup {
 #[derive(Resource)]
 struct Canvas {
     setup: PaintSetup,
-    /// One map per class, row 0 at the top, values in [0, 1].
+    /// One map per class, row 0 at the top, values in [0, 1]; uploaded to `images`.
     maps: Vec<Vec<f32>>,
-    /// World rectangle painted since the last placement.
+    /// The Bevy images the layer reads, one per class.
+    images: Vec<Handle<Image>>,
+    /// World rectangle painted since the last upload.
     dirty: Option<Rect>,
     /// Show white-noise placement instead of blue noise.
     random: bool,
-    sampler: Sampler,
     textures: Vec<Handle<Image>>,
     overlay: Handle<Image>,
-    live: HashMap<PointId, (Entity, u16, DVec2)>,
+    /// The entity holding the texton layer.
+    layer: Entity,
     random_live: Vec<Entity>,
     status: String,
 }
@@ -149,24 +157,44 @@ impl Canvas {
         });
     }
 
-    fn densities(&self) -> Vec<ImageDensity> {
-        let n = self.setup.map_size;
-        self.setup
+    /// The layer: one class per texton, each reading its map over the unit canvas on the
+    /// 2-D plane, with a rotation and a size hashed from each point's identity.
+    fn layer(&self) -> ScatterLayer {
+        let classes = self
+            .setup
             .classes
             .iter()
-            .zip(&self.maps)
-            .filter_map(|(c, map)| {
-                ImageDensity::from_values(
-                    n as u32,
-                    n as u32,
-                    map,
-                    DVec2::ZERO,
-                    DVec2::ONE,
-                    c.max_density,
-                )
-                .ok()
+            .zip(&self.images)
+            .zip(&self.textures)
+            .map(|((c, map), texture)| {
+                let density = LayerDensity::Image {
+                    image: map.clone(),
+                    min: Vec2::ZERO,
+                    size: Vec2::ONE,
+                    scale: c.max_density,
+                };
+                let sprite = Sprite {
+                    image: texture.clone(),
+                    custom_size: Some(Vec2::splat((c.size as f64 / c.max_density.sqrt()) as f32)),
+                    ..default()
+                };
+                let mut class = ScatterClass::custom(density, move |e| {
+                    e.insert(sprite.clone());
+                });
+                class.scale_variation = 0.15;
+                class
             })
-            .collect()
+            .collect();
+        ScatterLayer::new(classes)
+            .on_plane(GroundPlane::Xy)
+            .with_seed(self.setup.seed)
+            .with_tile_size(1.0)
+            .with_streaming(StreamingConfig {
+                chunk_size: 0.125,
+                load_distance: 2.0,
+                unload_distance: 3.0,
+                near_distance: 2.0,
+            })
     }
 
     fn save(&self, dir: &Path) -> Result<(), String> {
@@ -206,7 +234,6 @@ impl Canvas {
         }
         self.setup = setup;
         self.maps = maps;
-        self.sampler = Sampler::new(&TileSet::embedded(), self.setup.seed);
         self.dirty = Some(whole());
         Ok(())
     }
@@ -239,6 +266,21 @@ fn save_dir() -> PathBuf {
     std::env::var_os("RWT_PAINT_DIR").map_or_else(|| PathBuf::from("painted"), PathBuf::from)
 }
 
+/// A `n x n` single-channel image for a class map.
+fn map_image(n: usize) -> Image {
+    Image::new_fill(
+        Extent3d {
+            width: n as u32,
+            height: n as u32,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        &[0],
+        TextureFormat::R8Unorm,
+        RenderAssetUsages::default(),
+    )
+}
+
 fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<Assets<Image>>) {
     let setup = PaintSetup::default();
     let n = setup.map_size;
@@ -247,30 +289,29 @@ fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<As
         .iter()
         .map(|c| assets.load(format!("textons/{}", c.texton)))
         .collect();
-    let overlay = images.add(Image::new_fill(
-        Extent3d {
-            width: n as u32,
-            height: n as u32,
-            depth_or_array_layers: 1,
-        },
-        TextureDimension::D2,
-        &[255, 255, 255, 255],
-        TextureFormat::Rgba8UnormSrgb,
-        RenderAssetUsages::default(),
-    ));
+    let maps = setup
+        .classes
+        .iter()
+        .map(|_| images.add(map_image(n)))
+        .collect();
+    let mut overlay = map_image(n);
+    overlay.texture_descriptor.format = TextureFormat::Rgba8UnormSrgb;
+    overlay.data = Some(vec![255; n * n * 4]);
+    let overlay = images.add(overlay);
     let mut canvas = Canvas {
-        sampler: Sampler::new(&TileSet::embedded(), setup.seed),
         maps: Vec::new(),
+        images: maps,
         setup,
         dirty: None,
         random: false,
         textures,
         overlay: overlay.clone(),
-        live: HashMap::new(),
+        layer: Entity::PLACEHOLDER,
         random_live: Vec::new(),
         status: String::new(),
     };
     canvas.clear();
+    canvas.layer = commands.spawn(canvas.layer()).id();
     let classes = canvas.setup.classes.len();
     commands.insert_resource(canvas);
     commands.insert_resource(Brush {
@@ -279,28 +320,32 @@ fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<As
         radius: vec![0.06; classes],
         strength: vec![2.0; classes],
     });
-    commands.spawn(Camera2d);
+    // The unit canvas fills 92 % of the window's height; the layer streams around the
+    // camera, which sees all of it.
+    commands.spawn((
+        Camera2d,
+        Projection::Orthographic(OrthographicProjection {
+            scaling_mode: ScalingMode::FixedVertical {
+                viewport_height: 1.0 / 0.92,
+            },
+            ..OrthographicProjection::default_2d()
+        }),
+        Transform::from_xyz(0.5, 0.5, 10.0),
+        RwtViewer::all_around(),
+    ));
     commands.spawn((
         MapOverlay,
         Sprite {
             image: overlay,
+            custom_size: Some(Vec2::ONE),
             ..default()
         },
-        Transform::from_xyz(0.0, 0.0, -1.0),
+        Transform::from_xyz(0.5, 0.5, -1.0),
     ));
 }
 
 #[derive(Component)]
 struct MapOverlay;
-
-/// Pixels per world unit: the canvas fills 92 % of the window's height.
-fn pixels_per_unit(window: &Window) -> f64 {
-    window.height() as f64 * 0.92
-}
-
-fn to_screen(p: DVec2, ppu: f64) -> Vec2 {
-    ((p - 0.5) * ppu).as_vec2()
-}
 
 /// The smoke session: a stroke per class, an eraser stroke, then a save, a clear and a load
 /// (so that the screenshot shows the maps read back from disk).
@@ -351,6 +396,7 @@ fn paint_input(
     buttons: Res<ButtonInput<MouseButton>>,
     time: Res<Time>,
     windows: Query<&Window>,
+    cameras: Query<(&Camera, &GlobalTransform)>,
     mut canvas: ResMut<Canvas>,
     mut brush: ResMut<Brush>,
 ) {
@@ -383,10 +429,6 @@ fn paint_input(
     if keys.just_pressed(KeyCode::ArrowDown) {
         *brush.strength() = (*brush.strength() / 1.5).max(0.05);
     }
-    if keys.just_pressed(KeyCode::Space) {
-        canvas.random = !canvas.random;
-        canvas.dirty = Some(whole());
-    }
     if keys.just_pressed(KeyCode::KeyC) {
         canvas.clear();
     }
@@ -404,18 +446,10 @@ fn paint_input(
             Err(e) => format!("load failed: {e}"),
         };
     }
-    let Ok(window) = windows.single() else {
+    let Some(p) = cursor_on_canvas(&windows, &cameras) else {
         return;
     };
-    let Some(cursor) = window.cursor_position() else {
-        return;
-    };
-    let ppu = pixels_per_unit(window);
-    let p = DVec2::new(
-        (cursor.x - window.width() / 2.0) as f64,
-        (window.height() / 2.0 - cursor.y) as f64,
-    ) / ppu
-        + 0.5;
+    let p = p.as_dvec2();
     let amount = *brush.strength() * time.delta_secs();
     let radius = *brush.radius();
     let target = (!brush.erase_all).then_some(brush.class);
@@ -427,112 +461,92 @@ fn paint_input(
     }
 }
 
-fn place(mut commands: Commands, windows: Query<&Window>, mut canvas: ResMut<Canvas>) {
-    let Some(dirty) = canvas.dirty.take() else {
+/// Where the cursor points on the canvas (world units), if it is over the window.
+fn cursor_on_canvas(
+    windows: &Query<&Window>,
+    cameras: &Query<(&Camera, &GlobalTransform)>,
+) -> Option<Vec2> {
+    let cursor = windows.single().ok()?.cursor_position()?;
+    let (camera, at) = cameras.single().ok()?;
+    camera.viewport_to_world_2d(at, cursor).ok()
+}
+
+/// Uploads the painted maps into the images the layer reads, and tells the plugin which
+/// region changed: only the chunks under it re-scatter.
+fn upload_maps(
+    mut canvas: ResMut<Canvas>,
+    mut images: ResMut<Assets<Image>>,
+    mut painted: MessageWriter<DensityMapPainted>,
+) {
+    let Some(region) = canvas.dirty.take() else {
         return;
     };
-    let Ok(window) = windows.single() else {
+    for (map, handle) in canvas.maps.iter().zip(&canvas.images) {
+        let Some(mut image) = images.get_mut(handle) else {
+            continue;
+        };
+        image.data = Some(map.iter().map(|v| (v * 255.0).round() as u8).collect());
+        painted.write(DensityMapPainted {
+            image: handle.id(),
+            region,
+        });
+    }
+}
+
+/// Space: white noise with the same densities (rejection sampling) instead of the layer.
+fn compare_with_random(
+    mut commands: Commands,
+    mut canvas: ResMut<Canvas>,
+    keys: Res<ButtonInput<KeyCode>>,
+    mut shown: Local<bool>,
+) {
+    if keys.just_pressed(KeyCode::Space) {
+        canvas.random = !canvas.random;
+    }
+    if canvas.random == *shown && !(canvas.random && canvas.is_changed()) {
         return;
-    };
-    let ppu = pixels_per_unit(window);
-    let densities = canvas.densities();
+    }
+    *shown = canvas.random;
     let canvas = &mut *canvas;
     for e in canvas.random_live.drain(..) {
         commands.entity(e).despawn();
     }
-    let mut wanted: Vec<(PointId, u16, DVec2)> = Vec::new();
-    if canvas.random {
-        // Comparison: white noise with the same densities (rejection sampling).
-        for (_, (e, _, _)) in canvas.live.drain() {
-            commands.entity(e).despawn();
-        }
-        let total: f64 = canvas.setup.classes.iter().map(|c| c.max_density).sum();
-        for k in 0..total as u64 {
-            let h = |salt| unit_f64(hash_words(canvas.setup.seed, &[k, salt]));
-            let p = DVec2::new(h(1), h(2));
-            let mut u = h(3) * total;
-            for (class, d) in densities.iter().enumerate() {
-                let v = rwt_core::density::Density::density(d, p);
-                if u < v {
-                    let id = PointId {
-                        level: 255,
-                        x: k as i64,
-                        y: 0,
-                        index: 0,
-                    };
-                    let e = spawn_texton(&mut commands, canvas, id, class as u16, p, ppu);
-                    canvas.random_live.push(e);
-                    break;
-                }
-                u -= v;
-            }
-        }
+    if !canvas.random {
+        commands.entity(canvas.layer).insert(canvas.layer());
         return;
     }
-    let _ = canvas.sampler.query_classes(dirty, &densities, |p| {
-        wanted.push((p.id, p.class, p.position))
-    });
-    let fresh: HashMap<PointId, (u16, DVec2)> =
-        wanted.iter().map(|&(id, c, p)| (id, (c, p))).collect();
-    // Only the painted rectangle changes: what is outside it stays as it is.
-    canvas.live.retain(|id, (e, class, p)| {
-        let keep = !dirty.contains(*p) || fresh.get(id).is_some_and(|(c, _)| c == class);
-        if !keep {
-            commands.entity(*e).despawn();
-        }
-        keep
-    });
-    for (id, (class, p)) in fresh {
-        if !canvas.live.contains_key(&id) {
-            let e = spawn_texton(&mut commands, canvas, id, class, p, ppu);
-            canvas.live.insert(id, (e, class, p));
+    commands.entity(canvas.layer).remove::<ScatterLayer>();
+    let total: f64 = canvas.setup.classes.iter().map(|c| c.max_density).sum();
+    let n = canvas.setup.map_size;
+    for k in 0..total as u64 {
+        let h = |salt| unit_f64(hash_words(canvas.setup.seed, &[k, salt]));
+        let p = DVec2::new(h(1), h(2));
+        let texel = ((1.0 - p.y) * n as f64) as usize * n + (p.x * n as f64) as usize;
+        let mut u = h(3) * total;
+        for (class, c) in canvas.setup.classes.iter().enumerate() {
+            let v = canvas.maps[class][texel.min(n * n - 1)] as f64 * c.max_density;
+            if u < v {
+                let size = (c.size as f64 / c.max_density.sqrt()) as f32;
+                let e = commands.spawn((
+                    CountedInstance,
+                    Sprite {
+                        image: canvas.textures[class].clone(),
+                        custom_size: Some(Vec2::splat(size)),
+                        ..default()
+                    },
+                    Transform::from_xyz(p.x as f32, p.y as f32, 0.0)
+                        .with_rotation(Quat::from_rotation_z(h(4) as f32 * std::f32::consts::TAU)),
+                ));
+                canvas.random_live.push(e.id());
+                break;
+            }
+            u -= v;
         }
     }
-}
-
-fn spawn_texton(
-    commands: &mut Commands,
-    canvas: &Canvas,
-    id: PointId,
-    class: u16,
-    p: DVec2,
-    ppu: f64,
-) -> Entity {
-    let c = &canvas.setup.classes[class as usize];
-    let seed = canvas.setup.seed;
-    let size = (c.size as f64 / c.max_density.sqrt() * ppu * id.scale(seed, 0.15)) as f32;
-    let at = to_screen(p, ppu);
-    commands
-        .spawn((
-            CountedInstance,
-            Sprite {
-                image: canvas.textures[class as usize].clone(),
-                custom_size: Some(Vec2::splat(size)),
-                ..default()
-            },
-            Transform::from_xyz(
-                at.x,
-                at.y,
-                0.1 * class as f32 + unit_f64(id.hash(seed, 9)) as f32 * 0.05,
-            )
-            .with_rotation(Quat::from_rotation_z(id.rotation(seed) as f32)),
-        ))
-        .id()
 }
 
 /// The maps, tinted by class over white, behind the textons.
-fn show_maps(
-    canvas: Res<Canvas>,
-    windows: Query<&Window>,
-    mut images: ResMut<Assets<Image>>,
-    mut overlay: Query<&mut Sprite, With<MapOverlay>>,
-) {
-    if let (Ok(window), Ok(mut sprite)) = (windows.single(), overlay.single_mut()) {
-        let side = pixels_per_unit(window) as f32;
-        if sprite.custom_size != Some(Vec2::splat(side)) {
-            sprite.custom_size = Some(Vec2::splat(side));
-        }
-    }
+fn show_maps(canvas: Res<Canvas>, mut images: ResMut<Assets<Image>>) {
     if !canvas.is_changed() {
         return;
     }
@@ -563,6 +577,7 @@ fn hud(
     brush: Res<Brush>,
     live: Res<LiveInstances>,
     windows: Query<&Window>,
+    cameras: Query<(&Camera, &GlobalTransform)>,
     mut gizmos: Gizmos,
     mut hud: ResMut<Hud>,
 ) {
@@ -597,18 +612,8 @@ fn hud(
             canvas.status
         ),
     ];
-    if let Ok(window) = windows.single()
-        && let Some(cursor) = window.cursor_position()
-    {
-        let ppu = pixels_per_unit(window);
-        let at = Vec2::new(
-            cursor.x - window.width() / 2.0,
-            window.height() / 2.0 - cursor.y,
-        );
-        gizmos.circle_2d(
-            at,
-            (brush.radius[brush.class] * ppu) as f32,
-            Color::srgb(0.2, 0.2, 0.2),
-        );
+    if let Some(at) = cursor_on_canvas(&windows, &cameras) {
+        let radius = brush.radius[brush.class] as f32;
+        gizmos.circle_2d(at, radius, Color::srgb(0.2, 0.2, 0.2));
     }
 }

@@ -18,19 +18,7 @@ fn a_layer_file_loads_and_reloads() {
             classes: [(density: Constant(0.25), mesh: Cone(radius: 0.5, height: 2.0), material: Color(0.1, 0.5, 0.1))])"#,
     )
     .unwrap();
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin {
-            file_path: dir.to_string_lossy().into_owned(),
-            ..Default::default()
-        },
-        RwtPlugin::default().with_spawn_budget(50_000),
-    ))
-    .init_asset::<Mesh>()
-    .init_asset::<StandardMaterial>();
-    app.finish();
-    app.cleanup();
+    let mut app = app_reading(&dir);
     spawn_viewer(&mut app, Vec3::ZERO);
     let handle: Handle<ScatterLayerAsset> = app
         .world()

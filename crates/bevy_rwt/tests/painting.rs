@@ -12,15 +12,7 @@ use glam::DVec2;
 fn painting_changes_only_the_painted_region() {
     let mut app = create_app();
     spawn_viewer(&mut app, Vec3::ZERO);
-    let size = 64u32;
-    let image = solid_image(size, [128, 128, 128, 255]);
-    let handle = app.world_mut().resource_mut::<Assets<Image>>().add(image);
-    let density = LayerDensity::Image {
-        image: handle.clone(),
-        min: Vec2::splat(-64.0),
-        size: Vec2::splat(128.0),
-        scale: 1.0,
-    };
+    let (handle, density) = gray_map(&mut app, 1.0);
     app.world_mut().spawn(layer(density));
     tick_app(&mut app, 2_000);
     let before = instances(&mut app);
