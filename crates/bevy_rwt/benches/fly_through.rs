@@ -17,7 +17,14 @@ fn run(speed: f32) {
         "== flying at {speed} units per frame ({} units/s at 60 fps)",
         speed * 60.0
     );
+    let (mut app, viewer) = world();
+    fill(&mut app);
+    fly(&mut app, viewer, speed);
+}
 
+/// A headless app with one grass layer of 0.5 instances per square unit and a viewer;
+/// returns the app and the viewer.
+fn world() -> (App, Entity) {
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins,
@@ -50,8 +57,11 @@ fn run(speed: f32) {
             .with_tile_size(16.0)
             .with_streaming(streaming),
     );
+    (app, viewer)
+}
 
-    // Fill the world around the start.
+/// Runs frames until the world around the start is filled.
+fn fill(app: &mut App) {
     let started = Instant::now();
     let mut frames = 0;
     loop {
@@ -70,8 +80,10 @@ fn run(speed: f32) {
         "filled {live} instances in {frames} frames, {:.2} s",
         started.elapsed().as_secs_f64()
     );
+}
 
-    // Fly for 600 frames.
+/// Flies the viewer for 600 frames and prints frame times and churn.
+fn fly(app: &mut App, viewer: Entity, speed: f32) {
     let mut times = Vec::with_capacity(600);
     let (mut most, mut least) = (0, usize::MAX);
     let (mut spawned, mut despawned) = (0usize, 0usize);

@@ -46,58 +46,75 @@ fn resident_bytes() -> u64 {
         .map_or(0, |pages| pages * 4096)
 }
 
-#[test]
-fn a_long_random_walk_with_painting_and_layer_changes() {
-    // Small per-frame budgets so that queues, in-flight tasks and cancelled chunks are
-    // exercised on every step of the walk.
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin::default(),
-        RwtPlugin::default()
-            .with_spawn_budget(400)
-            .with_despawn_budget(400)
-            .with_max_tasks(6),
-    ));
-    app.finish();
-    app.cleanup();
-    let viewer = spawn_viewer(&mut app, Vec3::ZERO);
-    let size = 64u32;
-    let original = solid_image(size, [90, 90, 90, 255]);
-    let map = app
-        .world_mut()
-        .resource_mut::<Assets<Image>>()
-        .add(original.clone());
-    let painted = layer(LayerDensity::Image {
-        image: map.clone(),
-        min: Vec2::splat(-200.0),
-        size: Vec2::splat(400.0),
-        scale: 0.6,
-    })
-    .with_seed(5)
-    .with_falloff(20.0, 48.0);
-    app.world_mut().spawn(painted);
-    let constant = layer(LayerDensity::Constant(0.2));
-    let mut second = app.world_mut().spawn(constant.clone()).id();
-    tick_app(&mut app, 3_000);
-    let start = instances(&mut app);
-    let start_entities = entity_count(&mut app);
-    assert!(start.len() > 500, "{} instances at the start", start.len());
+/// The soak world: a viewer, a painted layer and a constant layer that the walk replaces.
+struct Soak {
+    app: App,
+    viewer: Entity,
+    map: Handle<Image>,
+    /// The map as it was before any painting.
+    original: Image,
+    /// The constant layer as it was at the start.
+    constant: ScatterLayer,
+    /// The entity holding the current constant layer.
+    second: Entity,
+}
 
-    let mut rng = Rng::new(2006, 1);
-    let mut at = Vec2::ZERO;
-    let mut heading = 0.0f32;
-    let (mut most_live, mut most_entities, mut most_queued) = (0usize, 0usize, 0usize);
-    let mut rss_after_warm_up = 0;
-    for frame in 0..FRAMES {
-        // A wandering walk (0.5 to 4 units a frame) that stays within 250 units of the start.
-        heading += (rng.next_f64() as f32 - 0.5) * 0.6;
-        if at.length() > 250.0 {
-            heading = (-at.y).atan2(-at.x);
+/// The most of each figure over the walk.
+#[derive(Default)]
+struct Peaks {
+    live: usize,
+    entities: usize,
+    queued: usize,
+    rss_after_warm_up: u64,
+}
+
+impl Soak {
+    /// Small per-frame budgets so that queues, in-flight tasks and cancelled chunks are
+    /// exercised on every step of the walk.
+    fn new() -> Self {
+        let mut app = App::new();
+        app.add_plugins((
+            MinimalPlugins,
+            AssetPlugin::default(),
+            RwtPlugin::default()
+                .with_spawn_budget(400)
+                .with_despawn_budget(400)
+                .with_max_tasks(6),
+        ));
+        app.finish();
+        app.cleanup();
+        let viewer = spawn_viewer(&mut app, Vec3::ZERO);
+        let original = solid_image(64, [90, 90, 90, 255]);
+        let map = app
+            .world_mut()
+            .resource_mut::<Assets<Image>>()
+            .add(original.clone());
+        let painted = layer(LayerDensity::Image {
+            image: map.clone(),
+            min: Vec2::splat(-200.0),
+            size: Vec2::splat(400.0),
+            scale: 0.6,
+        })
+        .with_seed(5)
+        .with_falloff(20.0, 48.0);
+        app.world_mut().spawn(painted);
+        let constant = layer(LayerDensity::Constant(0.2));
+        let second = app.world_mut().spawn(constant.clone()).id();
+        Self {
+            app,
+            viewer,
+            map,
+            original,
+            constant,
+            second,
         }
-        let step = 0.5 + 3.5 * rng.next_f64() as f32;
-        at += Vec2::new(heading.cos(), heading.sin()) * step;
-        move_viewer(&mut app, viewer, Vec3::new(at.x, 0.0, at.y));
+    }
+
+    /// One frame of the walk: move, sometimes paint or replace the constant layer, update,
+    /// and check that no identity is live twice and the figures agree.
+    fn step(&mut self, frame: usize, at: Vec2, rng: &mut Rng, peaks: &mut Peaks) {
+        let app = &mut self.app;
+        move_viewer(app, self.viewer, Vec3::new(at.x, 0.0, at.y));
         if frame % 250 == 125 {
             // Paint a random square white or black.
             let (x0, y0) = (rng.below(56) as u32, rng.below(56) as u32);
@@ -106,32 +123,74 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
             } else {
                 Color::BLACK
             };
-            paint_square(&mut app, &map, x0, y0, color);
+            paint_square(app, &self.map, x0, y0, color);
         }
         if frame % 1_000 == 500 {
             // Replace the constant layer by a denser or sparser one, or by itself.
-            app.world_mut().entity_mut(second).despawn();
+            app.world_mut().entity_mut(self.second).despawn();
             let density = 0.1 + 0.2 * rng.next_f64();
-            second = app
+            self.second = app
                 .world_mut()
                 .spawn(layer(LayerDensity::Constant(density)))
                 .id();
         }
         app.update();
-        let live = instances(&mut app).len(); // panics on a duplicate PointId
+        let live = instances(app).len(); // panics on a duplicate PointId
         let stats = app.world().resource::<RwtStats>().clone();
         assert_eq!(live, stats.live_instances);
-        most_live = most_live.max(live);
-        most_entities = most_entities.max(entity_count(&mut app));
+        peaks.live = peaks.live.max(live);
+        peaks.entities = peaks.entities.max(entity_count(app));
         // Waiting work never outgrows the loaded chunks it belongs to.
         assert!(stats.pending_tasks <= stats.loaded_chunks, "{stats:?}");
-        most_queued = most_queued.max(stats.queued_spawns);
+        peaks.queued = peaks.queued.max(stats.queued_spawns);
         if frame == 500 {
-            rss_after_warm_up = resident_bytes();
+            peaks.rss_after_warm_up = resident_bytes();
         }
     }
-    // Bounded: two layers of at most 0.6 and 0.3 per square unit over the unload disc.
+
+    /// A wandering walk (0.5 to 4 units a frame) that stays within 250 units of the start;
+    /// returns where it ends.
+    fn walk(&mut self, peaks: &mut Peaks) -> Vec2 {
+        let mut rng = Rng::new(2006, 1);
+        let mut at = Vec2::ZERO;
+        let mut heading = 0.0f32;
+        for frame in 0..FRAMES {
+            heading += (rng.next_f64() as f32 - 0.5) * 0.6;
+            if at.length() > 250.0 {
+                heading = (-at.y).atan2(-at.x);
+            }
+            let step = 0.5 + 3.5 * rng.next_f64() as f32;
+            at += Vec2::new(heading.cos(), heading.sin()) * step;
+            self.step(frame, at, &mut rng, peaks);
+        }
+        at
+    }
+
+    /// Undoes the changes and walks back to the start from `from`, then lets streaming
+    /// settle.
+    fn undo_and_return(&mut self, from: Vec2) {
+        let app = &mut self.app;
+        *app.world_mut()
+            .resource_mut::<Assets<Image>>()
+            .get_mut(&self.map)
+            .unwrap() = self.original.clone();
+        app.world_mut().entity_mut(self.second).despawn();
+        app.world_mut().spawn(self.constant.clone());
+        let steps = (from.length() / 3.0).ceil() as usize;
+        for i in 1..=steps {
+            let p = from * (1.0 - i as f32 / steps as f32);
+            move_viewer(app, self.viewer, Vec3::new(p.x, 0.0, p.y));
+            app.update();
+        }
+        tick_app(app, 3_000);
+    }
+}
+
+/// Bounded: two layers of at most 0.6 and 0.3 per square unit over the unload disc, and
+/// resident memory that stops growing after the warm-up.
+fn assert_bounded(peaks: &Peaks) {
     let disc = std::f64::consts::PI * (64.0f64 + 23.0).powi(2);
+    let (most_live, most_entities) = (peaks.live, peaks.entities);
     assert!(
         (most_live as f64) < 0.9 * disc,
         "{most_live} live instances"
@@ -140,10 +199,11 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
         (most_entities as f64) < 0.9 * disc + 1_000.0,
         "{most_entities} entities"
     );
-    let grown = resident_bytes().saturating_sub(rss_after_warm_up);
+    let grown = resident_bytes().saturating_sub(peaks.rss_after_warm_up);
     eprintln!(
         "soak: {FRAMES} frames, at most {most_live} live instances, {most_entities} entities, \
-         {most_queued} queued spawns; resident memory grew {} KiB after frame 500",
+         {} queued spawns; resident memory grew {} KiB after frame 500",
+        peaks.queued,
         grown >> 10
     );
     assert!(
@@ -151,23 +211,22 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
         "resident memory grew by {} MiB",
         grown >> 20
     );
+}
+
+#[test]
+fn a_long_random_walk_with_painting_and_layer_changes() {
+    let mut soak = Soak::new();
+    tick_app(&mut soak.app, 3_000);
+    let start = instances(&mut soak.app);
+    let start_entities = entity_count(&mut soak.app);
+    assert!(start.len() > 500, "{} instances at the start", start.len());
+    let mut peaks = Peaks::default();
+    let at = soak.walk(&mut peaks);
+    assert_bounded(&peaks);
 
     // Undo the changes and walk back: the world near the start is exactly as it was.
-    *app.world_mut()
-        .resource_mut::<Assets<Image>>()
-        .get_mut(&map)
-        .unwrap() = original;
-    app.world_mut().entity_mut(second).despawn();
-    app.world_mut().spawn(constant);
-    let steps = (at.length() / 3.0).ceil() as usize;
-    let from = at;
-    for i in 1..=steps {
-        let p = from * (1.0 - i as f32 / steps as f32);
-        move_viewer(&mut app, viewer, Vec3::new(p.x, 0.0, p.y));
-        app.update();
-    }
-    tick_app(&mut app, 3_000);
-    let end = instances(&mut app);
+    soak.undo_and_return(at);
+    let end = instances(&mut soak.app);
     let within = |p: &Vec3, d: f32| Vec2::new(p.x, p.z).length() < d;
     for (id, p) in &start {
         if within(p, 48.0 - 23.0) {
@@ -181,7 +240,7 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
     }
     // Nothing leaked: apart from instances kept by hysteresis, as many entities as before.
     let extra = end.len() as i64 - start.len() as i64;
-    let entities = entity_count(&mut app) as i64;
+    let entities = entity_count(&mut soak.app) as i64;
     assert!(
         (entities - start_entities as i64 - extra).abs() <= 1,
         "{entities} entities now, {start_entities} at the start, {extra} extra instances"
