@@ -163,29 +163,25 @@ fn on_layer_removed(
 fn on_layer_inserted(
     insert: On<Insert, ScatterLayer>,
     states: Query<&LayerState>,
+    mut statuses: Query<&mut ScatterLayerStatus>,
     mut commands: Commands,
 ) {
     if let Ok(old) = states.get(insert.entity) {
         old.despawn_all(&mut commands);
     }
+    if let Ok(mut status) = statuses.get_mut(insert.entity) {
+        status.loaded_chunks.clear();
+    }
     commands.entity(insert.entity).insert(LayerState::default());
 }
 
-/// Copies each layer's figures into its [`ScatterLayerStatus`].
+/// Copies each layer's counts into its [`ScatterLayerStatus`] (its loaded chunks are
+/// copied by planning, when they change).
 fn update_status(mut layers: Query<(&LayerState, &mut ScatterLayerStatus)>) {
     for (state, mut status) in &mut layers {
         let status = status.bypass_change_detection();
         status.live_instances = state.live();
         status.pending_tasks = state.pending();
         status.queued_spawns = state.queued();
-        if status.loaded_chunks.len() != state.chunks.loaded().len()
-            || !state
-                .chunks
-                .loaded()
-                .iter()
-                .all(|c| status.loaded_chunks.contains(c))
-        {
-            status.loaded_chunks = state.chunks.loaded().iter().copied().collect();
-        }
     }
 }

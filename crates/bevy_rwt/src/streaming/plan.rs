@@ -56,7 +56,9 @@ pub(super) fn plan_chunks(
             })
             .clone();
         let viewers = inputs.viewers.on(layer.plane);
-        update_chunks(entity, layer, state, viewers, &mut unloaded);
+        if update_chunks(entity, layer, state, viewers, &mut unloaded) {
+            status.loaded_chunks = state.chunks.loaded().iter().copied().collect();
+        }
         mark_band_changes(layer, state, viewers);
         let free = inputs
             .settings
@@ -67,15 +69,16 @@ pub(super) fn plan_chunks(
 }
 
 /// Loads and unloads chunks for the viewers: unloaded chunks queue their instances for
-/// despawning, loaded ones wait for generation.
+/// despawning, loaded ones wait for generation. Returns whether any chunk changed.
 fn update_chunks(
     entity: Entity,
     layer: &ScatterLayer,
     state: &mut LayerState,
     viewers: &[Viewer],
     unloaded: &mut MessageWriter<ChunkUnloaded>,
-) {
+) -> bool {
     let changes = state.chunks.update(&layer.streaming, viewers);
+    let changed = !(changes.load.is_empty() && changes.unload.is_empty());
     for chunk in changes.unload {
         if let Some(c) = state.states.remove(&chunk) {
             state.despawn.extend(c.instances.values().map(|(e, _)| *e));
@@ -89,6 +92,7 @@ fn update_chunks(
     for chunk in changes.load {
         state.states.entry(chunk).or_default().stale = true;
     }
+    changed
 }
 
 /// Chunks whose level-of-detail band moved with the viewers need regenerating.

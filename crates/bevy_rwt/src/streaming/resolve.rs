@@ -15,6 +15,8 @@ pub(super) struct Resolved {
     /// The exclusion mask, when the layer has one.
     exclusion: Option<SharedDensity>,
     height: Option<HeightFn>,
+    /// Every class's density with the exclusion applied, once all are made.
+    combined: Option<Vec<SharedDensity>>,
 }
 
 /// What generation tasks read: every class's density (exclusion applied) and the height.
@@ -66,6 +68,7 @@ impl Resolved {
         image: AssetId<Image>,
     ) -> Vec<Option<rwt_core::Rect>> {
         let mut covered = Vec::new();
+        self.combined = None;
         let reads = |d: &LayerDensity| d.image().is_some_and(|h| h.id() == image);
         for (slot, class) in self.classes.iter_mut().zip(&layer.classes) {
             if reads(&class.density) {
@@ -123,8 +126,11 @@ impl Resolved {
         if !missing.is_empty() {
             return Err(merge_missing(missing));
         }
+        if self.combined.is_none() {
+            self.combined = Some(self.densities());
+        }
         Ok(Sources {
-            densities: self.densities(),
+            densities: self.combined.clone().expect("made above"),
             height: self.height.clone().expect("made above"),
         })
     }
