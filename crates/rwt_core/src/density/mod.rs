@@ -34,10 +34,18 @@ pub trait Density {
         let _ = (min, max);
         0.0
     }
+    /// Whether a point at `p` with rank `threshold` appears, that is whether
+    /// `sanitize(density(p)) * factor` exceeds `threshold`: the question a query asks of
+    /// every point its bounds leave open. A density may override it to answer sooner, never
+    /// differently.
+    #[inline]
+    fn exceeds(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
+        sanitize(self.density(p)) * factor > threshold
+    }
 }
 
 /// A density behind a pointer is that density: references, boxes and shared pointers (the
-/// form generation tasks hand between threads) all forward the three methods.
+/// form generation tasks hand between threads) all forward every method.
 macro_rules! forward_density {
     ($($pointer:ty),*) => {$(
         impl<D: Density + ?Sized> Density for $pointer {
@@ -52,6 +60,10 @@ macro_rules! forward_density {
             #[inline]
             fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
                 (**self).min_over(min, max)
+            }
+            #[inline]
+            fn exceeds(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
+                (**self).exceeds(p, factor, threshold)
             }
         }
     )*};

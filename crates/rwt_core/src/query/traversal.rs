@@ -256,8 +256,7 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
                 (o.iy as f64 + cp.frac[1]) * o.side,
             );
             let rank = cp.rank as f64 + run.offset;
-            if self.rect.contains(p)
-                && (rank < run.sure || sanitize(self.density.density(p)) * run.area > rank)
+            if self.rect.contains(p) && (rank < run.sure || self.density.exceeds(p, run.area, rank))
             {
                 (self.emit)(Point {
                     position: p,

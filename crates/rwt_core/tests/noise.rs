@@ -1,0 +1,114 @@
+//! The noise density against the `noise` crate it wraps: the same values bit for bit, the
+//! same decisions from its early-out, and the same query output as the plain fBm with the
+//! loosest possible bounds.
+
+use glam::DVec2;
+use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
+use rwt_core::density::{Density, FnDensity, NoiseDensity, NoiseParams, sanitize};
+use rwt_core::query::{Point, PointId, Rect, Sampler};
+use rwt_core::rng::Rng;
+use rwt_core::tileset::TileSet;
+
+/// Parameter sets with either sign of amplitude and scale, few and many octaves.
+fn params() -> Vec<NoiseParams> {
+    let p = |seed, frequency, octaves, base, amplitude, scale| NoiseParams {
+        seed,
+        frequency,
+        octaves,
+        base,
+        amplitude,
+        scale,
+    };
+    vec![
+        p(3, 0.15, 4, 0.5, 0.5, 2_000.0),
+        p(11, 0.7, 1, 0.2, 0.9, 900.0),
+        p(12345, 0.05, 8, 0.6, -0.7, 1_500.0),
+        p(7, 1.3, 16, 0.1, 1.4, 600.0),
+        p(1, 0.4, 3, -0.2, 0.5, -800.0),
+    ]
+}
+
+/// What `NoiseDensity` promises to equal: the `noise` crate's own fBm.
+fn plain(params: NoiseParams) -> impl Fn(DVec2) -> f64 {
+    let fbm = Fbm::<Perlin>::new(params.seed).set_octaves(params.octaves);
+    move |p: DVec2| {
+        let q = p * params.frequency;
+        params.scale * (params.base + params.amplitude * fbm.get([q.x, q.y])).max(0.0)
+    }
+}
+
+#[test]
+fn values_are_the_noise_crates_fbm_bit_for_bit() {
+    let mut rng = Rng::new(40, 1);
+    for params in params() {
+        let (ours, theirs) = (NoiseDensity::new(params), plain(params));
+        for _ in 0..20_000 {
+            let p = DVec2::new(rng.next_f64() - 0.5, rng.next_f64() - 0.5) * 2e4;
+            assert_eq!(
+                ours.density(p).to_bits(),
+                theirs(p).to_bits(),
+                "{params:?} at {p:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn early_decisions_equal_full_evaluation() {
+    let mut rng = Rng::new(40, 2);
+    for params in params() {
+        let d = NoiseDensity::new(params);
+        for _ in 0..20_000 {
+            let p = DVec2::new(rng.next_f64(), rng.next_f64()) * 300.0;
+            let factor = 0.01 + rng.next_f64() * 4.0;
+            let value = sanitize(d.density(p)) * factor;
+            // Thresholds anywhere, and right at the value and one step either side.
+            for threshold in [
+                rng.next_f64() * 3_000.0,
+                value,
+                value.next_up(),
+                value.next_down(),
+            ] {
+                assert_eq!(
+                    d.exceeds(p, factor, threshold),
+                    value > threshold,
+                    "{params:?} at {p:?}, factor {factor}, threshold {threshold}"
+                );
+            }
+        }
+    }
+}
+
+/// The query of `d`: every point's identity and the bits of its position and threshold.
+fn query(sampler: &Sampler, rect: Rect, d: &impl Density) -> Vec<(PointId, [u64; 3])> {
+    let mut out: Vec<Point> = Vec::new();
+    sampler.query(rect, d, &mut out).unwrap();
+    out.iter()
+        .map(|p| {
+            let bits = [p.position.x, p.position.y, p.threshold].map(f64::to_bits);
+            (p.id, bits)
+        })
+        .collect()
+}
+
+#[test]
+fn queries_equal_the_plain_fbm_with_the_loosest_bounds() {
+    let set = TileSet::embedded();
+    let sampler = Sampler::new(&set, 5);
+    for params in params() {
+        let ours = NoiseDensity::new(params);
+        let theirs = plain(params);
+        // The density's range, and no lower bound: every open point is evaluated in full.
+        let top = params.scale.abs() * (params.base.abs() + params.amplitude.abs());
+        let reference = FnDensity::new(theirs, move |_, _| top);
+        for (origin, side) in [(-1.7, 3.1), (40.2, 1.3), (-0.25, 0.5)] {
+            let rect = Rect::new(DVec2::splat(origin), DVec2::splat(origin + side)).unwrap();
+            let (a, b) = (
+                query(&sampler, rect, &ours),
+                query(&sampler, rect, &reference),
+            );
+            assert!(!a.is_empty() || params.scale < 0.0, "{params:?}: no points");
+            assert_eq!(a, b, "{params:?} over {rect:?}");
+        }
+    }
+}
