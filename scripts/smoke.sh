@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every example in a real renderer (Xvfb + Mesa's lavapipe Vulkan driver) through its
 # scripted session (RWT_SCREENSHOT), and fails when an example exits with an error, its
-# screenshot is missing or blank (luminance variance < 20), or it reports 0 instances.
+# screenshot is missing or blank (luminance variance < 20), or it reports 0 instances
+# (entities and instanced together).
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png
@@ -39,17 +40,18 @@ for ex in "${examples[@]}"; do
         echo "FAIL $ex: exited with an error"; tail -20 "$out/$ex.log"; failed=1; continue
     fi
     line=$(grep -E '^rwt-smoke: screenshot' "$out/$ex.log" || true)
-    instances=$(sed -nE 's/.* instances ([0-9]+)$/\1/p' <<<"$line")
+    instances=$(sed -nE 's/.* instances ([0-9]+) instanced [0-9]+$/\1/p' <<<"$line")
+    instanced=$(sed -nE 's/.* instanced ([0-9]+)$/\1/p' <<<"$line")
     if [ ! -s "$png" ]; then
         echo "FAIL $ex: no screenshot"; tail -20 "$out/$ex.log"; failed=1; continue
     fi
     read -r w h var < <(python3 scripts/png_stats.py "$png")
     secs=$(( $(date +%s) - start ))
-    echo "$ex: ${w}x${h}, luminance variance $var, instances ${instances:-?}, ${secs} s"
+    echo "$ex: ${w}x${h}, luminance variance $var, instances ${instances:-?}, instanced ${instanced:-?}, ${secs} s"
     if python3 -c "import sys; sys.exit(0 if float('$var') >= 20 else 1)"; then :; else
         echo "FAIL $ex: blank screenshot"; failed=1
     fi
-    if [ -z "$instances" ] || [ "$instances" -eq 0 ]; then
+    if [ -z "$instances" ] || [ $((instances + ${instanced:-0})) -eq 0 ]; then
         echo "FAIL $ex: no instances"; failed=1
     fi
     if [ $docs = 1 ] && [ $failed = 0 ]; then

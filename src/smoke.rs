@@ -8,7 +8,7 @@
 use bevy::app::AppExit;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy_rwt::ScatterInstance;
+use bevy_rwt::{RwtStats, ScatterInstance};
 use std::path::PathBuf;
 
 /// The smoke session's settings and frame counter.
@@ -57,9 +57,10 @@ impl Smoke {
 #[derive(Component, Default)]
 pub struct CountedInstance;
 
-/// Live instances: `bevy_rwt` instances plus [`CountedInstance`]s, updated every frame.
+/// Live instances, updated every frame: entities (`bevy_rwt` instances plus
+/// [`CountedInstance`]s), and instances of `bevy_rwt`'s instanced classes.
 #[derive(Resource, Default, Debug, Clone, Copy)]
-pub struct LiveInstances(pub usize);
+pub struct LiveInstances(pub usize, pub usize);
 
 /// Runs the smoke session when the environment asks for one; counts instances always.
 pub struct SmokePlugin;
@@ -91,8 +92,10 @@ fn count_instances(
     mut live: ResMut<LiveInstances>,
     scattered: Query<(), With<ScatterInstance>>,
     counted: Query<(), With<CountedInstance>>,
+    stats: Option<Res<RwtStats>>,
 ) {
     live.0 = scattered.iter().len() + counted.iter().len();
+    live.1 = stats.map_or(0, |s| s.live_instanced);
 }
 
 /// Frames to wait for a screenshot with something on it before giving up.
@@ -120,7 +123,7 @@ fn finish(
     };
     let Some(path) = smoke.screenshot.clone() else {
         if smoke.frame == last {
-            println!("rwt-smoke: instances {}", live.0);
+            println!("rwt-smoke: instances {} instanced {}", live.0, live.1);
             exit.write(AppExit::Success);
         }
         return;
@@ -158,7 +161,7 @@ fn finish(
                 shots.next = Some(smoke.frame + 10);
                 return;
             }
-            exit.write(save(&path, &rgb, live.0));
+            exit.write(save(&path, &rgb, *live));
         },
     );
 }
@@ -174,7 +177,7 @@ pub fn luminance_variance(rgb: &image::RgbImage) -> f64 {
     lum.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / lum.len().max(1) as f64
 }
 
-fn save(path: &std::path::Path, rgb: &image::RgbImage, instances: usize) -> AppExit {
+fn save(path: &std::path::Path, rgb: &image::RgbImage, live: LiveInstances) -> AppExit {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         let _ = std::fs::create_dir_all(dir);
     }
@@ -183,10 +186,12 @@ fn save(path: &std::path::Path, rgb: &image::RgbImage, instances: usize) -> AppE
         return AppExit::error();
     }
     println!(
-        "rwt-smoke: screenshot {} ({}x{}) instances {instances}",
+        "rwt-smoke: screenshot {} ({}x{}) instances {} instanced {}",
         path.display(),
         rgb.width(),
-        rgb.height()
+        rgb.height(),
+        live.0,
+        live.1
     );
     AppExit::Success
 }

@@ -66,6 +66,7 @@
 
 pub mod diagnostics;
 pub mod gizmos;
+pub mod instancing;
 pub mod layers;
 mod settings;
 pub mod streaming;
@@ -74,6 +75,7 @@ pub mod viewers;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 pub use diagnostics::RwtStats;
+pub use instancing::{InstancedChunk, InstancedMaterial, RwtInstancingPlugin, RwtWind};
 pub use layers::{
     AssetStatus, ClassLook, GroundPlane, HeightSource, InstanceInserter, LayerDensity,
     ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus,
@@ -91,8 +93,9 @@ pub mod prelude {
     pub use crate::layers::file::{ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{
         AssetStatus, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
-        HeightSource, LayerDensity, RwtPlugin, RwtSettings, RwtStats, RwtSystems, RwtViewer,
-        ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus, ViewCone,
+        HeightSource, InstancedChunk, InstancedMaterial, LayerDensity, RwtPlugin, RwtSettings,
+        RwtStats, RwtSystems, RwtViewer, RwtWind, ScatterClass, ScatterInstance, ScatterLayer,
+        ScatterLayerStatus, ViewCone,
     };
     pub use rwt_core::streaming::{Falloff, StreamingConfig};
 }
@@ -170,6 +173,7 @@ impl Plugin for RwtPlugin {
             layers::RwtLayersPlugin { schedule },
             streaming::RwtStreamingPlugin { schedule, tile_set },
             diagnostics::RwtDiagnosticsPlugin { schedule },
+            instancing::RwtInstancingPlugin,
         ));
     }
 }

@@ -9,6 +9,12 @@ pub struct RwtSettings {
     pub spawn_budget: usize,
     /// Most instances despawned per frame (all layers).
     pub despawn_budget: usize,
+    /// Most instances of instanced classes handed to their chunk entities per frame (all
+    /// layers; at least one chunk per frame whatever its size).
+    pub upload_budget: usize,
+    /// Keep each instanced chunk's point identities beside its buffer
+    /// ([`crate::instancing::InstanceBuffer::ids`]): for tests and tools, 24 bytes per instance.
+    pub keep_instance_ids: bool,
     /// Most chunk generation tasks in flight per layer.
     pub max_tasks_in_flight: usize,
     /// Length of the view wedge drawn from a viewer on the ground.
@@ -20,6 +26,8 @@ impl Default for RwtSettings {
         Self {
             spawn_budget: 5_000,
             despawn_budget: 10_000,
+            upload_budget: 1_000_000,
+            keep_instance_ids: false,
             max_tasks_in_flight: 8,
             footprint_reach: 1.0e4,
         }

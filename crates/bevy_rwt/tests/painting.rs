@@ -74,20 +74,6 @@ fn painting_an_exclusion_map_removes_only_what_it_covers() {
 }
 
 /// A gray 64-texel map over -64..64 (x, z), its handle, and the density that reads it.
-fn gray_map(app: &mut App, scale: f64) -> (Handle<Image>, LayerDensity) {
-    let handle = app
-        .world_mut()
-        .resource_mut::<Assets<Image>>()
-        .add(solid_image(64, [128, 128, 128, 255]));
-    let density = LayerDensity::Image {
-        image: handle.clone(),
-        min: Vec2::splat(-64.0),
-        size: Vec2::splat(128.0),
-        scale,
-    };
-    (handle, density)
-}
-
 #[test]
 fn a_painted_region_message_limits_what_re_scatters() {
     // The same stroke twice: once announced with its region, once not. Only chunks under

@@ -13,13 +13,15 @@ use std::time::Instant;
 /// [`ScatterLayerStatus`]).
 #[derive(Resource, Clone, Debug, Default, PartialEq)]
 pub struct RwtStats {
-    /// Instances alive.
+    /// Entity instances alive.
     pub live_instances: usize,
+    /// Instances of instanced classes alive (drawn from chunk buffers, no entity each).
+    pub live_instanced: usize,
     /// Chunks loaded.
     pub loaded_chunks: usize,
     /// Chunks being generated or waiting to be.
     pub pending_tasks: usize,
-    /// Instances waiting for the spawn budget.
+    /// Instances waiting for the spawn budget (or, for instanced classes, the upload budget).
     pub queued_spawns: usize,
     /// Layers waiting for a layer file, density map or heightmap to load.
     pub layers_waiting: usize,
@@ -35,6 +37,8 @@ pub mod paths {
     use super::DiagnosticPath;
     /// Live instances.
     pub const LIVE_INSTANCES: DiagnosticPath = DiagnosticPath::const_new("rwt/live_instances");
+    /// Live instances of instanced classes.
+    pub const LIVE_INSTANCED: DiagnosticPath = DiagnosticPath::const_new("rwt/live_instanced");
     /// Loaded chunks.
     pub const LOADED_CHUNKS: DiagnosticPath = DiagnosticPath::const_new("rwt/loaded_chunks");
     /// Tasks in flight.
@@ -42,8 +46,13 @@ pub mod paths {
     /// Milliseconds in the plugin's systems per frame.
     pub const STREAMING_MS: DiagnosticPath = DiagnosticPath::const_new("rwt/streaming_ms");
     /// Every path.
-    pub const ALL: [DiagnosticPath; 4] =
-        [LIVE_INSTANCES, LOADED_CHUNKS, PENDING_TASKS, STREAMING_MS];
+    pub const ALL: [DiagnosticPath; 5] = [
+        LIVE_INSTANCES,
+        LIVE_INSTANCED,
+        LOADED_CHUNKS,
+        PENDING_TASKS,
+        STREAMING_MS,
+    ];
 }
 
 /// When the plugin's first system ran this frame.
@@ -58,6 +67,7 @@ fn start_timer(mut start: ResMut<FrameStart>) {
 fn update_stats(layers: Query<&ScatterLayerStatus>, mut stats: ResMut<RwtStats>) {
     let sum = |f: fn(&ScatterLayerStatus) -> usize| layers.iter().map(f).sum::<usize>();
     stats.live_instances = sum(|s| s.live_instances);
+    stats.live_instanced = sum(|s| s.live_instanced);
     stats.loaded_chunks = sum(|s| s.loaded_chunks.len());
     stats.pending_tasks = sum(|s| s.pending_tasks);
     stats.queued_spawns = sum(|s| s.queued_spawns);
@@ -69,6 +79,7 @@ fn publish(mut stats: ResMut<RwtStats>, start: Res<FrameStart>, mut diagnostics:
     stats.streaming_ms = start.0.elapsed().as_secs_f64() * 1e3;
     let s = stats.clone();
     diagnostics.add_measurement(&paths::LIVE_INSTANCES, || s.live_instances as f64);
+    diagnostics.add_measurement(&paths::LIVE_INSTANCED, || s.live_instanced as f64);
     diagnostics.add_measurement(&paths::LOADED_CHUNKS, || s.loaded_chunks as f64);
     diagnostics.add_measurement(&paths::PENDING_TASKS, || s.pending_tasks as f64);
     diagnostics.add_measurement(&paths::STREAMING_MS, || s.streaming_ms);

@@ -11,6 +11,7 @@ pub use plugin::RwtLayersPlugin;
 pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
 pub use status::{AssetStatus, ScatterLayerStatus};
 
+use crate::instancing::{InstancedLook, InstancedMaterial};
 use bevy::prelude::*;
 use rwt_core::density::{Constant, Density, NoiseDensity};
 use rwt_core::streaming::{Falloff, StreamingConfig};
@@ -108,6 +109,10 @@ pub enum ClassLook {
     /// Whatever the function inserts: a scene (`SceneRoot(handle.clone())`, with Bevy's
     /// `bevy_scene` feature in the game), another material type, colliders, markers.
     Custom(InstanceInserter),
+    /// No entity per instance: each chunk's instances are packed into one GPU buffer and
+    /// drawn with one instanced draw (grass, flowers, pebbles; see [`crate::instancing`]).
+    /// Only on the [`GroundPlane::Xz`] plane.
+    Instanced(InstancedLook),
 }
 
 impl std::fmt::Debug for ClassLook {
@@ -119,6 +124,7 @@ impl std::fmt::Debug for ClassLook {
                 .field("material", material)
                 .finish(),
             ClassLook::Custom(_) => f.write_str("Custom(..)"),
+            ClassLook::Instanced(look) => look.fmt(f),
         }
     }
 }
@@ -160,6 +166,18 @@ impl ScatterClass {
         insert: impl Fn(&mut EntityCommands) + Send + Sync + 'static,
     ) -> Self {
         Self::with_look(density, ClassLook::Custom(Arc::new(insert)))
+    }
+
+    /// A class drawn from per-chunk instance buffers, without an entity per instance.
+    pub fn instanced(
+        density: LayerDensity,
+        mesh: Handle<Mesh>,
+        material: InstancedMaterial,
+    ) -> Self {
+        Self::with_look(
+            density,
+            ClassLook::Instanced(InstancedLook { mesh, material }),
+        )
     }
 
     fn with_look(density: LayerDensity, look: ClassLook) -> Self {

@@ -26,10 +26,12 @@ pub struct ScatterLayerStatus {
     pub assets: AssetStatus,
     /// Chunks loaded.
     pub loaded_chunks: HashSet<ChunkCoord>,
-    /// Instances alive (spawned and not yet despawned).
+    /// Entity instances alive (spawned and not yet despawned).
     pub live_instances: usize,
+    /// Instances of instanced classes alive (in chunk buffers; no entity each).
+    pub live_instanced: usize,
     /// Chunks being generated or waiting to be.
     pub pending_tasks: usize,
-    /// Instances waiting for the spawn budget.
+    /// Instances waiting for the spawn budget (or, for instanced classes, the upload budget).
     pub queued_spawns: usize,
 }

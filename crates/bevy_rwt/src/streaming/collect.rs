@@ -1,7 +1,7 @@
 //! Finished generation tasks become spawn and despawn queues, by point identity: existing
 //! instances never move.
 
-use super::{ChunkLoaded, LayerState};
+use super::{ChunkContent, ChunkLoaded, LayerState};
 use bevy::platform::collections::HashSet;
 use bevy::prelude::*;
 use bevy::tasks::futures::check_ready;
@@ -27,8 +27,18 @@ pub(super) fn collect_results(
             }
         }
         for (chunk, band, result) in finished {
-            let Some(points) = result else { continue };
+            let Some(ChunkContent { points, packed }) = result else {
+                continue;
+            };
             let c = state.states.get_mut(&chunk).expect("finished chunks exist");
+            let packed_count: usize = packed.iter().map(|p| p.buffer.instances.len()).sum();
+            if !packed.is_empty() {
+                c.upload = packed;
+                if !c.in_upload_order {
+                    c.in_upload_order = true;
+                    state.upload_order.push_back(chunk);
+                }
+            }
             c.lod = band;
             // Compare with what the chunk shows or is about to show.
             let spawned = c.instances.iter().map(|(id, (_, class))| (*id, *class));
@@ -43,7 +53,7 @@ pub(super) fn collect_results(
                     }
                 }
             }
-            let count = points.len();
+            let count = points.len() + packed_count;
             c.queued.extend(diff.added);
             if !c.queued.is_empty() && !c.in_order {
                 c.in_order = true;

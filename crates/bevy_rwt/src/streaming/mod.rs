@@ -18,6 +18,7 @@ mod spawn;
 
 pub use plugin::RwtStreamingPlugin;
 
+use crate::instancing::{InstancedClasses, PackedClass};
 use crate::layers::{ScatterLayer, ScatterLayerStatus};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -63,8 +64,15 @@ pub struct DensityMapPainted {
 #[derive(Resource, Clone)]
 pub(crate) struct RwtTileSet(pub Arc<TileSet>);
 
-/// A chunk's generation task: its points, or nothing when the query was refused.
-type ChunkTask = Task<Option<Vec<Point>>>;
+/// What a chunk's generation task hands back: the points of entity classes, and the
+/// buffers of instanced ones (packed in the task).
+struct ChunkContent {
+    points: Vec<Point>,
+    packed: Vec<PackedClass>,
+}
+
+/// A chunk's generation task: its content, or nothing when the query was refused.
+type ChunkTask = Task<Option<ChunkContent>>;
 
 #[derive(Default)]
 struct ChunkState {
@@ -74,6 +82,12 @@ struct ChunkState {
     queued: Vec<Point>,
     /// Whether the chunk is in the spawn order.
     in_order: bool,
+    /// The chunk entity of each instanced class, with its instance count.
+    instanced: HashMap<u16, (Entity, usize)>,
+    /// Instance buffers generated but not yet handed to their entities (upload budget).
+    upload: Vec<PackedClass>,
+    /// Whether the chunk is in the upload order.
+    in_upload_order: bool,
     /// Level-of-detail band the content was generated for.
     lod: i64,
     task: Option<(ChunkTask, i64)>,
@@ -85,12 +99,16 @@ struct ChunkState {
 #[derive(Component, Default)]
 pub(crate) struct LayerState {
     sampler: Option<Arc<Sampler>>,
+    /// The layer's instanced classes (made with the sampler).
+    instanced: Option<InstancedClasses>,
     sources: resolve::Resolved,
     chunks: ChunkSet,
     states: HashMap<ChunkCoord, ChunkState>,
     /// Chunks with queued points, in the order they finished (unloaded ones are skipped).
     spawn_order: VecDeque<ChunkCoord>,
     despawn: VecDeque<Entity>,
+    /// Chunks with instance buffers to hand over, in the order they finished.
+    upload_order: VecDeque<ChunkCoord>,
 }
 
 impl LayerState {
@@ -102,6 +120,12 @@ impl LayerState {
             .map(|c| c.instances.len())
             .sum::<usize>()
             + self.despawn.len()
+    }
+
+    /// Live instances of the layer's instanced classes (in their chunks' buffers).
+    fn live_instanced(&self) -> usize {
+        let per_chunk = |c: &ChunkState| c.instanced.values().map(|(_, n)| n).sum::<usize>();
+        self.states.values().map(per_chunk).sum()
     }
 
     /// Chunks with a generation task in flight or waiting for one.
@@ -117,17 +141,22 @@ impl LayerState {
         self.states.values().filter(|c| c.task.is_some()).count()
     }
 
-    /// Instances waiting for the spawn budget.
+    /// Instances waiting for the spawn budget or, in instance buffers, the upload budget.
     fn queued(&self) -> usize {
-        self.states.values().map(|c| c.queued.len()).sum()
+        let upload =
+            |c: &ChunkState| -> usize { c.upload.iter().map(|p| p.buffer.instances.len()).sum() };
+        self.states
+            .values()
+            .map(|c| c.queued.len() + upload(c))
+            .sum()
     }
 
     /// Despawns every instance the layer has placed or was about to remove.
     fn despawn_all(&self, commands: &mut Commands) {
-        let placed = self
-            .states
-            .values()
-            .flat_map(|c| c.instances.values().map(|(e, _)| *e));
+        let placed = self.states.values().flat_map(|c| {
+            let instances = c.instances.values().map(|(e, _)| *e);
+            instances.chain(c.instanced.values().map(|(e, _)| *e))
+        });
         for e in placed.chain(self.despawn.iter().copied()) {
             commands.entity(e).try_despawn();
         }
@@ -181,6 +210,7 @@ fn update_status(mut layers: Query<(&LayerState, &mut ScatterLayerStatus)>) {
     for (state, mut status) in &mut layers {
         let status = status.bypass_change_detection();
         status.live_instances = state.live();
+        status.live_instanced = state.live_instanced();
         status.pending_tasks = state.pending();
         status.queued_spawns = state.queued();
     }

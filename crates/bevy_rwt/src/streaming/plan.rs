@@ -2,7 +2,8 @@
 //! generation tasks for the nearest of them.
 
 use super::resolve::Sources;
-use super::{ChunkTask, ChunkUnloaded, LayerState, RwtTileSet};
+use super::{ChunkContent, ChunkTask, ChunkUnloaded, LayerState, RwtTileSet};
+use crate::instancing::InstancedClasses;
 use crate::layers::{AssetStatus, ScatterLayer, ScatterLayerStatus, report_assets, slope};
 use crate::settings::RwtSettings;
 use crate::viewers::Viewers;
@@ -55,6 +56,11 @@ pub(super) fn plan_chunks(
                 Arc::new(sampler.with_tile_size(layer.tile_size))
             })
             .clone();
+        let keep_ids = inputs.settings.keep_instance_ids;
+        let instanced = state
+            .instanced
+            .get_or_insert_with(|| InstancedClasses::new(entity, layer, keep_ids))
+            .clone();
         let viewers = inputs.viewers.on(layer.plane);
         if update_chunks(entity, layer, state, viewers, &mut unloaded) {
             status.loaded_chunks = state.chunks.loaded().iter().copied().collect();
@@ -64,7 +70,13 @@ pub(super) fn plan_chunks(
             .settings
             .max_tasks_in_flight
             .saturating_sub(state.in_flight());
-        start_tasks(layer, state, viewers, &sampler, &sources, free);
+        let job = Job {
+            layer,
+            sampler: &sampler,
+            sources: &sources,
+            instanced: &instanced,
+        };
+        start_tasks(&job, state, viewers, free);
     }
 }
 
@@ -82,6 +94,7 @@ fn update_chunks(
     for chunk in changes.unload {
         if let Some(c) = state.states.remove(&chunk) {
             state.despawn.extend(c.instances.values().map(|(e, _)| *e));
+            state.despawn.extend(c.instanced.values().map(|(e, _)| *e));
         }
         // Its queued points go with it; its place in the spawn order is skipped later.
         unloaded.write(ChunkUnloaded {
@@ -108,15 +121,17 @@ fn mark_band_changes(layer: &ScatterLayer, state: &mut LayerState, viewers: &[Vi
     }
 }
 
+/// What every generation task of a layer shares.
+struct Job<'a> {
+    layer: &'a ScatterLayer,
+    sampler: &'a Arc<Sampler>,
+    sources: &'a Sources,
+    instanced: &'a InstancedClasses,
+}
+
 /// Starts generation tasks for up to `free` stale chunks without one, nearest first.
-fn start_tasks(
-    layer: &ScatterLayer,
-    state: &mut LayerState,
-    viewers: &[Viewer],
-    sampler: &Arc<Sampler>,
-    sources: &Sources,
-    free: usize,
-) {
+fn start_tasks(job: &Job, state: &mut LayerState, viewers: &[Viewer], free: usize) {
+    let layer = job.layer;
     let size = layer.streaming.chunk_size;
     let stale = state
         .states
@@ -129,22 +144,16 @@ fn start_tasks(
             .map_or(0, |f| f.chunk_band(chunk, size, viewers));
         let c = state.states.get_mut(&chunk).expect("listed above");
         c.stale = false;
-        c.task = Some((
-            start_task(layer, sampler.clone(), sources, chunk, band),
-            band,
-        ));
+        c.task = Some((start_task(job, chunk, band), band));
     }
 }
 
-/// Starts a generation task for a chunk: the query at the band's density, then the height
-/// and slope filters.
-fn start_task(
-    layer: &ScatterLayer,
-    sampler: Arc<Sampler>,
-    sources: &Sources,
-    chunk: ChunkCoord,
-    band: i64,
-) -> ChunkTask {
+/// Starts a generation task for a chunk: the query at the band's density, the height and
+/// slope filters, then the packing of instanced classes.
+fn start_task(job: &Job, chunk: ChunkCoord, band: i64) -> ChunkTask {
+    let layer = job.layer;
+    let (sampler, sources) = (job.sampler.clone(), job.sources);
+    let instanced = job.instanced.clone();
     let rect = chunk.rect(layer.streaming.chunk_size);
     let factor = layer.falloff.map_or(1.0, |f| f.factor(band));
     let (range, max_slope) = (layer.height_range, layer.max_slope);
@@ -162,7 +171,11 @@ fn start_task(
                     out.push(p);
                 }
             })
-            .ok()
-            .map(|_| out)
+            .ok()?;
+        let packed = instanced.pack(&mut out, rect.min(), &height, &scaled, factor);
+        Some(ChunkContent {
+            points: out,
+            packed,
+        })
     })
 }

@@ -1,24 +1,34 @@
 //! Budgeted spawning and despawning of the queued instances.
 
 use super::LayerState;
+use crate::instancing::{InstancedChunk, PackedClass};
 use crate::layers::{ClassLook, GroundPlane, HeightFn, ScatterInstance, ScatterLayer};
 use crate::settings::RwtSettings;
+use bevy::camera::primitives::{Aabb, MeshAabb};
 use bevy::prelude::*;
 use rwt_core::query::Point;
+use rwt_core::streaming::ChunkCoord;
 
-/// Spawns and despawns queued instances within the per-frame budgets (shared by all
-/// layers, in query order).
+/// Spawns and despawns queued instances and hands instance buffers to their chunk entities,
+/// within the per-frame budgets (shared by all layers, in query order).
 pub(super) fn apply_budget(
     mut commands: Commands,
     mut layers: Query<(Entity, &ScatterLayer, &mut LayerState)>,
     settings: Res<RwtSettings>,
+    meshes: Option<Res<Assets<Mesh>>>,
 ) {
     let mut spawn_budget = settings.spawn_budget;
     let mut despawn_budget = settings.despawn_budget;
+    let mut upload = Upload {
+        budget: settings.upload_budget,
+        meshes: meshes.as_deref(),
+        first: true,
+    };
     for (entity, layer, mut state) in &mut layers {
         let state = &mut *state;
         despawn_queued(&mut commands, state, &mut despawn_budget);
         spawn_queued(&mut commands, entity, layer, state, &mut spawn_budget);
+        upload.chunks(&mut commands, entity, layer, state);
     }
 }
 
@@ -107,5 +117,117 @@ fn spawn_instance(
             insert(&mut custom);
             custom.id()
         }
+        // Packed in the generation task instead; never queued for spawning.
+        ClassLook::Instanced(_) => commands.spawn((instance, transform)).id(),
     }
+}
+
+/// The per-frame hand-over of instance buffers to chunk entities.
+struct Upload<'a> {
+    /// Instances that may still be handed over this frame.
+    budget: usize,
+    meshes: Option<&'a Assets<Mesh>>,
+    /// Whether no chunk was handed over yet this frame (one always is).
+    first: bool,
+}
+
+impl Upload<'_> {
+    /// Hands the layer's waiting buffers over, chunk by chunk in the order they finished.
+    fn chunks(
+        &mut self,
+        commands: &mut Commands,
+        entity: Entity,
+        layer: &ScatterLayer,
+        state: &mut LayerState,
+    ) {
+        while let Some(&chunk) = state.upload_order.front() {
+            let Some(c) = state.states.get_mut(&chunk) else {
+                // Unloaded while waiting.
+                state.upload_order.pop_front();
+                continue;
+            };
+            let count: usize = c.upload.iter().map(|p| p.buffer.instances.len()).sum();
+            if count > self.budget && !self.first {
+                break;
+            }
+            self.budget = self.budget.saturating_sub(count);
+            self.first = false;
+            state.upload_order.pop_front();
+            c.in_upload_order = false;
+            for packed in std::mem::take(&mut c.upload) {
+                let class = packed.class;
+                let slot = c.instanced.get(&class).map(|(e, _)| *e);
+                let len = packed.buffer.instances.len();
+                match self.hand_over(commands, entity, layer, chunk, slot, packed) {
+                    Some(e) => c.instanced.insert(class, (e, len)),
+                    None => c.instanced.remove(&class),
+                };
+            }
+        }
+    }
+
+    /// Puts one class's buffer on its chunk entity (spawned when new, despawned when the
+    /// buffer is empty); returns the entity that holds it.
+    fn hand_over(
+        &self,
+        commands: &mut Commands,
+        entity: Entity,
+        layer: &ScatterLayer,
+        chunk: ChunkCoord,
+        slot: Option<Entity>,
+        packed: PackedClass,
+    ) -> Option<Entity> {
+        let class = layer.classes.get(packed.class as usize)?;
+        let ClassLook::Instanced(look) = &class.look else {
+            return None;
+        };
+        if packed.buffer.instances.is_empty() {
+            if let Some(e) = slot {
+                commands.entity(e).try_despawn();
+            }
+            return None;
+        }
+        let corner = chunk.rect(layer.streaming.chunk_size).min();
+        let max_scale = class.scale * (1.0 + class.scale_variation.abs());
+        let mesh_bounds = mesh_bounds(self.meshes.and_then(|m| m.get(&look.mesh)));
+        let aabb = chunk_aabb(&packed, mesh_bounds, max_scale);
+        let component = InstancedChunk {
+            layer: entity,
+            chunk,
+            class: packed.class,
+            mesh: look.mesh.clone(),
+            material: look.material.clone(),
+            mesh_top: mesh_bounds.1.y.max(1e-3),
+            falloff: layer.falloff.map(|f| (f.near as f32, f.far as f32)),
+            buffer: packed.buffer,
+        };
+        let transform = Transform::from_xyz(corner.x as f32, 0.0, corner.y as f32);
+        Some(match slot {
+            Some(e) => {
+                commands.entity(e).insert((component, aabb));
+                e
+            }
+            None => commands.spawn((component, aabb, transform)).id(),
+        })
+    }
+}
+
+/// Bounds of a mesh (a unit box standing on the ground while it is not loaded).
+fn mesh_bounds(mesh: Option<&Mesh>) -> (Vec3, Vec3) {
+    mesh.and_then(Mesh::compute_aabb)
+        .map_or((Vec3::new(-1.0, 0.0, -1.0), Vec3::ONE), |a| {
+            (a.min().into(), a.max().into())
+        })
+}
+
+/// Bounds of a chunk's instances with the mesh around each (turned any way, at the largest
+/// scale, swaying up to its height), relative to the chunk corner.
+fn chunk_aabb(packed: &PackedClass, mesh: (Vec3, Vec3), max_scale: f32) -> Aabb {
+    let (lo, hi) = packed.buffer.bounds;
+    let (mesh_lo, mesh_hi) = mesh;
+    let reach = mesh_lo.abs().max(mesh_hi.abs());
+    let horizontal = (reach.x.max(reach.z) * std::f32::consts::SQRT_2 + reach.y) * max_scale;
+    let min = lo + Vec3::new(-horizontal, mesh_lo.y.min(0.0) * max_scale, -horizontal);
+    let max = hi + Vec3::new(horizontal, mesh_hi.y.max(0.0) * max_scale, horizontal);
+    Aabb::from_min_max(min, max)
 }

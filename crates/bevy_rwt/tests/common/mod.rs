@@ -123,3 +123,19 @@ pub fn instances(app: &mut App) -> HashMap<PointId, Vec3> {
     }
     out
 }
+
+/// A mid-grey 64-texel density map over -64..64 (x and z) times `scale`, and the layer
+/// density reading it.
+pub fn gray_map(app: &mut App, scale: f64) -> (Handle<Image>, LayerDensity) {
+    let handle = app
+        .world_mut()
+        .resource_mut::<Assets<Image>>()
+        .add(solid_image(64, [128, 128, 128, 255]));
+    let density = LayerDensity::Image {
+        image: handle.clone(),
+        min: Vec2::splat(-64.0),
+        size: Vec2::splat(128.0),
+        scale,
+    };
+    (handle, density)
+}

@@ -1,0 +1,180 @@
+//! Instanced classes: dense foliage (grass, flowers, pebbles) without an entity per instance.
+//!
+//! A class whose look is [`ClassLook::Instanced`](crate::ClassLook::Instanced) is packed,
+//! in the chunk's generation task on the async compute pool, into one [`InstanceBuffer`] per
+//! chunk: [`GpuInstance`]s of 24 bytes, positions relative to the chunk's corner so that
+//! precision holds far from the origin. One entity per (chunk, class) carries it as an
+//! [`InstancedChunk`] with an `Aabb` for frustum culling; the render plugin
+//! ([`RwtInstancingPlugin`]) draws each with one instanced draw call.
+//!
+//! Each instance also stores the level-of-detail factor at which its point appears (its
+//! rank over the local density). The vertex shader grows an instance in over a band of
+//! that factor as the viewer approaches and shrinks it out as the viewer leaves, so a
+//! layer with a [`Falloff`](rwt_core::streaming::Falloff) neither pops when chunks change
+//! band nor at the streaming edge.
+
+mod pack;
+mod plugin;
+mod render;
+
+pub(crate) use pack::{InstancedClasses, PackedClass};
+pub use plugin::RwtInstancingPlugin;
+
+use bevy::camera::visibility::{self, VisibilityClass};
+use bevy::prelude::*;
+use bytemuck::{Pod, Zeroable};
+use rwt_core::query::PointId;
+use rwt_core::streaming::ChunkCoord;
+use std::sync::Arc;
+
+/// How an instanced class is shaded: a blade-like gradient from root to tip, lit by the
+/// scene's lights, with a hashed colour variation per instance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstancedMaterial {
+    /// Colour at the root (the mesh's lowest point).
+    pub base_color: Color,
+    /// Colour at the tip (the mesh's highest point).
+    pub tip_color: Color,
+    /// Strength of the per-instance colour variation, hashed from its point (0..1).
+    pub color_variation: f32,
+    /// Perceptual roughness of the surface.
+    pub roughness: f32,
+    /// How far the tip sways in the wind, in mesh heights per unit of wind strength; 0 for
+    /// rigid instances (pebbles).
+    pub wind_response: f32,
+    /// Width of the fade-in band, as a fraction of the level-of-detail factor: an instance
+    /// grows from nothing to full size while the factor rises by this much past the one at
+    /// which its point appears.
+    pub fade_band: f32,
+}
+
+impl Default for InstancedMaterial {
+    fn default() -> Self {
+        Self {
+            base_color: Color::srgb(0.10, 0.22, 0.04),
+            tip_color: Color::srgb(0.45, 0.62, 0.20),
+            color_variation: 0.25,
+            roughness: 0.8,
+            wind_response: 0.25,
+            fade_band: 0.1,
+        }
+    }
+}
+
+/// The look of an instanced class: one mesh drawn for every instance.
+#[derive(Clone, Debug)]
+pub struct InstancedLook {
+    /// The mesh (positions required; normals used when present). Its local y is up: the
+    /// root is its lowest point and the tip its highest.
+    pub mesh: Handle<Mesh>,
+    /// Its shading.
+    pub material: InstancedMaterial,
+}
+
+/// Wind for every instanced class: sway from a world-space noise field, coherent across
+/// chunk borders.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct RwtWind {
+    /// Direction on the ground (x, z); normalized by the shader.
+    pub direction: Vec2,
+    /// Strength: 0 is still air, 1 a stiff breeze.
+    pub strength: f32,
+    /// Spatial frequency of the gusts, cycles per world unit.
+    pub frequency: f32,
+    /// How fast the gusts travel, world units per second.
+    pub speed: f32,
+}
+
+impl Default for RwtWind {
+    fn default() -> Self {
+        Self {
+            direction: Vec2::new(1.0, 0.3),
+            strength: 0.5,
+            frequency: 0.05,
+            speed: 4.0,
+        }
+    }
+}
+
+/// One instance as the GPU reads it: 24 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuInstance {
+    /// Position relative to the chunk's corner (x, height, z).
+    pub offset: [f32; 3],
+    /// Uniform scale.
+    pub scale: f32,
+    /// Turn about y, as a fraction of a full turn (`u16::MAX` is one turn).
+    pub yaw: u16,
+    /// Level-of-detail factor at which the point appears, `0..=u16::MAX` for 0..=1.
+    pub appear: u16,
+    /// Colour variation hashed from the point, `0..=u16::MAX` for 0..=1.
+    pub tint: u16,
+    /// Padding (keeps the stride a multiple of 8).
+    pub reserved: u16,
+}
+
+/// Bytes per instance on the GPU.
+pub const GPU_BYTES_PER_INSTANCE: usize = std::mem::size_of::<GpuInstance>();
+
+impl GpuInstance {
+    /// The turn about y, radians in `[0, 2 pi)`.
+    pub fn yaw_radians(&self) -> f32 {
+        self.yaw as f32 / 65_536.0 * std::f32::consts::TAU
+    }
+
+    /// The level-of-detail factor at which the instance appears, 0..=1.
+    pub fn appear_factor(&self) -> f32 {
+        self.appear as f32 / u16::MAX as f32
+    }
+}
+
+/// A chunk's instances of one class, packed for the GPU.
+#[derive(Debug, Default)]
+pub struct InstanceBuffer {
+    /// The instances, in query order.
+    pub instances: Vec<GpuInstance>,
+    /// The identities of the instances, in the same order, when
+    /// [`RwtSettings::keep_instance_ids`](crate::RwtSettings::keep_instance_ids) is set
+    /// (tests and tools; 24 more bytes per instance on the CPU); empty otherwise.
+    pub ids: Vec<PointId>,
+    /// Bounds of the instances' positions relative to the chunk corner.
+    pub bounds: (Vec3, Vec3),
+}
+
+/// One chunk's instances of one instanced class: drawn by [`RwtInstancingPlugin`] with one
+/// instanced draw, culled by its `Aabb`.
+#[derive(Component, Clone, Debug)]
+#[require(Transform, Visibility, VisibilityClass)]
+#[component(on_add = visibility::add_visibility_class::<InstancedChunk>)]
+pub struct InstancedChunk {
+    /// The layer entity.
+    pub layer: Entity,
+    /// The chunk.
+    pub chunk: ChunkCoord,
+    /// The class index in the layer.
+    pub class: u16,
+    /// The mesh every instance draws.
+    pub mesh: Handle<Mesh>,
+    /// The shading.
+    pub material: InstancedMaterial,
+    /// Height of the mesh's top above its origin (the tip, which sways most).
+    pub mesh_top: f32,
+    /// Level-of-detail fall-off of the layer (`near`, `far`), for the shader's fade; `None`
+    /// when the layer has none (instances stay at full size).
+    pub falloff: Option<(f32, f32)>,
+    /// The instances (shared with the render world without copying).
+    pub buffer: Arc<InstanceBuffer>,
+}
+
+impl InstancedChunk {
+    /// Instances in the chunk.
+    pub fn len(&self) -> usize {
+        self.buffer.instances.len()
+    }
+
+    /// Whether the chunk holds no instance.
+    pub fn is_empty(&self) -> bool {
+        self.buffer.instances.is_empty()
+    }
+}

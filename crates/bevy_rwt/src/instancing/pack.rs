@@ -1,0 +1,157 @@
+//! Packing a chunk's points of instanced classes into GPU-ready buffers, in the generation
+//! task (off the main thread).
+
+use super::{GpuInstance, InstanceBuffer};
+use crate::layers::{ClassLook, GroundPlane, HeightFn, ScatterLayer};
+use bevy::prelude::*;
+use glam::DVec2;
+use rwt_core::density::{Density, sanitize};
+use rwt_core::query::Point;
+use std::sync::Arc;
+
+/// Salt of the hashed colour variation.
+const TINT_SALT: u64 = 0x7117;
+
+/// What packing needs of a layer: which classes are instanced, with their scale.
+#[derive(Clone, Debug)]
+pub(crate) struct InstancedClasses {
+    /// Per class: `(scale, scale variation)` when instanced.
+    classes: Arc<[Option<(f32, f32)>]>,
+    seed: u64,
+    keep_ids: bool,
+    /// Whether the layer's plane can show them (the x-z ground only); their points are left
+    /// out otherwise.
+    drawable: bool,
+}
+
+/// A chunk's instances of one class, ready for the GPU.
+pub(crate) struct PackedClass {
+    pub class: u16,
+    pub buffer: Arc<InstanceBuffer>,
+}
+
+impl InstancedClasses {
+    /// The instanced classes of `layer` (logs an error when its plane cannot show them).
+    pub fn new(entity: Entity, layer: &ScatterLayer, keep_ids: bool) -> Self {
+        let classes = layer
+            .classes
+            .iter()
+            .map(|c| match c.look {
+                ClassLook::Instanced(_) => Some((c.scale, c.scale_variation)),
+                _ => None,
+            })
+            .collect();
+        let packing = Self {
+            classes,
+            seed: layer.seed,
+            keep_ids,
+            drawable: layer.plane == GroundPlane::Xz,
+        };
+        if packing.any() && !packing.drawable {
+            error!(
+                "scatter layer {entity}: instanced classes are drawn on GroundPlane::Xz only; \
+                 their points are left out on {:?}",
+                layer.plane
+            );
+        }
+        packing
+    }
+
+    /// Whether any class is instanced.
+    pub fn any(&self) -> bool {
+        self.classes.iter().any(Option::is_some)
+    }
+
+    /// Whether points of `class` are packed rather than spawned.
+    pub fn is_instanced(&self, class: u16) -> bool {
+        matches!(self.classes.get(class as usize), Some(Some(_)))
+    }
+
+    /// Moves the points of instanced classes out of `points` into one buffer per class
+    /// (every instanced class gets one, empty or not, so that emptied chunks are cleared).
+    /// `densities` are the class densities the chunk was queried with, at level-of-detail
+    /// `factor`; `corner` is the chunk's corner, which positions are relative to.
+    pub fn pack(
+        &self,
+        points: &mut Vec<Point>,
+        corner: DVec2,
+        height: &HeightFn,
+        densities: &[impl Density],
+        factor: f64,
+    ) -> Vec<PackedClass> {
+        let mut buffers: Vec<InstanceBuffer> = self
+            .classes
+            .iter()
+            .map(|_| InstanceBuffer::default())
+            .collect();
+        points.retain(|p| {
+            if !self.is_instanced(p.class) {
+                return true;
+            }
+            let appear = appear_factor(p, densities, factor);
+            let buffer = &mut buffers[p.class as usize];
+            buffer
+                .instances
+                .push(self.instance(p, corner, height, appear));
+            if self.keep_ids {
+                buffer.ids.push(p.id);
+            }
+            false
+        });
+        buffers
+            .into_iter()
+            .enumerate()
+            .filter(|(class, _)| self.drawable && self.classes[*class].is_some())
+            .map(|(class, mut buffer)| {
+                buffer.bounds = bounds(&buffer.instances);
+                PackedClass {
+                    class: class as u16,
+                    buffer: Arc::new(buffer),
+                }
+            })
+            .collect()
+    }
+
+    /// One instance: the same place, turn and scale as the entity path would give it.
+    fn instance(&self, p: &Point, corner: DVec2, height: &HeightFn, appear: f64) -> GpuInstance {
+        let (scale, variation) = self.classes[p.class as usize].unwrap_or((1.0, 0.0));
+        let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+        let offset = p.position - corner;
+        GpuInstance {
+            offset: [offset.x as f32, height(ground), offset.y as f32],
+            scale: scale * p.id.scale(self.seed, variation as f64) as f32,
+            yaw: unit_u16(p.id.rotation(self.seed) / std::f64::consts::TAU),
+            appear: unit_u16(appear),
+            tint: unit_u16(p.id.unit(self.seed, TINT_SALT)),
+            reserved: 0,
+        }
+    }
+}
+
+/// The level-of-detail factor at which `p` appears: its threshold over the summed density
+/// at full detail (the query ran at `factor` times it).
+fn appear_factor(p: &Point, densities: &[impl Density], factor: f64) -> f64 {
+    let total: f64 = densities
+        .iter()
+        .map(|d| sanitize(d.density(p.position)))
+        .sum();
+    if total > 0.0 {
+        (p.threshold / total * factor).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// `v` in `[0, 1]` as a 16-bit fraction (`1` saturates at `u16::MAX`).
+fn unit_u16(v: f64) -> u16 {
+    (v * 65_536.0).clamp(0.0, u16::MAX as f64) as u16
+}
+
+/// Bounds of the instances' offsets (zero for no instance).
+fn bounds(instances: &[GpuInstance]) -> (Vec3, Vec3) {
+    let mut it = instances.iter().map(|i| Vec3::from_array(i.offset));
+    let Some(first) = it.next() else {
+        return (Vec3::ZERO, Vec3::ZERO);
+    };
+    it.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v)))
+}

@@ -1,0 +1,219 @@
+//! Instanced classes hold exactly what the entity path would spawn: the same points, places,
+//! turns, scales and classes, through level-of-detail changes, painting and a return to the
+//! start; and their chunk entities never leak.
+
+mod common;
+
+use bevy::prelude::*;
+use bevy_rwt::instancing::InstancedChunk;
+use bevy_rwt::prelude::*;
+use bevy_rwt::rwt_core::query::PointId;
+use common::*;
+use std::collections::{HashMap, HashSet};
+
+/// What an instance is: where, turned how far, how large, of which class.
+#[derive(Clone, Copy, Debug)]
+struct Placed {
+    position: Vec3,
+    yaw: f32,
+    scale: f32,
+    class: u16,
+}
+
+/// A layer with an entity class (sparse) and a second class on a painted map, entity or
+/// instanced, with a level-of-detail fall-off.
+fn two_class_layer(app: &mut App, instanced: bool) -> Handle<Image> {
+    let (map, painted) = gray_map(app, 0.8);
+    let bushes = ScatterClass::new(LayerDensity::Constant(0.05), default(), default());
+    let grass = if instanced {
+        ScatterClass::instanced(painted, default(), InstancedMaterial::default())
+    } else {
+        ScatterClass::new(painted, default(), default())
+    };
+    let mut l = layer(LayerDensity::Constant(0.0)).with_falloff(10.0, 70.0);
+    l.classes = vec![bushes, grass];
+    l.streaming.load_distance = 80.0;
+    l.streaming.unload_distance = 96.0;
+    app.world_mut().spawn(l);
+    map
+}
+
+fn instanced_app() -> App {
+    let mut app = create_app();
+    app.world_mut()
+        .resource_mut::<RwtSettings>()
+        .keep_instance_ids = true;
+    app
+}
+
+/// Every live instance of either path, by identity.
+fn placed(app: &mut App) -> HashMap<PointId, Placed> {
+    let mut out = HashMap::new();
+    let mut entities = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    for (i, t) in entities.iter(app.world()) {
+        let (yaw, _, _) = t.rotation.to_euler(EulerRot::YXZ);
+        let p = Placed {
+            position: t.translation,
+            yaw: yaw.rem_euclid(std::f32::consts::TAU),
+            scale: t.scale.x,
+            class: i.class,
+        };
+        assert!(out.insert(i.id, p).is_none(), "{:?} twice", i.id);
+    }
+    let mut chunks = app.world_mut().query::<(&InstancedChunk, &Transform)>();
+    for (c, t) in chunks.iter(app.world()) {
+        assert_eq!(c.buffer.ids.len(), c.len(), "ids kept beside the buffer");
+        for (id, g) in c.buffer.ids.iter().zip(&c.buffer.instances) {
+            let p = Placed {
+                position: t.translation + Vec3::from_array(g.offset),
+                yaw: g.yaw_radians(),
+                scale: g.scale,
+                class: c.class,
+            };
+            assert!(out.insert(*id, p).is_none(), "{id:?} twice");
+        }
+    }
+    out
+}
+
+fn assert_same(entities: &HashMap<PointId, Placed>, instanced: &HashMap<PointId, Placed>) {
+    let a: HashSet<_> = entities.keys().collect();
+    let b: HashSet<_> = instanced.keys().collect();
+    assert_eq!(a.len(), b.len(), "instance counts differ");
+    assert!(a == b, "different points");
+    for (id, e) in entities {
+        let i = &instanced[id];
+        assert_eq!(e.class, i.class, "{id:?}");
+        assert_eq!(e.scale, i.scale, "{id:?}");
+        assert!(
+            e.position.distance(i.position) < 1e-3,
+            "{id:?}: {e:?} vs {i:?}"
+        );
+        let turn = (e.yaw - i.yaw).rem_euclid(std::f32::consts::TAU);
+        assert!(
+            turn.min(std::f32::consts::TAU - turn) < 2e-4,
+            "{id:?}: {e:?} vs {i:?}"
+        );
+    }
+}
+
+/// One (chunk, class) entity per loaded chunk with instances of the class; none elsewhere.
+fn assert_no_leak(app: &mut App) {
+    let mut statuses = app.world_mut().query::<&ScatterLayerStatus>();
+    let loaded: HashSet<_> = statuses
+        .iter(app.world())
+        .flat_map(|s| s.loaded_chunks.iter().copied())
+        .collect();
+    let live_instanced: usize = statuses.iter(app.world()).map(|s| s.live_instanced).sum();
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    let mut seen = HashSet::new();
+    let mut held = 0;
+    for c in chunks.iter(app.world()) {
+        assert!(loaded.contains(&c.chunk), "{:?} is not loaded", c.chunk);
+        assert!(!c.is_empty(), "an empty chunk entity stays");
+        assert!(
+            seen.insert((c.chunk, c.class)),
+            "two entities for {:?}",
+            c.chunk
+        );
+        held += c.len();
+    }
+    assert_eq!(held, live_instanced, "status counts what the chunks hold");
+}
+
+#[test]
+fn instanced_chunks_hold_what_entities_would() {
+    let path = [
+        Vec3::ZERO,
+        Vec3::new(40.0, 0.0, 10.0),
+        Vec3::new(90.0, 0.0, -20.0),
+    ];
+    let mut apps = [create_app(), instanced_app()];
+    let maps: Vec<_> = apps
+        .iter_mut()
+        .enumerate()
+        .map(|(i, app)| two_class_layer(app, i == 1))
+        .collect();
+    let viewers: Vec<_> = apps
+        .iter_mut()
+        .map(|app| spawn_viewer(app, path[0]))
+        .collect();
+    let compare = |apps: &mut [App; 2], step: &str| {
+        for app in apps.iter_mut() {
+            tick_app(app, 4_000);
+        }
+        let (entities, instanced) = (placed(&mut apps[0]), placed(&mut apps[1]));
+        assert!(
+            entities.len() > 1_000,
+            "{step}: {} instances",
+            entities.len()
+        );
+        assert_same(&entities, &instanced);
+        assert_no_leak(&mut apps[1]);
+        let stats = apps[1].world().resource::<RwtStats>();
+        assert!(stats.live_instanced > 500, "{step}: {stats:?}");
+    };
+    compare(&mut apps, "start");
+    for at in &path[1..] {
+        for (app, v) in apps.iter_mut().zip(&viewers) {
+            move_viewer(app, *v, *at);
+        }
+        compare(&mut apps, "flight");
+    }
+    for (app, map) in apps.iter_mut().zip(&maps) {
+        paint_square(app, map, 40, 40, Color::WHITE);
+    }
+    compare(&mut apps, "painted");
+    for (app, v) in apps.iter_mut().zip(&viewers) {
+        move_viewer(app, *v, path[0]);
+    }
+    compare(&mut apps, "back at the start");
+}
+
+#[test]
+fn instanced_chunks_go_with_their_layer() {
+    let mut app = instanced_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    two_class_layer(&mut app, true);
+    tick_app(&mut app, 4_000);
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    assert!(chunks.iter(app.world()).count() > 4);
+    let layer = app
+        .world_mut()
+        .query_filtered::<Entity, With<ScatterLayer>>()
+        .single(app.world())
+        .unwrap();
+    app.world_mut().despawn(layer);
+    tick_app(&mut app, 100);
+    assert_eq!(chunks.iter(app.world()).count(), 0, "chunk entities leaked");
+}
+
+#[test]
+fn instances_appear_at_their_level_of_detail_factor() {
+    // Far from the viewer the fall-off keeps fewer points: every kept point appears at a
+    // factor below its chunk's, so the shader can grow it in before its neighbours come.
+    let mut app = instanced_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    two_class_layer(&mut app, true);
+    tick_app(&mut app, 4_000);
+    let mut chunks = app.world_mut().query::<(&InstancedChunk, &Transform)>();
+    let mut by_distance = Vec::new();
+    for (c, t) in chunks.iter(app.world()) {
+        for g in &c.buffer.instances {
+            let p = t.translation + Vec3::from_array(g.offset);
+            by_distance.push((Vec2::new(p.x, p.z).length(), g.appear_factor()));
+        }
+    }
+    // Fall-off: full within 10, none from 70.
+    let factor = |d: f32| (1.0 - (d - 10.0) / 60.0).clamp(0.0, 1.0);
+    let band = 60.0 / 8.0;
+    for (d, appear) in &by_distance {
+        // Generated for the chunk's nearest band: at most one band and a chunk above.
+        assert!(
+            *appear <= factor(d - 16.0 * 1.5 - band) + 1e-3,
+            "{d}: {appear}"
+        );
+    }
+    let spread: HashSet<_> = by_distance.iter().map(|(_, a)| (a * 10.0) as i32).collect();
+    assert!(spread.len() >= 8, "appearance factors spread over [0, 1]");
+}
