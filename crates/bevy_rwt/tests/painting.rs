@@ -33,16 +33,7 @@ fn painting_changes_only_the_painted_region() {
 fn painting_an_exclusion_map_removes_only_what_it_covers() {
     let mut app = create_app();
     spawn_viewer(&mut app, Vec3::ZERO);
-    let handle = app
-        .world_mut()
-        .resource_mut::<Assets<Image>>()
-        .add(solid_image(64, [0, 0, 0, 255]));
-    let mask = LayerDensity::Image {
-        image: handle.clone(),
-        min: Vec2::splat(-64.0),
-        size: Vec2::splat(128.0),
-        scale: 1.0,
-    };
+    let (handle, mask) = solid_map(&mut app, [0, 0, 0, 255], 1.0);
     app.world_mut()
         .spawn(layer(LayerDensity::Constant(0.5)).with_exclusion(mask));
     tick_app(&mut app, 2_000);
@@ -73,7 +64,6 @@ fn painting_an_exclusion_map_removes_only_what_it_covers() {
     );
 }
 
-/// A gray 64-texel map over -64..64 (x, z), its handle, and the density that reads it.
 #[test]
 fn a_painted_region_message_limits_what_re_scatters() {
     // The same stroke twice: once announced with its region, once not. Only chunks under

@@ -88,6 +88,9 @@ impl InstancedClasses {
             if !self.is_instanced(p.class) {
                 return true;
             }
+            if !self.drawable {
+                return false;
+            }
             let appear = appear_factor(p, densities, factor);
             let buffer = &mut buffers[p.class as usize];
             buffer

@@ -127,10 +127,16 @@ pub fn instances(app: &mut App) -> HashMap<PointId, Vec3> {
 /// A mid-grey 64-texel density map over -64..64 (x and z) times `scale`, and the layer
 /// density reading it.
 pub fn gray_map(app: &mut App, scale: f64) -> (Handle<Image>, LayerDensity) {
+    solid_map(app, [128, 128, 128, 255], scale)
+}
+
+/// A 64-texel map of one colour over -64..64 (x and z) times `scale`, and the layer density
+/// reading it.
+pub fn solid_map(app: &mut App, rgba: [u8; 4], scale: f64) -> (Handle<Image>, LayerDensity) {
     let handle = app
         .world_mut()
         .resource_mut::<Assets<Image>>()
-        .add(solid_image(64, [128, 128, 128, 255]));
+        .add(solid_image(64, rgba));
     let density = LayerDensity::Image {
         image: handle.clone(),
         min: Vec2::splat(-64.0),
