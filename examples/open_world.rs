@@ -11,6 +11,7 @@ use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::pbr::{DistanceFog, FogFalloff};
 use bevy::prelude::*;
+use bevy_rwt::instancing::blade_mesh;
 use bevy_rwt::prelude::*;
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rwt_core::density::{NoiseDensity, NoiseParams};
@@ -180,7 +181,7 @@ fn looks(meshes: &mut Assets<Mesh>, materials: &mut Assets<StandardMaterial>) ->
             .scaled_by(Vec3::new(1.2, 0.7, 1.2))
             .translated_by(Vec3::Y * 0.4),
     );
-    let blade = meshes.add(blade_mesh());
+    let blade = meshes.add(blade_mesh(0.09, 0.72, 0.12));
 
     Looks {
         conifer: (conifer, solid(Color::srgb(0.09, 0.24, 0.12))),
@@ -296,36 +297,6 @@ fn grass(terrain: &Terrain, looks: &Looks) -> ScatterLayer {
         .with_falloff(25.0, 105.0)
         .with_height(terrain.source())
         .with_height_range(WATER + 0.3, 90.0)
-}
-
-/// A grass blade: a tapered, slightly curved strip 0.7 m high, facing +z.
-fn blade_mesh() -> Mesh {
-    let rows = [
-        (0.0, 0.045, 0.0),
-        (0.25, 0.04, 0.02),
-        (0.5, 0.03, 0.06),
-        (0.72, 0.0, 0.12),
-    ];
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    for &(y, half, bend) in &rows {
-        for side in [-1.0f32, 1.0] {
-            positions.push([side * half, y, bend]);
-            normals.push([0.0, 0.35, 1.0]);
-        }
-    }
-    let mut indices = Vec::new();
-    for r in 0..rows.len() as u32 - 1 {
-        let (a, b, c, d) = (2 * r, 2 * r + 1, 2 * r + 2, 2 * r + 3);
-        indices.extend([a, b, d, a, d, c]);
-    }
-    Mesh::new(
-        PrimitiveTopology::TriangleList,
-        RenderAssetUsages::default(),
-    )
-    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
-    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, normals)
-    .with_inserted_indices(Indices::U32(indices))
 }
 
 /// The smoke session's flight: 1.5 km along a gentle curve, 22 m above the ground.

@@ -136,6 +136,12 @@ impl RwtPlugin {
         self
     }
 
+    /// Most instances of instanced classes handed to their chunk entities per frame.
+    pub fn with_upload_budget(mut self, n: usize) -> Self {
+        self.settings.upload_budget = n;
+        self
+    }
+
     /// Most generation tasks in flight per layer.
     pub fn with_max_tasks(mut self, n: usize) -> Self {
         self.settings.max_tasks_in_flight = n.max(1);
@@ -173,7 +179,7 @@ impl Plugin for RwtPlugin {
             layers::RwtLayersPlugin { schedule },
             streaming::RwtStreamingPlugin { schedule, tile_set },
             diagnostics::RwtDiagnosticsPlugin { schedule },
-            instancing::RwtInstancingPlugin,
+            instancing::RwtInstancingPlugin { schedule },
         ));
     }
 }

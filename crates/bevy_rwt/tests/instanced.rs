@@ -4,8 +4,10 @@
 
 mod common;
 
+use bevy::asset::RenderAssetUsages;
+use bevy::mesh::PrimitiveTopology;
 use bevy::prelude::*;
-use bevy_rwt::instancing::InstancedChunk;
+use bevy_rwt::instancing::{InstancedChunk, InstancedClassError};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
 use common::*;
@@ -216,4 +218,90 @@ fn instances_appear_at_their_level_of_detail_factor() {
     }
     let spread: HashSet<_> = by_distance.iter().map(|(_, a)| (a * 10.0) as i32).collect();
     assert!(spread.len() >= 8, "appearance factors spread over [0, 1]");
+}
+
+/// A mesh of `topology` with these positions and normals.
+fn mesh(topology: PrimitiveTopology, positions: usize, normals: usize) -> Mesh {
+    let mut m = Mesh::new(topology, RenderAssetUsages::default());
+    if positions > 0 {
+        let p: Vec<[f32; 3]> = (0..positions).map(|i| [i as f32, i as f32, 0.0]).collect();
+        m.insert_attribute(Mesh::ATTRIBUTE_POSITION, p);
+    }
+    if normals > 0 {
+        m.insert_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0, 0.0, 1.0]; normals]);
+    }
+    m
+}
+
+/// The class errors of the only layer.
+fn class_errors(app: &mut App) -> Vec<(u16, InstancedClassError)> {
+    let mut q = app.world_mut().query::<&ScatterLayerStatus>();
+    q.single(app.world()).unwrap().class_errors.clone()
+}
+
+#[test]
+fn meshes_that_cannot_be_drawn_are_reported_per_class() {
+    use InstancedClassError::*;
+    let mut app = create_app_with(|app| {
+        app.init_asset::<Mesh>();
+    });
+    let mut meshes = app.world_mut().resource_mut::<Assets<Mesh>>();
+    let list = PrimitiveTopology::TriangleList;
+    let looks = [
+        meshes.add(mesh(list, 3, 3)),
+        meshes.add(mesh(list, 0, 0)),
+        meshes.add(mesh(PrimitiveTopology::LineList, 2, 0)),
+        meshes.add(mesh(list, 3, 2)),
+        meshes.add(mesh(list, 0, 0)),
+    ];
+    // The last mesh is given positions but no vertex.
+    let empty: Vec<[f32; 3]> = Vec::new();
+    meshes
+        .get_mut(&looks[4])
+        .unwrap()
+        .insert_attribute(Mesh::ATTRIBUTE_POSITION, empty);
+    let classes = looks
+        .iter()
+        .map(|m| ScatterClass::instanced(LayerDensity::Constant(0.1), m.clone(), default()))
+        .collect();
+    let mut l = layer(LayerDensity::Constant(0.0));
+    l.classes = classes;
+    app.world_mut().spawn(l);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    tick_app(&mut app, 4_000);
+    let normals = AttributeLength {
+        attribute: Mesh::ATTRIBUTE_NORMAL.name.to_string(),
+        len: 2,
+        vertices: 3,
+    };
+    assert_eq!(
+        class_errors(&mut app),
+        [
+            (1, MissingPositions),
+            (2, Topology(PrimitiveTopology::LineList)),
+            (3, normals.clone()),
+            (4, Empty)
+        ]
+    );
+    // The classes still stream (every class has chunks) and nothing panicked.
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    let classes: HashSet<u16> = chunks.iter(app.world()).map(|c| c.class).collect();
+    assert_eq!(classes.len(), 5);
+
+    // Fixed meshes are checked again.
+    let mut meshes = app.world_mut().resource_mut::<Assets<Mesh>>();
+    *meshes.get_mut(&looks[1]).unwrap() = mesh(list, 3, 3);
+    *meshes.get_mut(&looks[2]).unwrap() = mesh(PrimitiveTopology::TriangleStrip, 4, 0);
+    app.update();
+    app.update();
+    assert_eq!(class_errors(&mut app), [(3, normals), (4, Empty)]);
+
+    // A layer on the x-y plane cannot draw instanced classes.
+    let mut q = app.world_mut().query::<&mut ScatterLayer>();
+    let mut layer = q.single_mut(app.world_mut()).unwrap();
+    layer.plane = GroundPlane::Xy;
+    app.update();
+    let errors = class_errors(&mut app);
+    assert_eq!(errors.len(), 5, "{errors:?}");
+    assert!(errors.iter().all(|(_, e)| *e == Plane(GroundPlane::Xy)));
 }

@@ -15,7 +15,8 @@ fn a_layer_file_loads_and_reloads() {
     std::fs::write(
         dir.join("meadow.layer.ron"),
         r#"(tile_size: 8.0, seed: 3, chunk_size: 16.0, load_distance: 48.0, unload_distance: 64.0,
-            classes: [(density: Constant(0.25), mesh: Cone(radius: 0.5, height: 2.0), material: Color(0.1, 0.5, 0.1))])"#,
+            classes: [(density: Constant(0.25), mesh: Cone(radius: 0.5, height: 2.0), material: Color(0.1, 0.5, 0.1)),
+                      (density: Constant(2.0), mesh: Blade(width: 0.1, height: 0.5), material: Instanced(wind_response: 0.4))])"#,
     )
     .unwrap();
     let mut app = app_reading(&dir);
@@ -42,6 +43,15 @@ fn a_layer_file_loads_and_reloads() {
     tick_app(&mut app, 2_000);
     let first = instances(&mut app).len();
     assert!(first > 100);
+    // The instanced class streams into chunk buffers, drawn with the file's blade.
+    let status = app.world().get::<ScatterLayerStatus>(entity).unwrap();
+    let ratio = status.live_instanced as f64 / first as f64;
+    assert!((ratio - 8.0).abs() < 1.0, "{first} and {status:?}");
+    assert!(status.class_errors.is_empty(), "{status:?}");
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    let chunk = chunks.iter(app.world()).next().unwrap();
+    assert_eq!(chunk.material.wind_response, 0.4);
+    assert!((chunk.mesh_top - 0.5).abs() < 1e-6, "the blade is loaded");
     // What a file watcher does on save: the asset changes, the layer restreams.
     {
         let mut assets = app.world_mut().resource_mut::<Assets<ScatterLayerAsset>>();

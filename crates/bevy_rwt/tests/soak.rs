@@ -6,6 +6,7 @@ mod common;
 
 use bevy::asset::AssetPlugin;
 use bevy::prelude::*;
+use bevy_rwt::instancing::{GpuInstance, InstancedChunk};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
 use bevy_rwt::rwt_core::rng::Rng;
@@ -15,22 +16,45 @@ use std::collections::HashMap;
 /// Frames of the walk (each one `app.update()`, without waiting for streaming to settle).
 const FRAMES: usize = 10_000;
 
-/// Live instances by (layer seed, identity); panics when one layer has two instances with
-/// the same identity.
+/// Live instances, entity or instanced, by (layer seed, identity); panics when one layer
+/// has two instances with the same identity.
 fn instances(app: &mut App) -> HashMap<(u64, PointId), Vec3> {
     let mut layers = app.world_mut().query::<(Entity, &ScatterLayer)>();
     let seeds: HashMap<Entity, u64> = layers.iter(app.world()).map(|(e, l)| (e, l.seed)).collect();
-    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
     let mut out = HashMap::new();
-    for (i, t) in q.iter(app.world()) {
-        let seed = seeds[&i.layer];
+    let mut insert = |seed: u64, id: PointId, at: Vec3| {
         assert!(
-            out.insert((seed, i.id), t.translation).is_none(),
-            "two live instances of layer {seed} share {:?}",
-            i.id
+            out.insert((seed, id), at).is_none(),
+            "two live instances of layer {seed} share {id:?}"
         );
+    };
+    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    for (i, t) in q.iter(app.world()) {
+        insert(seeds[&i.layer], i.id, t.translation);
+    }
+    let mut chunks = app.world_mut().query::<(&InstancedChunk, &Transform)>();
+    for (c, t) in chunks.iter(app.world()) {
+        for (id, g) in c.buffer.ids.iter().zip(&c.buffer.instances) {
+            insert(
+                seeds[&c.layer],
+                *id,
+                t.translation + Vec3::from_array(g.offset),
+            );
+        }
     }
     out
+}
+
+/// Bytes held by instanced chunk buffers (instances and the identities kept for the test).
+fn buffer_bytes(app: &mut App) -> usize {
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    chunks
+        .iter(app.world())
+        .map(|c| {
+            c.buffer.instances.capacity() * size_of::<GpuInstance>()
+                + c.buffer.ids.capacity() * size_of::<PointId>()
+        })
+        .sum()
 }
 
 /// Entities in the world.
@@ -63,6 +87,8 @@ struct Soak {
 #[derive(Default)]
 struct Peaks {
     live: usize,
+    live_instanced: usize,
+    buffer_bytes: usize,
     entities: usize,
     queued: usize,
     rss_after_warm_up: u64,
@@ -79,8 +105,12 @@ impl Soak {
             RwtPlugin::default()
                 .with_spawn_budget(400)
                 .with_despawn_budget(400)
+                .with_upload_budget(3_000)
                 .with_max_tasks(6),
         ));
+        app.world_mut()
+            .resource_mut::<RwtSettings>()
+            .keep_instance_ids = true;
         app.finish();
         app.cleanup();
         let viewer = spawn_viewer(&mut app, Vec3::ZERO);
@@ -98,6 +128,13 @@ impl Soak {
         .with_seed(5)
         .with_falloff(20.0, 48.0);
         app.world_mut().spawn(painted);
+        // Instanced grass, with a fall-off so that chunks change band as the walk goes.
+        let grass = ScatterClass::instanced(LayerDensity::Constant(0.5), default(), default());
+        let mut instanced = layer(LayerDensity::Constant(0.0))
+            .with_seed(11)
+            .with_falloff(20.0, 56.0);
+        instanced.classes = vec![grass];
+        app.world_mut().spawn(instanced);
         let constant = layer(LayerDensity::Constant(0.2));
         let second = app.world_mut().spawn(constant.clone()).id();
         Self {
@@ -137,8 +174,10 @@ impl Soak {
         app.update();
         let live = instances(app).len(); // panics on a duplicate PointId
         let stats = app.world().resource::<RwtStats>().clone();
-        assert_eq!(live, stats.live_instances);
-        peaks.live = peaks.live.max(live);
+        assert_eq!(live, stats.live_instances + stats.live_instanced);
+        peaks.live = peaks.live.max(stats.live_instances);
+        peaks.live_instanced = peaks.live_instanced.max(stats.live_instanced);
+        peaks.buffer_bytes = peaks.buffer_bytes.max(buffer_bytes(app));
         peaks.entities = peaks.entities.max(entity_count(app));
         // Waiting work never outgrows the loaded chunks it belongs to.
         assert!(stats.pending_tasks <= stats.loaded_chunks, "{stats:?}");
@@ -186,7 +225,8 @@ impl Soak {
     }
 }
 
-/// Bounded: two layers of at most 0.6 and 0.3 per square unit over the unload disc, and
+/// Bounded: entity layers of at most 0.6 and 0.3 per square unit and an instanced one of
+/// 0.5 over the unload disc, instance buffers that hold no more than their instances, and
 /// resident memory that stops growing after the warm-up.
 fn assert_bounded(peaks: &Peaks) {
     let disc = std::f64::consts::PI * (64.0f64 + 23.0).powi(2);
@@ -199,10 +239,25 @@ fn assert_bounded(peaks: &Peaks) {
         (most_entities as f64) < 0.9 * disc + 1_000.0,
         "{most_entities} entities"
     );
+    let most_instanced = peaks.live_instanced;
+    assert!(
+        most_instanced > 1_000 && (most_instanced as f64) < 0.5 * disc,
+        "{most_instanced} live instanced"
+    );
+    // Buffers are packed to size: no more than their instances and identities, plus slack
+    // for the chunks being swapped this frame.
+    let per_instance = size_of::<GpuInstance>() + size_of::<PointId>();
+    assert!(
+        peaks.buffer_bytes <= 2 * most_instanced * per_instance,
+        "{} bytes of instance buffers for {most_instanced} instances",
+        peaks.buffer_bytes
+    );
     let grown = resident_bytes().saturating_sub(peaks.rss_after_warm_up);
     eprintln!(
         "soak: {FRAMES} frames, at most {most_live} live instances, {most_entities} entities, \
-         {} queued spawns; resident memory grew {} KiB after frame 500",
+         {most_instanced} instanced in {} KiB of buffers, {} queued spawns; resident memory \
+         grew {} KiB after frame 500",
+        peaks.buffer_bytes >> 10,
         peaks.queued,
         grown >> 10
     );
@@ -218,7 +273,7 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
     let mut soak = Soak::new();
     tick_app(&mut soak.app, 3_000);
     let start = instances(&mut soak.app);
-    let start_entities = entity_count(&mut soak.app);
+    let start_entities = other_entities(&mut soak.app);
     assert!(start.len() > 500, "{} instances at the start", start.len());
     let mut peaks = Peaks::default();
     let at = soak.walk(&mut peaks);
@@ -238,11 +293,25 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
             assert_eq!(start.get(id), Some(p), "{id:?} appeared");
         }
     }
-    // Nothing leaked: apart from instances kept by hysteresis, as many entities as before.
-    let extra = end.len() as i64 - start.len() as i64;
-    let entities = entity_count(&mut soak.app) as i64;
-    assert!(
-        (entities - start_entities as i64 - extra).abs() <= 1,
-        "{entities} entities now, {start_entities} at the start, {extra} extra instances"
-    );
+    // Nothing leaked: apart from instances and chunk entities, as many entities as before
+    // (the viewer, the layers), and one chunk entity per loaded chunk of the instanced layer.
+    assert_eq!(other_entities(&mut soak.app), start_entities);
+    let mut statuses = soak
+        .app
+        .world_mut()
+        .query::<(&ScatterLayer, &ScatterLayerStatus)>();
+    let instanced_chunks = statuses
+        .iter(soak.app.world())
+        .find(|(l, _)| l.seed == 11)
+        .map(|(_, s)| s.loaded_chunks.len())
+        .unwrap();
+    let mut chunks = soak.app.world_mut().query::<&InstancedChunk>();
+    assert!(chunks.iter(soak.app.world()).count() <= instanced_chunks);
+}
+
+/// Entities that are neither instances nor instanced chunks.
+fn other_entities(app: &mut App) -> usize {
+    let mut instances = app.world_mut().query::<&ScatterInstance>();
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    entity_count(app) - instances.iter(app.world()).count() - chunks.iter(app.world()).count()
 }

@@ -13,10 +13,14 @@
 //! layer with a [`Falloff`](rwt_core::streaming::Falloff) neither pops when chunks change
 //! band nor at the streaming edge.
 
+mod blade;
+mod mesh;
 mod pack;
 mod plugin;
 mod render;
 
+pub use blade::blade_mesh;
+pub use mesh::{InstancedClassError, InstancedMeshes, check_instanced_mesh};
 pub(crate) use pack::{InstancedClasses, PackedClass};
 pub use plugin::RwtInstancingPlugin;
 

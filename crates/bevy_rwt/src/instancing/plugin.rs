@@ -1,10 +1,12 @@
 //! The instancing feature plugin: the wind resource, and the render-world systems that draw
 //! every [`InstancedChunk`] with one instanced draw.
 
-use super::render;
-use super::{InstancedChunk, RwtWind};
+use super::{InstancedChunk, InstancedMeshes, RwtWind};
+use super::{mesh, render};
+use crate::settings::RwtSystems;
 use bevy::asset::embedded_asset;
 use bevy::core_pipeline::core_3d::Transparent3d;
+use bevy::ecs::schedule::InternedScheduleLabel;
 use bevy::pbr::MeshPipelineSystems;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
@@ -13,13 +15,27 @@ use bevy::render::render_phase::AddRenderCommand;
 use bevy::render::render_resource::SpecializedMeshPipelines;
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
-/// Draws instanced classes (part of [`crate::RwtPlugin`]). Without a renderer (headless
-/// apps, tests) it only registers the wind: chunk buffers are still made and counted.
-pub struct RwtInstancingPlugin;
+/// Draws instanced classes (part of [`crate::RwtPlugin`]) and reports classes it cannot
+/// draw in their layer's [`crate::ScatterLayerStatus::class_errors`]. Without a renderer
+/// (headless apps, tests) chunk buffers are still made and counted.
+pub struct RwtInstancingPlugin {
+    /// Schedule of the main-world systems.
+    pub schedule: InternedScheduleLabel,
+}
 
 impl Plugin for RwtInstancingPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<RwtWind>();
+        app.init_resource::<RwtWind>()
+            .init_resource::<InstancedMeshes>()
+            .add_systems(
+                self.schedule,
+                (
+                    mesh::forget_changed_meshes.before(RwtSystems::Apply),
+                    mesh::report_class_errors
+                        .after(RwtSystems::Apply)
+                        .before(RwtSystems::Stats),
+                ),
+            );
         if app.get_sub_app(RenderApp).is_none() {
             return;
         }

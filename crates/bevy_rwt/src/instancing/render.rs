@@ -3,6 +3,7 @@
 //! world's buffer is the same one) and a small uniform with the chunk's corner, shading,
 //! fall-off and wind.
 
+use super::mesh::check_topology;
 use super::{GpuInstance, InstanceBuffer, InstancedChunk, RwtWind};
 use bevy::core_pipeline::core_3d::{Transparent3d, TransparentSortingInfo3d};
 use bevy::ecs::query::QueryItem;
@@ -130,9 +131,18 @@ pub(super) struct InstancedPipeline {
     chunk_layout: BindGroupLayoutDescriptor,
 }
 
-/// Meshes whose pipeline could not be made, reported once each.
+/// Meshes that cannot be drawn, reported once each.
 #[derive(Resource, Default)]
 pub(super) struct ReportedMeshes(HashSet<AssetId<Mesh>>);
+
+impl ReportedMeshes {
+    /// Logs why `mesh` cannot be drawn, the first time only.
+    fn once(&mut self, mesh: AssetId<Mesh>, reason: &str) {
+        if self.0.insert(mesh) {
+            error!("instanced class mesh {mesh:?} cannot be drawn: {reason}");
+        }
+    }
+}
 
 pub(super) fn init_pipeline(
     mut commands: Commands,
@@ -309,12 +319,17 @@ pub(super) fn queue_chunks(
                     mesh.primitive_topology(),
                     mesh.index_format(),
                 );
-            let id = match pipelines.specialize(&cache, &pipeline, key, &mesh.layout) {
+            let id = check_topology(mesh.primitive_topology())
+                .map_err(|e| e.to_string())
+                .and_then(|()| {
+                    pipelines
+                        .specialize(&cache, &pipeline, key, &mesh.layout)
+                        .map_err(|e| e.to_string())
+                });
+            let id = match id {
                 Ok(id) => id,
                 Err(e) => {
-                    if reported.0.insert(chunk.mesh) {
-                        error!("instanced class mesh {:?} cannot be drawn: {e}", chunk.mesh);
-                    }
+                    reported.once(chunk.mesh, &e);
                     continue;
                 }
             };

@@ -15,12 +15,16 @@
 //!          mesh: Cone(radius: 0.6, height: 2.5), material: Color(0.15, 0.4, 0.15)),
 //!         (density: Image(path: "maps/flowers.png", min: (-128.0, -128.0), size: (256.0, 256.0), scale: 2.0),
 //!          mesh: Path("models/flower.glb#Mesh0/Primitive0"), material: Path("models/flower.glb#Material0")),
+//!         // Instanced: one draw per chunk, no entity per blade.
+//!         (density: Constant(40.0), mesh: Blade(width: 0.08, height: 0.6, bend: 0.1),
+//!          material: Instanced(tip: (0.3, 0.5, 0.1), wind_response: 0.3), scale_variation: 0.3),
 //!     ],
 //!     exclusion: Image(path: "maps/roads.png", min: (-128.0, -128.0), size: (256.0, 256.0), scale: 1.0),
 //! )
 //! ```
 
 use super::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+use crate::instancing::{InstancedMaterial, blade_mesh};
 use bevy::asset::{AssetLoader, LoadContext, io::Reader};
 use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
@@ -81,15 +85,100 @@ pub enum MeshDescription {
         /// Size on x, y, z.
         size: (f32, f32, f32),
     },
+    /// A grass blade for instanced classes (see [`crate::instancing::blade_mesh`]).
+    Blade {
+        /// Width at the root.
+        width: f32,
+        /// Height of the tip.
+        height: f32,
+        /// How far the tip curves forward.
+        #[serde(default)]
+        bend: f32,
+    },
 }
 
-/// A material in a layer file: an asset path or a plain colour (linear RGB).
+impl MeshDescription {
+    /// The mesh of a primitive; `None` for an asset path.
+    pub fn primitive(&self) -> Option<Mesh> {
+        Some(match self {
+            MeshDescription::Path(_) => return None,
+            MeshDescription::Sphere { radius } => Mesh::from(Sphere::new(*radius)),
+            MeshDescription::Cone { radius, height } => Mesh::from(Cone {
+                radius: *radius,
+                height: *height,
+            }),
+            MeshDescription::Cuboid { size } => Mesh::from(Cuboid::new(size.0, size.1, size.2)),
+            MeshDescription::Blade {
+                width,
+                height,
+                bend,
+            } => blade_mesh(*width, *height, *bend),
+        })
+    }
+}
+
+/// A material in a layer file: an asset path or a plain colour (linear RGB) for entity
+/// classes, or the shading of an instanced class.
 #[derive(Deserialize, Clone, Debug, PartialEq)]
 pub enum MaterialDescription {
     /// Asset path, e.g. `"models/tree.glb#Material0"`.
     Path(String),
     /// A plain colour.
     Color(f32, f32, f32),
+    /// The class is instanced (no entity per instance; see [`crate::instancing`]), shaded so.
+    Instanced(InstancedMaterialDescription),
+}
+
+/// The shading of an instanced class in a layer file (colours linear RGB); each field
+/// defaults to [`InstancedMaterial::default`]'s.
+#[derive(Deserialize, Clone, Debug, PartialEq)]
+#[serde(default)]
+pub struct InstancedMaterialDescription {
+    /// Colour at the root.
+    pub base: (f32, f32, f32),
+    /// Colour at the tip.
+    pub tip: (f32, f32, f32),
+    /// See [`InstancedMaterial::color_variation`].
+    pub color_variation: f32,
+    /// See [`InstancedMaterial::roughness`].
+    pub roughness: f32,
+    /// See [`InstancedMaterial::wind_response`].
+    pub wind_response: f32,
+    /// See [`InstancedMaterial::fade_band`].
+    pub fade_band: f32,
+}
+
+impl Default for InstancedMaterialDescription {
+    fn default() -> Self {
+        let m = InstancedMaterial::default();
+        let linear = |c: Color| {
+            let c = c.to_linear();
+            (c.red, c.green, c.blue)
+        };
+        Self {
+            base: linear(m.base_color),
+            tip: linear(m.tip_color),
+            color_variation: m.color_variation,
+            roughness: m.roughness,
+            wind_response: m.wind_response,
+            fade_band: m.fade_band,
+        }
+    }
+}
+
+impl InstancedMaterialDescription {
+    /// The material it describes.
+    pub fn to_material(&self) -> InstancedMaterial {
+        let color = |(r, g, b): (f32, f32, f32)| Color::linear_rgb(r, g, b);
+        InstancedMaterial {
+            base_color: color(self.base),
+            tip_color: color(self.tip),
+            color_variation: self.color_variation,
+            roughness: self.roughness,
+            wind_response: self.wind_response,
+            fade_band: self.fade_band,
+        }
+    }
 }
 
 fn one() -> f32 {
@@ -251,7 +340,8 @@ impl LayerDescription {
         Ok(d)
     }
 
-    /// The layer, with handles made by the given functions (asset loads in a loader).
+    /// The layer, with handles made by the given functions (asset loads in a loader;
+    /// `material` is called for the classes that are not instanced only).
     pub fn to_layer(
         &self,
         mut mesh: impl FnMut(&MeshDescription) -> Handle<Mesh>,
@@ -262,14 +352,19 @@ impl LayerDescription {
         let classes = self
             .classes
             .iter()
-            .map(|c| ScatterClass {
-                scale: c.scale,
-                scale_variation: c.scale_variation,
-                ..ScatterClass::new(
-                    c.density.to_density(&mut image),
-                    mesh(&c.mesh),
-                    material(&c.material),
-                )
+            .map(|c| {
+                let density = c.density.to_density(&mut image);
+                let class = match &c.material {
+                    MaterialDescription::Instanced(m) => {
+                        ScatterClass::instanced(density, mesh(&c.mesh), m.to_material())
+                    }
+                    other => ScatterClass::new(density, mesh(&c.mesh), material(other)),
+                };
+                ScatterClass {
+                    scale: c.scale,
+                    scale_variation: c.scale_variation,
+                    ..class
+                }
             })
             .collect();
         let mut layer = ScatterLayer::new(classes)
@@ -313,30 +408,19 @@ impl AssetLoader for ScatterLayerLoader {
         let mut meshes = Vec::new();
         let mut materials = Vec::new();
         for (i, c) in description.classes.iter().enumerate() {
-            meshes.push(match &c.mesh {
-                MeshDescription::Path(p) => ctx.load(p.clone()),
-                MeshDescription::Sphere { radius } => {
-                    ctx.add_labeled_asset(format!("mesh{i}"), Mesh::from(Sphere::new(*radius)))
-                }
-                MeshDescription::Cone { radius, height } => ctx.add_labeled_asset(
-                    format!("mesh{i}"),
-                    Mesh::from(Cone {
-                        radius: *radius,
-                        height: *height,
-                    }),
-                ),
-                MeshDescription::Cuboid { size } => ctx.add_labeled_asset(
-                    format!("mesh{i}"),
-                    Mesh::from(Cuboid::new(size.0, size.1, size.2)),
-                ),
+            meshes.push(match (&c.mesh, c.mesh.primitive()) {
+                (MeshDescription::Path(p), _) => ctx.load(p.clone()),
+                (_, Some(m)) => ctx.add_labeled_asset(format!("mesh{i}"), m),
+                (_, None) => Handle::default(),
             });
-            materials.push(match &c.material {
-                MaterialDescription::Path(p) => ctx.load(p.clone()),
-                MaterialDescription::Color(r, g, b) => ctx.add_labeled_asset(
+            match &c.material {
+                MaterialDescription::Path(p) => materials.push(ctx.load(p.clone())),
+                MaterialDescription::Color(r, g, b) => materials.push(ctx.add_labeled_asset(
                     format!("material{i}"),
                     StandardMaterial::from(Color::linear_rgb(*r, *g, *b)),
-                ),
-            });
+                )),
+                MaterialDescription::Instanced(_) => {}
+            }
         }
         let mut images = Vec::new();
         for d in description
@@ -369,6 +453,7 @@ impl AssetLoader for ScatterLayerLoader {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::layers::ClassLook;
 
     const MEADOW: &str = r#"(
         tile_size: 4.0,
@@ -420,6 +505,46 @@ mod tests {
         );
         assert!(matches!(layer.exclusion, Some(LayerDensity::Image { .. })));
         assert_eq!(loads, ["roads.png"]);
+    }
+
+    #[test]
+    fn instanced_classes_in_a_layer_file() {
+        let text = MEADOW.replace(
+            "classes: [",
+            "classes: [(density: Constant(30.0), mesh: Blade(width: 0.08, height: 0.6), \
+             material: Instanced(tip: (0.3, 0.5, 0.1), fade_band: 0.2), scale_variation: 0.3), \
+             (density: Constant(5.0), mesh: Cuboid(size: (0.1, 0.1, 0.1)), material: Instanced()),",
+        );
+        let d = LayerDescription::from_ron(&text).unwrap();
+        let mut materials = 0;
+        let layer = d.to_layer(
+            |_| Handle::default(),
+            |_| {
+                materials += 1;
+                Handle::default()
+            },
+            |_| Handle::default(),
+        );
+        assert_eq!(materials, 2, "entity classes only");
+        let ClassLook::Instanced(look) = &layer.classes[0].look else {
+            panic!("{:?}", layer.classes[0].look);
+        };
+        assert_eq!(look.material.tip_color, Color::linear_rgb(0.3, 0.5, 0.1));
+        assert_eq!(look.material.fade_band, 0.2);
+        let defaults = InstancedMaterial::default();
+        assert_eq!(look.material.roughness, defaults.roughness);
+        assert_eq!(layer.classes[0].scale_variation, 0.3);
+        let ClassLook::Instanced(plain) = &layer.classes[1].look else {
+            panic!("{:?}", layer.classes[1].look);
+        };
+        let base = defaults.base_color.to_linear();
+        let read = plain.material.base_color.to_linear();
+        assert!((base.green - read.green).abs() < 1e-6, "{base:?} {read:?}");
+        let blade = d.classes[0].mesh.primitive().unwrap();
+        let (_, hi) = crate::instancing::check_instanced_mesh(&blade)
+            .unwrap()
+            .unwrap();
+        assert!((hi.y - 0.6).abs() < 1e-6);
     }
 
     #[test]

@@ -1,5 +1,6 @@
 //! What the plugin reports about each layer: its assets, chunks and instances.
 
+use crate::instancing::InstancedClassError;
 use bevy::platform::collections::HashSet;
 use bevy::prelude::*;
 use rwt_core::streaming::ChunkCoord;
@@ -34,4 +35,7 @@ pub struct ScatterLayerStatus {
     pub pending_tasks: usize,
     /// Instances waiting for the spawn budget (or, for instanced classes, the upload budget).
     pub queued_spawns: usize,
+    /// Instanced classes that cannot be drawn (class index, reason): their chunks stream and
+    /// are counted, but are not drawn until the cause is fixed.
+    pub class_errors: Vec<(u16, InstancedClassError)>,
 }

@@ -107,6 +107,9 @@ pub(crate) struct LayerState {
     /// Chunks with queued points, in the order they finished (unloaded ones are skipped).
     spawn_order: VecDeque<ChunkCoord>,
     despawn: VecDeque<Entity>,
+    /// Chunk entities of instanced classes whose chunks were unloaded: despawned this frame
+    /// whatever the budget (one entity each).
+    retired: Vec<Entity>,
     /// Chunks with instance buffers to hand over, in the order they finished.
     upload_order: VecDeque<ChunkCoord>,
 }
@@ -157,7 +160,8 @@ impl LayerState {
             let instances = c.instances.values().map(|(e, _)| *e);
             instances.chain(c.instanced.values().map(|(e, _)| *e))
         });
-        for e in placed.chain(self.despawn.iter().copied()) {
+        let waiting = self.despawn.iter().chain(&self.retired).copied();
+        for e in placed.chain(waiting) {
             commands.entity(e).try_despawn();
         }
     }

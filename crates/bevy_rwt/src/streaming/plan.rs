@@ -94,7 +94,7 @@ fn update_chunks(
     for chunk in changes.unload {
         if let Some(c) = state.states.remove(&chunk) {
             state.despawn.extend(c.instances.values().map(|(e, _)| *e));
-            state.despawn.extend(c.instanced.values().map(|(e, _)| *e));
+            state.retired.extend(c.instanced.values().map(|(e, _)| *e));
         }
         // Its queued points go with it; its place in the spawn order is skipped later.
         unloaded.write(ChunkUnloaded {

@@ -1,10 +1,10 @@
 //! Budgeted spawning and despawning of the queued instances.
 
 use super::LayerState;
-use crate::instancing::{InstancedChunk, PackedClass};
+use crate::instancing::{InstancedChunk, InstancedMeshes, PackedClass};
 use crate::layers::{ClassLook, GroundPlane, HeightFn, ScatterInstance, ScatterLayer};
 use crate::settings::RwtSettings;
-use bevy::camera::primitives::{Aabb, MeshAabb};
+use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
 use rwt_core::query::Point;
 use rwt_core::streaming::ChunkCoord;
@@ -16,12 +16,14 @@ pub(super) fn apply_budget(
     mut layers: Query<(Entity, &ScatterLayer, &mut LayerState)>,
     settings: Res<RwtSettings>,
     meshes: Option<Res<Assets<Mesh>>>,
+    mut checked: ResMut<InstancedMeshes>,
 ) {
     let mut spawn_budget = settings.spawn_budget;
     let mut despawn_budget = settings.despawn_budget;
     let mut upload = Upload {
         budget: settings.upload_budget,
         meshes: meshes.as_deref(),
+        checked: &mut checked,
         first: true,
     };
     for (entity, layer, mut state) in &mut layers {
@@ -32,8 +34,12 @@ pub(super) fn apply_budget(
     }
 }
 
-/// Despawns queued instances, oldest first, while the budget lasts.
+/// Despawns the chunk entities of unloaded chunks, then queued instances, oldest first,
+/// while the budget lasts.
 fn despawn_queued(commands: &mut Commands, state: &mut LayerState, budget: &mut usize) {
+    for e in state.retired.drain(..) {
+        commands.entity(e).try_despawn();
+    }
     while *budget > 0 {
         let Some(e) = state.despawn.pop_front() else {
             break;
@@ -127,6 +133,8 @@ struct Upload<'a> {
     /// Instances that may still be handed over this frame.
     budget: usize,
     meshes: Option<&'a Assets<Mesh>>,
+    /// Mesh bounds, checked once per mesh.
+    checked: &'a mut InstancedMeshes,
     /// Whether no chunk was handed over yet this frame (one always is).
     first: bool,
 }
@@ -169,7 +177,7 @@ impl Upload<'_> {
     /// Puts one class's buffer on its chunk entity (spawned when new, despawned when the
     /// buffer is empty); returns the entity that holds it.
     fn hand_over(
-        &self,
+        &mut self,
         commands: &mut Commands,
         entity: Entity,
         layer: &ScatterLayer,
@@ -189,7 +197,7 @@ impl Upload<'_> {
         }
         let corner = chunk.rect(layer.streaming.chunk_size).min();
         let max_scale = class.scale * (1.0 + class.scale_variation.abs());
-        let mesh_bounds = mesh_bounds(self.meshes.and_then(|m| m.get(&look.mesh)));
+        let mesh_bounds = self.checked.bounds(&look.mesh, self.meshes);
         let aabb = chunk_aabb(&packed, mesh_bounds, max_scale);
         let component = InstancedChunk {
             layer: entity,
@@ -210,14 +218,6 @@ impl Upload<'_> {
             None => commands.spawn((component, aabb, transform)).id(),
         })
     }
-}
-
-/// Bounds of a mesh (a unit box standing on the ground while it is not loaded).
-fn mesh_bounds(mesh: Option<&Mesh>) -> (Vec3, Vec3) {
-    mesh.and_then(Mesh::compute_aabb)
-        .map_or((Vec3::new(-1.0, 0.0, -1.0), Vec3::ONE), |a| {
-            (a.min().into(), a.max().into())
-        })
 }
 
 /// Bounds of a chunk's instances with the mesh around each (turned any way, at the largest
