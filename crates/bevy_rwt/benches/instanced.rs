@@ -7,20 +7,26 @@
 //!
 //! A frame is the whole `app.update()`: planning, collecting finished generation tasks
 //! (points queried and packed on the async compute pool), buffer hand-off or spawning and
-//! despawning. `live` is the median count of live instances over the flight. Progress and
-//! fill times go to stderr.
+//! despawning; frames are paced at 60 per second, as in a game, so that generation runs
+//! between them. `live` is the median count of live instances over the flight. Fill
+//! times and what is left pending after the flight go to stderr.
 
 use bevy::prelude::*;
 use bevy_rwt::instancing::GPU_BYTES_PER_INSTANCE;
 use bevy_rwt::prelude::*;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Streaming radius of the grass, world units.
 const RADIUS: f64 = 160.0;
+/// Chunk side, world units.
+const CHUNK: f64 = 32.0;
 /// Frames of flight per run.
 const FRAMES: usize = 600;
 /// Flight speed, world units per frame (120 units per second at 60 fps).
 const SPEED: f32 = 2.0;
+/// Frames are paced at 60 per second, as in a game: generation tasks run on the async
+/// compute pool between frames, and a frame's time is that of its `app.update()`.
+const FRAME: Duration = Duration::from_nanos(16_666_667);
 
 /// How the grass is drawn.
 #[derive(Clone, Copy, PartialEq)]
@@ -40,7 +46,9 @@ fn main() {
 
 /// Fills and flies a world holding about `live` instances, and prints its line.
 fn run(path: Path, live: f64) {
-    let density = live / (std::f64::consts::PI * RADIUS * RADIUS);
+    // Chunks touching the load disc stay loaded out to the unload distance: about a chunk
+    // beyond the radius.
+    let density = live / (std::f64::consts::PI * (RADIUS + CHUNK).powi(2));
     let (mut app, viewer) = world(path, density);
     fill(&mut app, live);
     let (times, counts) = fly(&mut app, viewer);
@@ -92,7 +100,7 @@ fn world(path: Path, density: f64) -> (App, Entity) {
         ),
     };
     let streaming = StreamingConfig {
-        chunk_size: 32.0,
+        chunk_size: CHUNK,
         load_distance: RADIUS,
         unload_distance: RADIUS + 24.0,
         near_distance: 48.0,
@@ -135,6 +143,7 @@ fn fill(app: &mut App, expected: f64) {
 fn fly(app: &mut App, viewer: Entity) -> (Vec<f64>, Vec<usize>) {
     let mut times = Vec::with_capacity(FRAMES);
     let mut counts = Vec::with_capacity(FRAMES);
+    let start = Instant::now();
     for f in 0..FRAMES {
         let x = f as f32 * SPEED;
         let at = Vec3::new(x, 2.0, (x * 0.01).sin() * 100.0);
@@ -145,10 +154,13 @@ fn fly(app: &mut App, viewer: Entity) -> (Vec<f64>, Vec<usize>) {
         app.update();
         times.push(t.elapsed().as_secs_f64() * 1e3);
         counts.push(live(app));
+        let next = start + FRAME * (f as u32 + 1);
+        std::thread::sleep(next.saturating_duration_since(Instant::now()));
     }
     let s = app.world().resource::<RwtStats>();
+    let slowest = (0..FRAMES).max_by(|&a, &b| times[a].total_cmp(&times[b])).unwrap_or(0);
     eprintln!(
-        "after the flight: {} live, {} pending tasks, {} queued",
+        "after the flight: {} live, {} pending tasks, {} queued; slowest frame {slowest}",
         live(app),
         s.pending_tasks,
         s.queued_spawns
