@@ -268,7 +268,6 @@ fn bushes(terrain: &Terrain, looks: &Looks, assets: &AssetServer) -> ScatterLaye
     .with_height_range(WATER + 0.5, 200.0)
 }
 
-/// Grass: dense noise patches close to the camera only.
 /// Grass blades, drawn from per-chunk instance buffers (no entity per blade), growing in
 /// and out with the level of detail.
 fn grass(terrain: &Terrain, looks: &Looks) -> ScatterLayer {
@@ -279,7 +278,7 @@ fn grass(terrain: &Terrain, looks: &Looks) -> ScatterLayer {
             octaves: 3,
             base: 0.45,
             amplitude: 0.9,
-            scale: 14.0,
+            scale: 140.0,
         })),
         looks.blade.0.clone(),
         looks.blade.1.clone(),
@@ -290,28 +289,31 @@ fn grass(terrain: &Terrain, looks: &Looks) -> ScatterLayer {
         .with_tile_size(4.0)
         .with_streaming(StreamingConfig {
             chunk_size: 16.0,
-            load_distance: 110.0,
-            unload_distance: 130.0,
+            load_distance: 120.0,
+            unload_distance: 140.0,
             near_distance: 24.0,
         })
-        .with_falloff(25.0, 105.0)
+        .with_falloff(35.0, 115.0)
         .with_height(terrain.source())
         .with_height_range(WATER + 0.3, 90.0)
 }
 
-/// The smoke session's flight: 1.5 km along a gentle curve, 22 m above the ground.
+/// The smoke session's flight: 1.5 km along a gentle curve, 22 m above the ground, then
+/// down to 2.5 m, in the grass.
 fn fly_script(
     smoke: Res<Smoke>,
     terrain: Res<Terrain>,
     mut camera: Query<(&mut FlyCamera, &mut Transform)>,
 ) {
-    let t = smoke.progress();
+    // Three quarters of the session flying, the last quarter hovering down into the grass.
+    let t = (smoke.progress() / 0.75).min(1.0);
+    let landing = ((smoke.progress() - 0.75) / 0.2).clamp(0.0, 1.0);
     for (mut cam, mut transform) in &mut camera {
         cam.yaw = 0.6 * t;
-        cam.pitch = -0.12;
+        cam.pitch = -0.12 + 0.06 * landing;
         let along = 1500.0 * t;
         let p = Vec2::new(-along * (0.3 * t).sin(), -along * (0.3 * t).cos());
-        let y = terrain.height(p).max(WATER) + 22.0;
+        let y = terrain.height(p).max(WATER) + 22.0 - 19.5 * landing;
         transform.translation = Vec3::new(p.x, y, p.y);
         transform.rotation = cam.rotation();
     }

@@ -2,7 +2,7 @@
 # Runs every example in a real renderer (Xvfb + Mesa's lavapipe Vulkan driver) through its
 # scripted session (RWT_SCREENSHOT), and fails when an example exits with an error, its
 # screenshot is missing or blank (luminance variance < 20), or it reports 0 instances
-# (entities and instanced together).
+# (entities and instanced together), or open_world has fewer than a million instanced blades.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png
@@ -53,6 +53,9 @@ for ex in "${examples[@]}"; do
     fi
     if [ -z "$instances" ] || [ $((instances + ${instanced:-0})) -eq 0 ]; then
         echo "FAIL $ex: no instances"; failed=1
+    fi
+    if [ "$ex" = open_world ] && [ "${instanced:-0}" -lt 1000000 ]; then
+        echo "FAIL $ex: fewer than a million instanced blades"; failed=1
     fi
     if [ $docs = 1 ] && [ $failed = 0 ]; then
         mkdir -p docs/screenshots
