@@ -9,7 +9,8 @@
 //! (points queried and packed on the async compute pool), buffer hand-off or spawning and
 //! despawning; frames are paced at 60 per second, as in a game, so that generation runs
 //! between them. `live` is the median count of live instances over the flight. Fill
-//! times and what is left pending after the flight go to stderr.
+//! times and what is left pending after the flight go to stderr; with `RWT_BENCH_TRACE` set,
+//! so does every frame over 3 ms, with the live count before and after it.
 
 use bevy::prelude::*;
 use bevy_rwt::instancing::GPU_BYTES_PER_INSTANCE;
@@ -154,11 +155,24 @@ fn fly(app: &mut App, viewer: Entity) -> (Vec<f64>, Vec<usize>) {
         app.update();
         times.push(t.elapsed().as_secs_f64() * 1e3);
         counts.push(live(app));
+        if std::env::var_os("RWT_BENCH_TRACE").is_some() && times[f] > 3.0 {
+            let s = app.world().resource::<RwtStats>();
+            eprintln!(
+                "frame {f}: {:.2} ms, live {} -> {}, loaded chunks {}, pending {}",
+                times[f],
+                counts.get(f.wrapping_sub(1)).copied().unwrap_or(0),
+                counts[f],
+                s.loaded_chunks,
+                s.pending_tasks
+            );
+        }
         let next = start + FRAME * (f as u32 + 1);
         std::thread::sleep(next.saturating_duration_since(Instant::now()));
     }
     let s = app.world().resource::<RwtStats>();
-    let slowest = (0..FRAMES).max_by(|&a, &b| times[a].total_cmp(&times[b])).unwrap_or(0);
+    let slowest = (0..FRAMES)
+        .max_by(|&a, &b| times[a].total_cmp(&times[b]))
+        .unwrap_or(0);
     eprintln!(
         "after the flight: {} live, {} pending tasks, {} queued; slowest frame {slowest}",
         live(app),

@@ -1,0 +1,207 @@
+//! What a field of grass costs the CPU in a real renderer, drawn by the instanced path or
+//! with one entity per blade:
+//!
+//! `cargo run --release --example grass_cost -- instanced 1000000`
+//! `cargo run --release --example grass_cost -- entities 1000000`
+//!
+//! A flat field holds about the given number of live blades (streamed by the plugin) around
+//! a camera 2 m above it. Once streaming has settled and 10 frames have warmed up, 30
+//! frames are timed and one line is printed:
+//!
+//! `grass-cost: path=P live=N main_ms=X/Y render_world_ms=X/Y frame_ms=X/Y` (median/p95)
+//!
+//! `main_ms` is the main world's schedules (the plugin, transforms, visibility);
+//! `render_world_ms` is extraction, preparation and queueing in the render world, from the
+//! end of the main world's frame to the start of the render graph (pipelined rendering is
+//! off, so the two run one after the other); `frame_ms` is the whole frame, including the
+//! render graph and, with a software driver such as lavapipe, the drawing itself.
+
+use bevy::prelude::*;
+use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
+use bevy::render::{Render, RenderApp, RenderSystems};
+use bevy_rwt::instancing::blade_mesh;
+use bevy_rwt::prelude::*;
+use rwt_examples::prelude::*;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// Streaming radius of the field, metres.
+const RADIUS: f64 = 150.0;
+/// Chunk side, metres.
+const CHUNK: f64 = 32.0;
+/// Frames timed once streaming has settled.
+const TIMED: usize = 30;
+/// Frames run before, to warm up.
+const WARM_UP: usize = 10;
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let entities = match args.next().as_deref() {
+        Some("entities") => true,
+        Some("instanced") | None => false,
+        Some(other) => {
+            eprintln!("usage: grass_cost [instanced|entities] [COUNT] (not {other:?})");
+            std::process::exit(2);
+        }
+    };
+    let count: f64 = args.next().and_then(|c| c.parse().ok()).unwrap_or(1.0e6);
+    let clock = Clock::default();
+    let mut app = App::new();
+    app.add_plugins(
+        example_plugins("rwt grass_cost")
+            .build()
+            .disable::<PipelinedRenderingPlugin>(),
+    )
+    .add_plugins(
+        RwtPlugin::default()
+            .with_spawn_budget(200_000)
+            .with_max_tasks(16),
+    )
+    .insert_resource(Field { entities, count })
+    .insert_resource(clock.clone())
+    .add_systems(Startup, setup)
+    .add_systems(First, start_frame)
+    .add_systems(Last, (end_main_world, settle).chain());
+    app.sub_app_mut(RenderApp)
+        .insert_resource(clock)
+        .add_systems(
+            Render,
+            end_render_world
+                .after(RenderSystems::PrepareBindGroups)
+                .before(RenderSystems::Render),
+        );
+    app.run();
+}
+
+/// What to draw.
+#[derive(Resource)]
+struct Field {
+    entities: bool,
+    count: f64,
+}
+
+/// Timestamps shared by the main and render worlds.
+#[derive(Resource, Clone, Default)]
+struct Clock(Arc<Mutex<Timing>>);
+
+#[derive(Default)]
+struct Timing {
+    frame_start: Option<Instant>,
+    main_end: Option<Instant>,
+    /// Whether the current frame is timed.
+    recording: bool,
+    /// Per frame: main world, render world, whole frame (ms).
+    samples: Vec<[f64; 3]>,
+    /// Render-world time of the frame in progress.
+    render_ms: f64,
+}
+
+fn setup(
+    mut commands: Commands,
+    field: Res<Field>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    commands.spawn((
+        Camera3d::default(),
+        RwtViewer::all_around(),
+        Transform::from_xyz(0.0, 2.0, 0.0).looking_at(Vec3::new(40.0, 0.0, 30.0), Vec3::Y),
+    ));
+    commands.spawn((
+        DirectionalLight::default(),
+        Transform::from_xyz(1.0, 2.0, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(600.0, 600.0))),
+        MeshMaterial3d(materials.add(Color::srgb(0.2, 0.3, 0.1))),
+    ));
+    let density =
+        LayerDensity::Constant(field.count / (std::f64::consts::PI * (RADIUS + CHUNK).powi(2)));
+    let blade = meshes.add(blade_mesh(0.09, 0.72, 0.12));
+    let grass = if field.entities {
+        let material = materials.add(StandardMaterial {
+            base_color: Color::srgb(0.3, 0.5, 0.15),
+            double_sided: true,
+            cull_mode: None,
+            ..default()
+        });
+        ScatterClass::new(density, blade, material)
+    } else {
+        ScatterClass::instanced(density, blade, InstancedMaterial::default())
+    };
+    commands.spawn(
+        ScatterLayer::new(vec![grass])
+            .with_tile_size(2.0)
+            .with_streaming(StreamingConfig {
+                chunk_size: CHUNK,
+                load_distance: RADIUS,
+                unload_distance: RADIUS + 24.0,
+                near_distance: 48.0,
+            }),
+    );
+}
+
+fn start_frame(clock: Res<Clock>) {
+    let mut t = clock.0.lock().unwrap();
+    let now = Instant::now();
+    if t.recording
+        && let (Some(start), Some(end)) = (t.frame_start, t.main_end)
+    {
+        let sample = [
+            (end - start).as_secs_f64() * 1e3,
+            t.render_ms,
+            (now - start).as_secs_f64() * 1e3,
+        ];
+        t.samples.push(sample);
+    }
+    t.frame_start = Some(now);
+}
+
+fn end_main_world(clock: Res<Clock>) {
+    clock.0.lock().unwrap().main_end = Some(Instant::now());
+}
+
+fn end_render_world(clock: Res<Clock>) {
+    let mut t = clock.0.lock().unwrap();
+    if let Some(end) = t.main_end {
+        t.render_ms = end.elapsed().as_secs_f64() * 1e3;
+    }
+}
+
+/// Waits for streaming to settle, warms up for [`WARM_UP`] frames, times [`TIMED`]
+/// frames, prints and exits.
+fn settle(
+    clock: Res<Clock>,
+    stats: Res<RwtStats>,
+    field: Res<Field>,
+    mut settled_frames: Local<usize>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let live = stats.live_instances + stats.live_instanced;
+    if *settled_frames == 0 && (stats.pending_tasks > 0 || stats.queued_spawns > 0 || live == 0) {
+        return;
+    }
+    *settled_frames += 1;
+    let mut t = clock.0.lock().unwrap();
+    t.recording = *settled_frames > WARM_UP;
+    if t.samples.len() < TIMED {
+        return;
+    }
+    let column = |i: usize| {
+        let mut v: Vec<f64> = t.samples.iter().map(|s| s[i]).collect();
+        v.sort_by(f64::total_cmp);
+        format!("{:.2}/{:.2}", v[v.len() / 2], v[v.len() * 95 / 100])
+    };
+    let path = if field.entities {
+        "entities"
+    } else {
+        "instanced"
+    };
+    println!(
+        "grass-cost: path={path} live={live} main_ms={} render_world_ms={} frame_ms={}",
+        column(0),
+        column(1),
+        column(2)
+    );
+    exit.write(AppExit::Success);
+}
