@@ -17,6 +17,10 @@ pub struct RwtSettings {
     pub keep_instance_ids: bool,
     /// Most chunk generation tasks in flight per layer.
     pub max_tasks_in_flight: usize,
+    /// Most points one chunk's query may produce (its entities, or its instance buffers at
+    /// 24 bytes each), estimated before it runs: a chunk over it is not generated, is
+    /// counted in [`crate::ScatterLayerStatus::refused_chunks`], and the layer logs why once.
+    pub chunk_point_budget: usize,
     /// Length of the view wedge drawn from a viewer on the ground.
     pub footprint_reach: f64,
 }
@@ -29,6 +33,7 @@ impl Default for RwtSettings {
             upload_budget: 1_000_000,
             keep_instance_ids: false,
             max_tasks_in_flight: 8,
+            chunk_point_budget: 4_000_000,
             footprint_reach: 1.0e4,
         }
     }

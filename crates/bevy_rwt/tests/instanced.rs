@@ -305,3 +305,33 @@ fn meshes_that_cannot_be_drawn_are_reported_per_class() {
     assert_eq!(errors.len(), 5, "{errors:?}");
     assert!(errors.iter().all(|(_, e)| *e == Plane(GroundPlane::Xy)));
 }
+
+#[test]
+fn chunks_over_the_point_budget_are_refused_and_counted() {
+    let mut app = create_app();
+    app.world_mut()
+        .resource_mut::<RwtSettings>()
+        .chunk_point_budget = 10_000;
+    spawn_viewer(&mut app, Vec3::ZERO);
+    // 100 per square unit: about 25 600 points in a 16-unit chunk, over the budget.
+    let grass = ScatterClass::instanced(LayerDensity::Constant(100.0), default(), default());
+    let mut dense = layer(LayerDensity::Constant(0.0));
+    dense.classes = vec![grass];
+    let dense = app.world_mut().spawn(dense).id();
+    let sparse = app
+        .world_mut()
+        .spawn(layer(LayerDensity::Constant(0.2)).with_seed(9))
+        .id();
+    tick_app(&mut app, 4_000);
+    let status = app.world().get::<ScatterLayerStatus>(dense).unwrap();
+    assert!(!status.loaded_chunks.is_empty());
+    assert_eq!(
+        status.refused_chunks,
+        status.loaded_chunks.len(),
+        "{status:?}"
+    );
+    assert_eq!(status.live_instanced, 0);
+    let fine = app.world().get::<ScatterLayerStatus>(sparse).unwrap();
+    assert_eq!(fine.refused_chunks, 0);
+    assert!(fine.live_instances > 100);
+}

@@ -35,6 +35,9 @@ pub struct ScatterLayerStatus {
     pub pending_tasks: usize,
     /// Instances waiting for the spawn budget (or, for instanced classes, the upload budget).
     pub queued_spawns: usize,
+    /// Loaded chunks not generated because their query would exceed
+    /// [`crate::RwtSettings::chunk_point_budget`] (lower the density, or raise the budget).
+    pub refused_chunks: usize,
     /// Instanced classes that cannot be drawn (class index, reason): their chunks stream and
     /// are counted, but are not drawn until the cause is fixed.
     pub class_errors: Vec<(u16, InstancedClassError)>,

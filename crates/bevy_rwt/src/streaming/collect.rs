@@ -27,10 +27,18 @@ pub(super) fn collect_results(
             }
         }
         for (chunk, band, result) in finished {
-            let Some(ChunkContent { points, packed }) = result else {
-                continue;
-            };
             let c = state.states.get_mut(&chunk).expect("finished chunks exist");
+            let ChunkContent { points, packed } = match result {
+                Ok(content) => content,
+                Err(e) => {
+                    c.refused = true;
+                    if !std::mem::replace(&mut state.refusal_logged, true) {
+                        error!("scatter layer {entity}: chunk {chunk:?} not generated: {e}");
+                    }
+                    continue;
+                }
+            };
+            c.refused = false;
             let packed_count: usize = packed.iter().map(|p| p.buffer.instances.len()).sum();
             if !packed.is_empty() {
                 c.upload = packed;

@@ -23,7 +23,7 @@ use crate::layers::{ScatterLayer, ScatterLayerStatus};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::tasks::Task;
-use rwt_core::query::{Point, PointId, Rect, Sampler};
+use rwt_core::query::{Point, PointId, QueryError, Rect, Sampler};
 use rwt_core::streaming::{ChunkCoord, ChunkSet};
 use rwt_core::tileset::TileSet;
 use std::collections::VecDeque;
@@ -71,8 +71,9 @@ struct ChunkContent {
     packed: Vec<PackedClass>,
 }
 
-/// A chunk's generation task: its content, or nothing when the query was refused.
-type ChunkTask = Task<Option<ChunkContent>>;
+/// A chunk's generation task: its content, or why the query was refused (over the chunk
+/// point budget).
+type ChunkTask = Task<Result<ChunkContent, QueryError>>;
 
 #[derive(Default)]
 struct ChunkState {
@@ -93,6 +94,9 @@ struct ChunkState {
     task: Option<(ChunkTask, i64)>,
     /// Content must be regenerated (painted map changed, band changed while busy).
     stale: bool,
+    /// The last query was refused (over the chunk point budget): the chunk shows what it
+    /// showed before, or nothing.
+    refused: bool,
 }
 
 /// Per-layer streaming state, added with the layer.
@@ -112,6 +116,8 @@ pub(crate) struct LayerState {
     retired: Vec<Entity>,
     /// Chunks with instance buffers to hand over, in the order they finished.
     upload_order: VecDeque<ChunkCoord>,
+    /// Whether a refused query was logged (once per layer).
+    refusal_logged: bool,
 }
 
 impl LayerState {
@@ -217,5 +223,6 @@ fn update_status(mut layers: Query<(&LayerState, &mut ScatterLayerStatus)>) {
         status.live_instanced = state.live_instanced();
         status.pending_tasks = state.pending();
         status.queued_spawns = state.queued();
+        status.refused_chunks = state.states.values().filter(|c| c.refused).count();
     }
 }

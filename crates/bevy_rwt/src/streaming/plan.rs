@@ -52,7 +52,8 @@ pub(super) fn plan_chunks(
         let sampler = state
             .sampler
             .get_or_insert_with(|| {
-                let sampler = Sampler::new(&inputs.tile_set.0, layer.seed);
+                let sampler = Sampler::new(&inputs.tile_set.0, layer.seed)
+                    .with_budget(inputs.settings.chunk_point_budget);
                 Arc::new(sampler.with_tile_size(layer.tile_size))
             })
             .clone();
@@ -162,18 +163,16 @@ fn start_task(job: &Job, chunk: ChunkCoord, band: i64) -> ChunkTask {
     AsyncComputeTaskPool::get().spawn(async move {
         let scaled: Vec<_> = densities.iter().map(|d| Scale(d.clone(), factor)).collect();
         let mut out = Vec::new();
-        sampler
-            .query_classes(rect, &scaled, |p| {
-                let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
-                let in_range = range.is_none_or(|(lo, hi)| (lo..=hi).contains(&height(ground)));
-                let flat_enough = max_slope.is_none_or(|m| slope(&height, ground, 0.25) <= m);
-                if in_range && flat_enough {
-                    out.push(p);
-                }
-            })
-            .ok()?;
+        sampler.query_classes(rect, &scaled, |p| {
+            let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+            let in_range = range.is_none_or(|(lo, hi)| (lo..=hi).contains(&height(ground)));
+            let flat_enough = max_slope.is_none_or(|m| slope(&height, ground, 0.25) <= m);
+            if in_range && flat_enough {
+                out.push(p);
+            }
+        })?;
         let packed = instanced.pack(&mut out, rect.min(), &height, &scaled, factor);
-        Some(ChunkContent {
+        Ok(ChunkContent {
             points: out,
             packed,
         })
