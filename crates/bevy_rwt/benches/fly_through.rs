@@ -2,8 +2,11 @@
 //! `cargo bench -p bevy_rwt`. Prints the median and maximum time of a whole frame (the
 //! plugin's systems and the spawning and despawning they command) and instance churn.
 
+mod common;
+
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
+use common::{headless_app, move_viewer};
 use std::time::Instant;
 
 fn main() {
@@ -25,22 +28,7 @@ fn run(speed: f32) {
 /// A headless app with one grass layer of 0.5 instances per square unit and a viewer;
 /// returns the app and the viewer.
 fn world() -> (App, Entity) {
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        bevy::asset::AssetPlugin::default(),
-        RwtPlugin::default().with_max_tasks(32),
-    ));
-    app.finish();
-    app.cleanup();
-    let viewer = app
-        .world_mut()
-        .spawn((
-            RwtViewer::all_around(),
-            Transform::default(),
-            GlobalTransform::default(),
-        ))
-        .id();
+    let (mut app, viewer) = headless_app(RwtPlugin::default().with_max_tasks(32));
     let grass = ScatterClass::new(
         LayerDensity::Constant(0.5),
         Handle::default(),
@@ -96,9 +84,7 @@ fn fly(app: &mut App, viewer: Entity, speed: f32) {
     for f in 0..600 {
         let x = f as f32 * speed;
         let at = Vec3::new(x, 2.0, (x * 0.01).sin() * 200.0);
-        let mut e = app.world_mut().entity_mut(viewer);
-        *e.get_mut::<Transform>().unwrap() = Transform::from_translation(at);
-        *e.get_mut::<GlobalTransform>().unwrap() = GlobalTransform::from_translation(at);
+        move_viewer(app, viewer, at);
         let t = Instant::now();
         app.update();
         times.push(t.elapsed().as_secs_f64() * 1e3);

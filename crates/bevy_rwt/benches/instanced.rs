@@ -12,9 +12,12 @@
 //! times and what is left pending after the flight go to stderr; with `RWT_BENCH_TRACE` set,
 //! so does every frame over 3 ms, with the live count before and after it.
 
+mod common;
+
 use bevy::prelude::*;
 use bevy_rwt::instancing::GPU_BYTES_PER_INSTANCE;
 use bevy_rwt::prelude::*;
+use common::{headless_app, move_viewer};
 use std::time::{Duration, Instant};
 
 /// Streaming radius of the grass, world units.
@@ -69,25 +72,12 @@ fn run(path: Path, live: f64) {
 /// A headless app with one grass layer of `density` blades per square unit within
 /// [`RADIUS`] and a viewer; returns the app and the viewer.
 fn world(path: Path, density: f64) -> (App, Entity) {
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        bevy::asset::AssetPlugin::default(),
+    let (mut app, viewer) = headless_app(
         RwtPlugin::default()
             .with_max_tasks(32)
             .with_spawn_budget(20_000)
             .with_despawn_budget(40_000),
-    ));
-    app.finish();
-    app.cleanup();
-    let viewer = app
-        .world_mut()
-        .spawn((
-            RwtViewer::all_around(),
-            Transform::default(),
-            GlobalTransform::default(),
-        ))
-        .id();
+    );
     let grass = match path {
         Path::Instanced => ScatterClass::instanced(
             LayerDensity::Constant(density),
@@ -148,9 +138,7 @@ fn fly(app: &mut App, viewer: Entity) -> (Vec<f64>, Vec<usize>) {
     for f in 0..FRAMES {
         let x = f as f32 * SPEED;
         let at = Vec3::new(x, 2.0, (x * 0.01).sin() * 100.0);
-        let mut e = app.world_mut().entity_mut(viewer);
-        *e.get_mut::<Transform>().unwrap() = Transform::from_translation(at);
-        *e.get_mut::<GlobalTransform>().unwrap() = GlobalTransform::from_translation(at);
+        move_viewer(app, viewer, at);
         let t = Instant::now();
         app.update();
         times.push(t.elapsed().as_secs_f64() * 1e3);
