@@ -19,6 +19,7 @@
 //! | [`layers::RwtLayersPlugin`] | [`layers`] | layer files (`*.layer.ron`) and asset status |
 //! | [`streaming::RwtStreamingPlugin`] | [`streaming`] | chunks, generation tasks, budgeted spawns, repainting |
 //! | [`diagnostics::RwtDiagnosticsPlugin`] | [`diagnostics`] | [`RwtStats`] and `rwt/` diagnostics |
+//! | [`instancing::RwtInstancingPlugin`] | [`instancing`] | instanced classes: mesh checks, one instanced draw per chunk (wind, fade-in) |
 //! | [`gizmos::RwtGizmosPlugin`] (opt-in) | [`gizmos`] | chunk and tile outlines |
 //!
 //! The data path from a painted map to an instance: a brush writes the map (`Image`) and a

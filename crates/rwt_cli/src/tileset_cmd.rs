@@ -305,7 +305,7 @@ mod tests {
     #[test]
     fn check_gates_base_and_subdivision_prefixes_on_min_rho() {
         let shipped =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/tilesets/default.ron");
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../rwt_core/tilesets/default.ron");
         assert_eq!(check_cmd(&shipped, Some(0.6)), Ok(true));
         // The shipped set's worst prefixes are 0.642 (base, 431 points) and 0.643 (4 N).
         assert_eq!(check_cmd(&shipped, Some(0.66)), Ok(false));

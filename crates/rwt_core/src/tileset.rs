@@ -15,7 +15,7 @@ use thiserror::Error;
 pub const FORMAT_VERSION: u32 = 1;
 
 /// The shipped tile set, built by `rwt tileset build` and embedded in the library.
-const EMBEDDED: &[u8] = include_bytes!("../../../assets/tilesets/default.ron");
+const EMBEDDED: &[u8] = include_bytes!("../tilesets/default.ron");
 
 /// Scale of the fixed-point tile coordinates.
 pub const FIXED_ONE: f64 = 4_294_967_296.0;
