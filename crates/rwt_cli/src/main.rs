@@ -44,8 +44,8 @@ enum Command {
         /// The rectangle: x0 y0 x1 y1.
         #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true)]
         rect: Vec<f64>,
-        /// const:V (points per unit area), image:PATH[:V], dark:PATH[:V] or
-        /// noise:V[:FREQ[:OCTAVES[:SEED]]]; images are stretched over the rectangle.
+        /// `const:V` (points per unit area), `image:PATH[:V]`, `dark:PATH[:V]` or
+        /// `noise:V[:FREQ[:OCTAVES[:SEED]]]`; images are stretched over the rectangle.
         #[arg(long)]
         density: String,
         /// Tiling seed.

@@ -93,7 +93,7 @@ impl LayerDensity {
 }
 
 /// Inserts a class's own components into every instance it spawns (after `Transform` and
-/// [`ScatterInstance`](crate::ScatterInstance)).
+/// [`ScatterInstance`]).
 pub type InstanceInserter = Arc<dyn Fn(&mut EntityCommands) + Send + Sync>;
 
 /// How the instances of a class look.

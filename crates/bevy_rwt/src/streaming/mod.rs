@@ -2,12 +2,12 @@
 //!
 //! Every decision (which chunks, which level of detail, which instances change) comes from
 //! [`rwt_core::streaming`]; this module moves data between Bevy and those functions:
-//! - [`resolve`]: a layer's densities and height source as thread-safe snapshots, re-made
+//! - `resolve`: a layer's densities and height source as thread-safe snapshots, re-made
 //!   only for the maps that change;
-//! - [`plan`]: chunks to load and unload, generation tasks for the nearest stale chunks;
-//! - [`collect`]: finished tasks to spawn and despawn queues (by point identity);
-//! - [`spawn`]: budgeted spawning and despawning;
-//! - [`repaint`]: painted maps mark the chunks they cover stale.
+//! - `plan`: chunks to load and unload, generation tasks for the nearest stale chunks;
+//! - `collect`: finished tasks to spawn and despawn queues (by point identity);
+//! - `spawn`: budgeted spawning and despawning;
+//! - `repaint`: painted maps mark the chunks they cover stale.
 
 mod collect;
 mod plan;

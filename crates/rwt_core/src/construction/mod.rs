@@ -2,14 +2,14 @@
 //! Compiled with the `build` feature: games that only query a shipped set need none of it.
 //!
 //! [`build`] runs the paper's stages, one call each:
-//! 1. progressive toroidal source tiles ([`source_tile`]), one per edge colour and
+//! 1. progressive toroidal source tiles (`source_tile`), one per edge colour and
 //!    orientation plus one unique interior per tile;
-//! 2. Wang tiles by merging sources along min-cost Voronoi seams ([`seam`], [`merging`]),
+//! 2. Wang tiles by merging sources along min-cost Voronoi seams (`seam`, `merging`),
 //!    keeping the first `N` of the interleaved source ranks;
-//! 3. subdivision rules ([`subdivision`]);
-//! 4. relaxation to the exact subset property ([`relaxation`]);
-//! 5. the final base ranking and the subdivision ranking ([`ranking`], on
-//!    [`progressive`]), both with spacing guaranteed against every possible neighbour tile.
+//! 3. subdivision rules (`subdivision`);
+//! 4. relaxation to the exact subset property (`relaxation`);
+//! 5. the final base ranking and the subdivision ranking (`ranking`, on
+//!    `progressive`), both with spacing guaranteed against every possible neighbour tile.
 //!
 //! Independent work (source tiles, merges, relaxation steps) runs on rayon; every random
 //! choice comes from a stream derived from the seed and the item, so the result does not
