@@ -550,3 +550,52 @@ fn lower_bounds_skip_evaluations_without_changing_any_point() {
         },
     );
 }
+
+#[test]
+fn parallel_queries_return_the_serial_points_in_the_serial_order() {
+    let noise = NoiseDensity::new(NoiseParams {
+        seed: 4,
+        frequency: 0.05,
+        octaves: 3,
+        base: 0.3,
+        amplitude: 0.8,
+        scale: 6.0,
+    });
+    // Zero over the left half: whole blocks are skipped on both paths.
+    let half = from_fn(|p: DVec2| if p.x > 37.0 { 3.0 } else { 0.0 }, 3.0);
+    let rects = [
+        square(0.0, 100.0),
+        Rect::new(DVec2::new(-73.3, -12.9), DVec2::new(61.7, 88.2)).unwrap(),
+        Rect::new(DVec2::new(5.5, 5.5), DVec2::new(6.5, 400.0)).unwrap(),
+        square(1.0e6, 3.0),
+    ];
+    let densities: [&(dyn Density + Sync); 3] = [&Constant(4.0), &noise, &half];
+    let mut sentinel = Vec::new();
+    sampler(9)
+        .query(square(0.0, 1.0), &Constant(20.0), &mut sentinel)
+        .unwrap();
+    let mut empty = 0;
+    for (seed, rect) in rects.iter().enumerate() {
+        let s = sampler(seed as u64).with_tile_size(1.5);
+        for density in densities {
+            let mut serial = Vec::new();
+            let n = s.query(*rect, density, &mut serial).unwrap();
+            let mut parallel = sentinel.clone();
+            let m = s.query_par(*rect, density, &mut parallel).unwrap();
+            assert_eq!(n, m);
+            // Appended after what `out` held, in the same order.
+            assert_eq!(parallel[..sentinel.len()], sentinel[..]);
+            assert_eq!(serial[..], parallel[sentinel.len()..], "{rect:?}");
+            empty += usize::from(n == 0);
+        }
+    }
+    assert_eq!(
+        empty, 1,
+        "only the strip left of the half-plane density is empty"
+    );
+    let tight = sampler(1).with_budget(10);
+    assert!(matches!(
+        tight.query_par(square(0.0, 100.0), &Constant(4.0), &mut Vec::new()),
+        Err(QueryError::BudgetExceeded { .. })
+    ));
+}

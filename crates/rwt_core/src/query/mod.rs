@@ -18,6 +18,8 @@
 //! its [`Point::threshold`], so raising the density anywhere only adds points, and splitting
 //! a rectangle into pieces (half-open: `[min, max)`) yields exactly the union of the pieces.
 
+#[cfg(feature = "parallel")]
+mod parallel;
 mod point;
 mod prepared;
 mod rect;
@@ -73,6 +75,14 @@ pub enum QueryError {
         /// The budget.
         budget: usize,
     },
+}
+
+/// Base tiles `[i0, i1) x [j0, j1)` of a query.
+struct TileRange {
+    i0: i64,
+    i1: i64,
+    j0: i64,
+    j1: i64,
 }
 
 /// Generates points of a tile set's infinite point set: the run-time side of rwt.
@@ -161,27 +171,11 @@ impl Sampler {
         density: &D,
         mut emit: impl FnMut(Point),
     ) -> Result<usize, QueryError> {
-        self.check(&rect)?;
-        let estimate = self.work_bound(&rect, density);
-        if estimate.is_nan() || estimate > self.budget as f64 {
-            return Err(QueryError::BudgetExceeded {
-                estimate,
-                budget: self.budget,
-            });
-        }
-        let mut count = 0usize;
-        if rect.is_empty() {
+        let Some(TileRange { i0, i1, j0, j1 }) = self.admit(&rect, density)? else {
             return Ok(0);
-        }
+        };
         let s = self.tile_size;
-        let (i0, i1) = (
-            (rect.min().x / s).floor() as i64,
-            (rect.max().x / s).ceil() as i64,
-        );
-        let (j0, j1) = (
-            (rect.min().y / s).floor() as i64,
-            (rect.max().y / s).ceil() as i64,
-        );
+        let mut count = 0usize;
         let mut visit = Visit {
             sampler: self,
             rect,
@@ -193,6 +187,33 @@ impl Sampler {
         };
         visit.blocks(i0, i1, j0, j1, s);
         Ok(count)
+    }
+
+    /// Checks a query against the coordinate limit and the budget; returns the base tiles
+    /// it spans (`None` for an empty rectangle).
+    fn admit<D: Density + ?Sized>(
+        &self,
+        rect: &Rect,
+        density: &D,
+    ) -> Result<Option<TileRange>, QueryError> {
+        self.check(rect)?;
+        let estimate = self.work_bound(rect, density);
+        if estimate.is_nan() || estimate > self.budget as f64 {
+            return Err(QueryError::BudgetExceeded {
+                estimate,
+                budget: self.budget,
+            });
+        }
+        if rect.is_empty() {
+            return Ok(None);
+        }
+        let s = self.tile_size;
+        Ok(Some(TileRange {
+            i0: (rect.min().x / s).floor() as i64,
+            i1: (rect.max().x / s).ceil() as i64,
+            j0: (rect.min().y / s).floor() as i64,
+            j1: (rect.max().y / s).ceil() as i64,
+        }))
     }
 
     /// All points of `rect` for `density`, appended to `out`; returns how many.

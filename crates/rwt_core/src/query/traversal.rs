@@ -10,7 +10,7 @@ use crate::tiling::base_tile;
 use glam::DVec2;
 
 /// Blocks of base tiles wider than this are bounded as a whole before they are split.
-const LEAF_BLOCK: i64 = 8;
+pub(super) const LEAF_BLOCK: i64 = 8;
 
 /// Most cells of a subdivision (`n = 8`).
 const MAX_CELLS: usize = 64;

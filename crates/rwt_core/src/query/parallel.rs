@@ -1,0 +1,107 @@
+//! Parallel queries (feature `parallel`): the serial traversal's block recursion with its
+//! splits forked on rayon. Each branch collects its own points and the branches are joined
+//! in the order the serial traversal visits them, so a parallel query returns exactly the
+//! serial query's points in exactly its order.
+
+use super::traversal::{LEAF_BLOCK, Visit};
+use super::{Point, QueryError, Rect, Sampler, TileRange};
+use crate::density::{Density, sanitize};
+use glam::DVec2;
+
+impl Sampler {
+    /// The points of `rect` for `density`, appended to `out` in the order
+    /// [`Sampler::query`] gives them, computed on rayon's thread pool; returns how many.
+    /// Blocks of base tiles are the unit of work, so small queries gain nothing.
+    ///
+    /// ```
+    /// use glam::DVec2;
+    /// use rwt_core::{Constant, Rect, Sampler, TileSet};
+    ///
+    /// let sampler = Sampler::new(&TileSet::embedded(), 3);
+    /// let rect = Rect::new(DVec2::ZERO, DVec2::splat(200.0)).unwrap();
+    /// let (mut serial, mut parallel) = (Vec::new(), Vec::new());
+    /// sampler.query(rect, &Constant(2.0), &mut serial).unwrap();
+    /// sampler.query_par(rect, &Constant(2.0), &mut parallel).unwrap();
+    /// assert_eq!(serial, parallel);
+    /// ```
+    pub fn query_par<D: Density + Sync + ?Sized>(
+        &self,
+        rect: Rect,
+        density: &D,
+        out: &mut Vec<Point>,
+    ) -> Result<usize, QueryError> {
+        let Some(range) = self.admit(&rect, density)? else {
+            return Ok(0);
+        };
+        let points = Fork {
+            sampler: self,
+            rect,
+            density,
+        }
+        .blocks(range);
+        out.extend_from_slice(&points);
+        Ok(points.len())
+    }
+}
+
+/// A parallel query in progress.
+struct Fork<'a, D: ?Sized> {
+    sampler: &'a Sampler,
+    rect: Rect,
+    density: &'a D,
+}
+
+impl<D: Density + Sync + ?Sized> Fork<'_, D> {
+    /// The points of base tiles `range`: the serial `Visit::blocks` split, each half on its
+    /// own task, the first half's points first.
+    fn blocks(&self, range: TileRange) -> Vec<Point> {
+        let TileRange { i0, i1, j0, j1 } = range;
+        if i1 <= i0 || j1 <= j0 {
+            return Vec::new();
+        }
+        if i1 - i0 <= LEAF_BLOCK && j1 - j0 <= LEAF_BLOCK {
+            return self.serial(range);
+        }
+        let s = self.sampler.tile_size();
+        let block = Rect::from_ordered(
+            DVec2::new(i0 as f64 * s, j0 as f64 * s),
+            DVec2::new(i1 as f64 * s, j1 as f64 * s),
+        );
+        let Some(block) = block.intersect(&self.rect) else {
+            return Vec::new();
+        };
+        let bound = sanitize(self.density.max_over(block.min(), block.max()));
+        if bound.is_nan() || bound <= 0.0 {
+            return Vec::new();
+        }
+        let (im, jm) = (i0 + (i1 - i0) / 2, j0 + (j1 - j0) / 2);
+        let (first, second) = if i1 - i0 >= j1 - j0 {
+            (TileRange { i1: im, ..range }, TileRange { i0: im, ..range })
+        } else {
+            (TileRange { j1: jm, ..range }, TileRange { j0: jm, ..range })
+        };
+        let (mut a, b) = rayon::join(|| self.blocks(first), || self.blocks(second));
+        a.extend_from_slice(&b);
+        a
+    }
+
+    /// The points of a block small enough to take on one thread.
+    fn serial(&self, range: TileRange) -> Vec<Point> {
+        let mut points = Vec::new();
+        let mut emit = |p: Point| points.push(p);
+        let mut visit = Visit {
+            sampler: self.sampler,
+            rect: self.rect,
+            density: self.density,
+            emit: &mut emit,
+        };
+        visit.blocks(
+            range.i0,
+            range.i1,
+            range.j0,
+            range.j1,
+            self.sampler.tile_size(),
+        );
+        points
+    }
+}
