@@ -1,4 +1,5 @@
-//! `rwt bench`: query throughput and scaling, as ratios measured in one run (one thread).
+//! `rwt bench`: query throughput and scaling, as ratios measured in one run (one thread),
+//! and the parallel query's speedup.
 
 use fast_poisson::Poisson2D;
 use glam::DVec2;
@@ -94,7 +95,9 @@ pub fn run(quick: bool) -> Result<(), String> {
     };
     let uniform_time = bench.throughput()?;
     bench.against_bridson(if quick { 50_000.0 } else { 200_000.0 });
-    bench.scaling(uniform_time)
+    bench.scaling(uniform_time)?;
+    bench.parallel();
+    Ok(())
 }
 
 impl Bench {
@@ -197,6 +200,44 @@ impl Bench {
             bridson_rate / 1e6,
             ours_time * 1e3,
             ours_rate / bridson_rate
+        );
+    }
+
+    /// The parallel query against the serial one, on the noise density (where a query's
+    /// time goes into evaluating the density rather than writing points).
+    fn parallel(&mut self) {
+        let noise = NoiseDensity::new(NoiseParams {
+            seed: 3,
+            frequency: 0.15,
+            octaves: 4,
+            base: 0.5,
+            amplitude: 0.5,
+            scale: 2.0 * self.d_uniform,
+        });
+        let (sampler, rect, out) = (&self.sampler, self.rect, &mut self.out);
+        let serial = best_time(self.runs, || {
+            out.clear();
+            black_box(sampler.query(rect, &noise, out).ok());
+        });
+        let parallel = best_time(self.runs, || {
+            out.clear();
+            black_box(sampler.query_par(rect, &noise, out).ok());
+        });
+        let runs = best_time(self.runs, || {
+            black_box(sampler.query_par_runs(rect, &noise).ok());
+        });
+        say!(
+            "noise (4-octave fBm) over the same world: serial {:.2} ms, parallel {:.2} ms \
+             ({:.2} ms as runs, {:.2}x, before joining them into one vector)",
+            serial * 1e3,
+            parallel * 1e3,
+            runs * 1e3,
+            serial / runs
+        );
+        say!(
+            "parallel: {} threads, speedup {:.2}",
+            rayon::current_num_threads(),
+            serial / parallel
         );
     }
 

@@ -586,6 +586,8 @@ fn parallel_queries_return_the_serial_points_in_the_serial_order() {
             // Appended after what `out` held, in the same order.
             assert_eq!(parallel[..sentinel.len()], sentinel[..]);
             assert_eq!(serial[..], parallel[sentinel.len()..], "{rect:?}");
+            let runs = s.query_par_runs(*rect, density).unwrap();
+            assert!(runs.concat() == serial, "{rect:?}");
             empty += usize::from(n == 0);
         }
     }

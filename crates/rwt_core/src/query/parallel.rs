@@ -7,6 +7,10 @@ use super::traversal::{LEAF_BLOCK, Visit};
 use super::{Point, QueryError, Rect, Sampler, TileRange};
 use crate::density::{Density, sanitize};
 use glam::DVec2;
+use rayon::prelude::*;
+
+/// Points each task copies when the runs are joined.
+const JOIN_GRAIN: usize = 1 << 15;
 
 impl Sampler {
     /// The points of `rect` for `density`, appended to `out` in the order
@@ -30,19 +34,52 @@ impl Sampler {
         density: &D,
         out: &mut Vec<Point>,
     ) -> Result<usize, QueryError> {
+        let runs = self.query_par_runs(rect, density)?;
+        // Start of each run in the joined order; the join itself runs in parallel too.
+        let starts: Vec<usize> = runs
+            .iter()
+            .scan(0, |at, r| {
+                let start = *at;
+                *at += r.len();
+                Some(start)
+            })
+            .collect();
+        let count = runs.iter().map(Vec::len).sum();
+        out.par_extend(
+            (0..count)
+                .into_par_iter()
+                .with_min_len(JOIN_GRAIN)
+                .map(|i| {
+                    let run = starts.partition_point(|&s| s <= i) - 1;
+                    runs[run][i - starts[run]]
+                }),
+        );
+        Ok(count)
+    }
+
+    /// The points of [`Sampler::query_par`] as consecutive runs (one per block of base
+    /// tiles), without joining them into one vector: read in order, the runs are exactly
+    /// the serial query's points in its order. Writers that stream points out (a file, a
+    /// GPU buffer) save the copy that joining costs.
+    pub fn query_par_runs<D: Density + Sync + ?Sized>(
+        &self,
+        rect: Rect,
+        density: &D,
+    ) -> Result<Vec<Vec<Point>>, QueryError> {
         let Some(range) = self.admit(&rect, density)? else {
-            return Ok(0);
+            return Ok(Vec::new());
         };
-        let points = Fork {
+        Ok(Fork {
             sampler: self,
             rect,
             density,
         }
-        .blocks(range);
-        out.extend_from_slice(&points);
-        Ok(points.len())
+        .blocks(range))
     }
 }
+
+/// Most points reserved up front for one block (more grow the vector as usual).
+const MAX_RESERVE: f64 = 4.0e6;
 
 /// A parallel query in progress.
 struct Fork<'a, D: ?Sized> {
@@ -52,15 +89,16 @@ struct Fork<'a, D: ?Sized> {
 }
 
 impl<D: Density + Sync + ?Sized> Fork<'_, D> {
-    /// The points of base tiles `range`: the serial `Visit::blocks` split, each half on its
-    /// own task, the first half's points first.
-    fn blocks(&self, range: TileRange) -> Vec<Point> {
+    /// The points of base tiles `range`, as runs in serial order (joined once at the end,
+    /// not copied at every split): the serial `Visit::blocks` split, each half on its own
+    /// task, the first half's runs first.
+    fn blocks(&self, range: TileRange) -> Vec<Vec<Point>> {
         let TileRange { i0, i1, j0, j1 } = range;
         if i1 <= i0 || j1 <= j0 {
             return Vec::new();
         }
         if i1 - i0 <= LEAF_BLOCK && j1 - j0 <= LEAF_BLOCK {
-            return self.serial(range);
+            return vec![self.serial(range)];
         }
         let s = self.sampler.tile_size();
         let block = Rect::from_ordered(
@@ -81,13 +119,27 @@ impl<D: Density + Sync + ?Sized> Fork<'_, D> {
             (TileRange { j1: jm, ..range }, TileRange { j0: jm, ..range })
         };
         let (mut a, b) = rayon::join(|| self.blocks(first), || self.blocks(second));
-        a.extend_from_slice(&b);
+        a.extend(b);
         a
     }
 
-    /// The points of a block small enough to take on one thread.
+    /// The points of a block small enough to take on one thread, in a vector sized by the
+    /// density's bound over the block (memory the points do not reach is never touched).
     fn serial(&self, range: TileRange) -> Vec<Point> {
-        let mut points = Vec::new();
+        let s = self.sampler.tile_size();
+        let block = Rect::from_ordered(
+            DVec2::new(range.i0 as f64 * s, range.j0 as f64 * s),
+            DVec2::new(range.i1 as f64 * s, range.j1 as f64 * s),
+        );
+        let Some(block) = block.intersect(&self.rect) else {
+            return Vec::new();
+        };
+        let bound = sanitize(self.density.max_over(block.min(), block.max())) * block.area();
+        let mut points = Vec::with_capacity(if bound.is_finite() {
+            (bound * 1.05).min(MAX_RESERVE) as usize + 16
+        } else {
+            0
+        });
         let mut emit = |p: Point| points.push(p);
         let mut visit = Visit {
             sampler: self.sampler,
