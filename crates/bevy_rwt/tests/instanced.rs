@@ -335,3 +335,46 @@ fn chunks_over_the_point_budget_are_refused_and_counted() {
     assert_eq!(fine.refused_chunks, 0);
     assert!(fine.live_instances > 100);
 }
+
+#[test]
+fn chunk_bounds_follow_a_mesh_that_loads_late() {
+    use bevy::camera::primitives::Aabb;
+    let mut app = create_app_with(|app| {
+        app.init_asset::<Mesh>();
+    });
+    let late = app.world().resource::<Assets<Mesh>>().reserve_handle();
+    let grass = ScatterClass::instanced(LayerDensity::Constant(0.5), late.clone(), default());
+    let mut l = layer(LayerDensity::Constant(0.0));
+    l.classes = vec![grass];
+    app.world_mut().spawn(l);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    tick_app(&mut app, 4_000);
+    let tops = |app: &mut App| -> Vec<(f32, f32)> {
+        let mut q = app.world_mut().query::<(&InstancedChunk, &Aabb)>();
+        q.iter(app.world())
+            .map(|(c, a)| (c.mesh_top, a.max().y / c.max_scale))
+            .collect()
+    };
+    let before = tops(&mut app);
+    assert!(!before.is_empty());
+    // Not loaded yet: a unit box.
+    assert!(
+        before
+            .iter()
+            .all(|&(top, y)| top == 1.0 && (y - 1.0).abs() < 0.2)
+    );
+    // A 5-unit tall mesh arrives: every chunk drawing it is refitted.
+    let tall = Mesh::from(Cuboid::new(0.2, 5.0, 0.2)).translated_by(Vec3::Y * 2.5);
+    app.world_mut()
+        .resource_mut::<Assets<Mesh>>()
+        .insert(late.id(), tall)
+        .unwrap();
+    app.update();
+    app.update();
+    let after = tops(&mut app);
+    assert_eq!(after.len(), before.len());
+    assert!(
+        after.iter().all(|&(top, y)| top == 5.0 && y > 4.9),
+        "{after:?}"
+    );
+}

@@ -1,11 +1,13 @@
 //! What the instanced path needs of a class's mesh, checked once per mesh (and again when it
 //! changes): its bounds for culling and fading, or the reason it cannot be drawn.
 
+use super::InstancedChunk;
 use crate::layers::{ClassLook, GroundPlane, ScatterLayer, ScatterLayerStatus};
+use bevy::camera::primitives::Aabb;
 use bevy::camera::primitives::MeshAabb;
 use bevy::ecs::message::MessageCursor;
 use bevy::mesh::{MeshAccessError, PrimitiveTopology};
-use bevy::platform::collections::HashMap;
+use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 
 /// Why an instanced class cannot be drawn. Its chunks still stream and are counted; the
@@ -110,24 +112,41 @@ impl InstancedMeshes {
     }
 }
 
-/// Drops the checks of meshes that changed or went away (apps without meshes have no mesh
-/// events).
-pub(super) fn forget_changed_meshes(
+/// Drops the checks of meshes that changed or went away, and fits the bounds of the chunks
+/// drawing a mesh that loaded or changed (chunks handed over before their mesh loaded were
+/// given a unit box). Apps without meshes have no mesh events.
+pub(super) fn refit_changed_meshes(
     events: Option<Res<Messages<AssetEvent<Mesh>>>>,
     mut cursor: Local<MessageCursor<AssetEvent<Mesh>>>,
     mut checked: ResMut<InstancedMeshes>,
+    meshes: Option<Res<Assets<Mesh>>>,
+    mut chunks: Query<(&mut InstancedChunk, &mut Aabb)>,
 ) {
     let Some(events) = events else {
         return;
     };
+    let mut changed = HashSet::new();
     for event in cursor.read(&events) {
         match event {
             AssetEvent::Modified { id }
             | AssetEvent::Removed { id }
             | AssetEvent::Unused { id } => {
                 checked.0.remove(id);
+                changed.insert(*id);
             }
-            AssetEvent::Added { .. } | AssetEvent::LoadedWithDependencies { .. } => {}
+            AssetEvent::Added { id } | AssetEvent::LoadedWithDependencies { id } => {
+                changed.insert(*id);
+            }
+        }
+    }
+    if changed.is_empty() {
+        return;
+    }
+    for (mut chunk, mut aabb) in &mut chunks {
+        if changed.contains(&chunk.mesh.id()) {
+            let bounds = checked.bounds(&chunk.mesh, meshes.as_deref());
+            chunk.mesh_top = bounds.1.y.max(1e-3);
+            *aabb = chunk.aabb(bounds);
         }
     }
 }

@@ -24,6 +24,7 @@ pub use mesh::{InstancedClassError, InstancedMeshes, check_instanced_mesh};
 pub(crate) use pack::{InstancedClasses, PackedClass};
 pub use plugin::RwtInstancingPlugin;
 
+use bevy::camera::primitives::Aabb;
 use bevy::camera::visibility::{self, VisibilityClass};
 use bevy::prelude::*;
 use bytemuck::{Pod, Zeroable};
@@ -164,6 +165,8 @@ pub struct InstancedChunk {
     pub material: InstancedMaterial,
     /// Height of the mesh's top above its origin (the tip, which sways most).
     pub mesh_top: f32,
+    /// Largest scale of the class's instances (for the chunk's bounds).
+    pub max_scale: f32,
     /// Level-of-detail fall-off of the layer (`near`, `far`), for the shader's fade; `None`
     /// when the layer has none (instances stay at full size).
     pub falloff: Option<(f32, f32)>,
@@ -180,5 +183,18 @@ impl InstancedChunk {
     /// Whether the chunk holds no instance.
     pub fn is_empty(&self) -> bool {
         self.buffer.instances.is_empty()
+    }
+
+    /// Bounds of the instances with `mesh` (min, max) around each (turned any way, at the
+    /// largest scale, swaying up to its height), relative to the chunk corner.
+    pub fn aabb(&self, mesh: (Vec3, Vec3)) -> Aabb {
+        let (lo, hi) = self.buffer.bounds;
+        let (mesh_lo, mesh_hi) = mesh;
+        let reach = mesh_lo.abs().max(mesh_hi.abs());
+        let s = self.max_scale;
+        let horizontal = (reach.x.max(reach.z) * std::f32::consts::SQRT_2 + reach.y) * s;
+        let min = lo + Vec3::new(-horizontal, mesh_lo.y.min(0.0) * s, -horizontal);
+        let max = hi + Vec3::new(horizontal, mesh_hi.y.max(0.0) * s, horizontal);
+        Aabb::from_min_max(min, max)
     }
 }

@@ -30,7 +30,7 @@ impl Plugin for RwtInstancingPlugin {
             .add_systems(
                 self.schedule,
                 (
-                    mesh::forget_changed_meshes.before(RwtSystems::Apply),
+                    mesh::refit_changed_meshes.before(RwtSystems::Apply),
                     mesh::report_class_errors
                         .after(RwtSystems::Apply)
                         .before(RwtSystems::Stats),

@@ -4,7 +4,6 @@ use super::LayerState;
 use crate::instancing::{InstancedChunk, InstancedMeshes, PackedClass};
 use crate::layers::{ClassLook, GroundPlane, HeightFn, ScatterInstance, ScatterLayer};
 use crate::settings::RwtSettings;
-use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
 use rwt_core::query::Point;
 use rwt_core::streaming::ChunkCoord;
@@ -198,7 +197,6 @@ impl Upload<'_> {
         let corner = chunk.rect(layer.streaming.chunk_size).min();
         let max_scale = class.scale * (1.0 + class.scale_variation.abs());
         let mesh_bounds = self.checked.bounds(&look.mesh, self.meshes);
-        let aabb = chunk_aabb(&packed, mesh_bounds, max_scale);
         let component = InstancedChunk {
             layer: entity,
             chunk,
@@ -206,9 +204,11 @@ impl Upload<'_> {
             mesh: look.mesh.clone(),
             material: look.material.clone(),
             mesh_top: mesh_bounds.1.y.max(1e-3),
+            max_scale,
             falloff: layer.falloff.map(|f| (f.near as f32, f.far as f32)),
             buffer: packed.buffer,
         };
+        let aabb = component.aabb(mesh_bounds);
         let transform = Transform::from_xyz(corner.x as f32, 0.0, corner.y as f32);
         Some(match slot {
             Some(e) => {
@@ -218,16 +218,4 @@ impl Upload<'_> {
             None => commands.spawn((component, aabb, transform)).id(),
         })
     }
-}
-
-/// Bounds of a chunk's instances with the mesh around each (turned any way, at the largest
-/// scale, swaying up to its height), relative to the chunk corner.
-fn chunk_aabb(packed: &PackedClass, mesh: (Vec3, Vec3), max_scale: f32) -> Aabb {
-    let (lo, hi) = packed.buffer.bounds;
-    let (mesh_lo, mesh_hi) = mesh;
-    let reach = mesh_lo.abs().max(mesh_hi.abs());
-    let horizontal = (reach.x.max(reach.z) * std::f32::consts::SQRT_2 + reach.y) * max_scale;
-    let min = lo + Vec3::new(-horizontal, mesh_lo.y.min(0.0) * max_scale, -horizontal);
-    let max = hi + Vec3::new(horizontal, mesh_hi.y.max(0.0) * max_scale, horizontal);
-    Aabb::from_min_max(min, max)
 }
