@@ -46,6 +46,18 @@ pub fn synthetic_map(size: u32) -> Vec<f32> {
         .collect()
 }
 
+/// The 4-octave fBm density of the benchmark, averaging `d_uniform`.
+fn bench_noise(d_uniform: f64) -> NoiseDensity {
+    NoiseDensity::new(NoiseParams {
+        seed: 3,
+        frequency: 0.15,
+        octaves: 4,
+        base: 0.5,
+        amplitude: 0.5,
+        scale: 2.0 * d_uniform,
+    })
+}
+
 /// Times one density (monomorphized, as a user's own density type would be).
 fn measure<D: Density>(
     sampler: &Sampler,
@@ -116,14 +128,7 @@ impl Bench {
         let image =
             ImageDensity::from_values(1024, 1024, &map, DVec2::ZERO, DVec2::splat(tiles), scale)
                 .map_err(|e| e.to_string())?;
-        let noise = NoiseDensity::new(NoiseParams {
-            seed: 3,
-            frequency: 0.15,
-            octaves: 4,
-            base: 0.5,
-            amplitude: 0.5,
-            scale: 2.0 * d_uniform,
-        });
+        let noise = bench_noise(d_uniform);
         let rows = vec![
             self.measure("uniform", &Constant(d_uniform)),
             self.measure("image (1024^2 map)", &image),
@@ -206,14 +211,7 @@ impl Bench {
     /// The parallel query against the serial one, on the noise density (where a query's
     /// time goes into evaluating the density rather than writing points).
     fn parallel(&mut self) {
-        let noise = NoiseDensity::new(NoiseParams {
-            seed: 3,
-            frequency: 0.15,
-            octaves: 4,
-            base: 0.5,
-            amplitude: 0.5,
-            scale: 2.0 * self.d_uniform,
-        });
+        let noise = bench_noise(self.d_uniform);
         let (sampler, rect, out) = (&self.sampler, self.rect, &mut self.out);
         let serial = best_time(self.runs, || {
             out.clear();
