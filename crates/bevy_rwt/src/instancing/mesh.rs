@@ -3,8 +3,7 @@
 
 use super::InstancedChunk;
 use crate::layers::{ClassLook, GroundPlane, ScatterLayer, ScatterLayerStatus};
-use bevy::camera::primitives::Aabb;
-use bevy::camera::primitives::MeshAabb;
+use bevy::camera::primitives::{Aabb, MeshAabb};
 use bevy::ecs::message::MessageCursor;
 use bevy::mesh::{MeshAccessError, PrimitiveTopology};
 use bevy::platform::collections::{HashMap, HashSet};
@@ -41,9 +40,8 @@ pub enum InstancedClassError {
 /// Bounds of a mesh that the instanced path can draw (min, max), or why it cannot; `None`
 /// while the mesh's data is not in the main world.
 pub fn check_instanced_mesh(mesh: &Mesh) -> Option<Result<(Vec3, Vec3), InstancedClassError>> {
-    match check_topology(mesh.primitive_topology()) {
-        Ok(()) => {}
-        Err(e) => return Some(Err(e)),
+    if let Err(e) = check_topology(mesh.primitive_topology()) {
+        return Some(Err(e));
     }
     let positions = match mesh.try_attribute(Mesh::ATTRIBUTE_POSITION) {
         Ok(p) => p.len(),
