@@ -98,10 +98,10 @@ pub enum MeshDescription {
 }
 
 impl MeshDescription {
-    /// The mesh of a primitive; `None` for an asset path.
-    pub fn primitive(&self) -> Option<Mesh> {
-        Some(match self {
-            MeshDescription::Path(_) => return None,
+    /// The mesh of a primitive, or the asset path to load.
+    pub fn primitive(&self) -> Result<Mesh, &str> {
+        Ok(match self {
+            MeshDescription::Path(path) => return Err(path),
             MeshDescription::Sphere { radius } => Mesh::from(Sphere::new(*radius)),
             MeshDescription::Cone { radius, height } => Mesh::from(Cone {
                 radius: *radius,
@@ -408,10 +408,9 @@ impl AssetLoader for ScatterLayerLoader {
         let mut meshes = Vec::new();
         let mut materials = Vec::new();
         for (i, c) in description.classes.iter().enumerate() {
-            meshes.push(match (&c.mesh, c.mesh.primitive()) {
-                (MeshDescription::Path(p), _) => ctx.load(p.clone()),
-                (_, Some(m)) => ctx.add_labeled_asset(format!("mesh{i}"), m),
-                (_, None) => Handle::default(),
+            meshes.push(match c.mesh.primitive() {
+                Ok(m) => ctx.add_labeled_asset(format!("mesh{i}"), m),
+                Err(path) => ctx.load(path.to_string()),
             });
             match &c.material {
                 MaterialDescription::Path(p) => materials.push(ctx.load(p.clone())),

@@ -78,9 +78,6 @@ impl Sampler {
     }
 }
 
-/// Most points reserved up front for one block (more grow the vector as usual).
-const MAX_RESERVE: f64 = 4.0e6;
-
 /// A parallel query in progress.
 struct Fork<'a, D: ?Sized> {
     sampler: &'a Sampler,
@@ -123,23 +120,9 @@ impl<D: Density + Sync + ?Sized> Fork<'_, D> {
         a
     }
 
-    /// The points of a block small enough to take on one thread, in a vector sized by the
-    /// density's bound over the block (memory the points do not reach is never touched).
+    /// The points of a block small enough to take on one thread.
     fn serial(&self, range: TileRange) -> Vec<Point> {
-        let s = self.sampler.tile_size();
-        let block = Rect::from_ordered(
-            DVec2::new(range.i0 as f64 * s, range.j0 as f64 * s),
-            DVec2::new(range.i1 as f64 * s, range.j1 as f64 * s),
-        );
-        let Some(block) = block.intersect(&self.rect) else {
-            return Vec::new();
-        };
-        let bound = sanitize(self.density.max_over(block.min(), block.max())) * block.area();
-        let mut points = Vec::with_capacity(if bound.is_finite() {
-            (bound * 1.05).min(MAX_RESERVE) as usize + 16
-        } else {
-            0
-        });
+        let mut points = Vec::new();
         let mut emit = |p: Point| points.push(p);
         let mut visit = Visit {
             sampler: self.sampler,
