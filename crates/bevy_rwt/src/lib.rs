@@ -65,6 +65,8 @@
 //!     .run();
 //! ```
 
+#[cfg(feature = "brush")]
+pub mod brush;
 pub mod diagnostics;
 pub mod gizmos;
 pub mod instancing;
@@ -78,7 +80,7 @@ use bevy::prelude::*;
 pub use diagnostics::RwtStats;
 pub use instancing::{InstancedChunk, InstancedMaterial, RwtInstancingPlugin, RwtWind};
 pub use layers::{
-    AssetStatus, ClassLook, GroundPlane, HeightSource, InstanceInserter, LayerDensity,
+    AssetStatus, ClassLook, GroundPlane, HeightSource, InstanceInserter, LayerDensity, MeshLod,
     ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus,
 };
 pub use rwt_core;
@@ -90,6 +92,8 @@ pub use viewers::{RwtViewer, ViewCone};
 
 /// Everything a game needs.
 pub mod prelude {
+    #[cfg(feature = "brush")]
+    pub use crate::brush::{BrushCommand, BrushTarget, DensityBrush, PaintDab, RwtBrushPlugin};
     pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
     pub use crate::layers::file::{ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{

@@ -333,3 +333,72 @@ fn a_custom_class_inserts_its_own_components() {
         mesh_count + tree_count
     );
 }
+
+#[test]
+fn a_class_with_a_far_look_crossfades_between_its_two_meshes() {
+    use bevy::camera::visibility::VisibilityRange;
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let far_mesh = Handle::<Mesh>::default();
+    let class = ScatterClass::new(
+        LayerDensity::Constant(0.05),
+        Handle::default(),
+        Handle::default(),
+    )
+    .with_lod(far_mesh.clone(), Handle::default(), 40.0);
+    app.world_mut().spawn(
+        ScatterLayer::new(vec![class])
+            .with_tile_size(8.0)
+            .with_streaming(streaming()),
+    );
+    tick_app(&mut app, 2_000);
+    let mut q = app
+        .world_mut()
+        .query::<(&ScatterInstance, &VisibilityRange, &Children)>();
+    let near: Vec<(VisibilityRange, Entity)> = q
+        .iter(app.world())
+        .map(|(_, r, c)| {
+            assert_eq!(c.len(), 1, "one far child");
+            (r.clone(), c[0])
+        })
+        .collect();
+    assert!(near.len() > 100, "{} instances", near.len());
+    assert_eq!(
+        near.len(),
+        instances(&mut app).len(),
+        "every instance has its far look"
+    );
+    for (range, child) in near {
+        assert_eq!(
+            (range.start_margin, range.end_margin.clone()),
+            (0.0..0.0, 38.0..42.0)
+        );
+        let far = app.world().get::<VisibilityRange>(child).unwrap();
+        assert_eq!(
+            far.start_margin, range.end_margin,
+            "the crossfade bands match"
+        );
+        assert!(far.end_margin.start > 1e6);
+        assert!(
+            app.world().get::<ScatterInstance>(child).is_none(),
+            "counted once"
+        );
+    }
+    // Unloading despawns the far looks with their instances.
+    let viewer = app
+        .world_mut()
+        .query_filtered::<Entity, With<RwtViewer>>()
+        .single(app.world())
+        .unwrap();
+    move_viewer(&mut app, viewer, Vec3::new(5_000.0, 0.0, 0.0));
+    tick_app(&mut app, 2_000);
+    move_viewer(&mut app, viewer, Vec3::new(10_000.0, 0.0, 0.0));
+    tick_app(&mut app, 2_000);
+    let far_left = app
+        .world_mut()
+        .query_filtered::<(), (With<VisibilityRange>, Without<ScatterInstance>)>()
+        .iter(app.world())
+        .count();
+    let live = instances(&mut app).len();
+    assert_eq!(far_left, live);
+}

@@ -61,7 +61,9 @@ pub fn nearest_first(
 }
 
 /// Level of detail by density: full density up to `near` from the nearest viewer, falling
-/// linearly to none at `far`. Approaching only adds points between the existing ones.
+/// linearly to `floor` (a fraction of the full density, 0 for none) at `far`. Approaching
+/// only adds points between the existing ones. A floor keeps a sparse remainder out to the
+/// load distance: forests on distant hills rather than bare ones.
 ///
 /// The fall-off is quantized into [`Falloff::BANDS`] bands by the chunk's distance: a chunk
 /// is generated for a band, and re-generated only when a viewer moves it into another one,
@@ -70,30 +72,62 @@ pub fn nearest_first(
 pub struct Falloff {
     /// Distance up to which the density is full.
     pub near: f64,
-    /// Distance from which the density is zero.
+    /// Distance from which the density is `floor`.
     pub far: f64,
+    /// Fraction of the full density kept beyond `far` (0 to 1).
+    pub floor: f64,
 }
 
 impl Falloff {
     /// Bands between `near` and `far`.
     pub const BANDS: f64 = 8.0;
 
+    /// Full density to `near`, none from `far` on.
+    pub fn new(near: f64, far: f64) -> Self {
+        Self {
+            near,
+            far,
+            floor: 0.0,
+        }
+    }
+
+    /// Keeps `floor` (a fraction, clamped to 0..1) of the full density beyond `far`.
+    pub fn with_floor(mut self, floor: f64) -> Self {
+        self.floor = if floor.is_finite() {
+            floor.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        self
+    }
+
     /// Width of a band (never zero).
     fn step(&self) -> f64 {
         ((self.far - self.near) / Self::BANDS).max(1e-6)
     }
 
-    /// The band of a chunk at `distance` from the nearest viewer: 0 within `near`.
+    /// The band of a chunk at `distance` from the nearest viewer: 0 within `near`, and no
+    /// higher than the first band at the floor (farther chunks keep their content).
     pub fn band(&self, distance: f64) -> i64 {
-        ((distance - self.near).max(0.0) / self.step())
+        let band = ((distance - self.near).max(0.0) / self.step())
             .floor()
-            .min(1e6) as i64
+            .min(1e6) as i64;
+        band.min(self.floor_band())
     }
 
-    /// The density factor of a band: 1 for band 0, falling linearly to 0 at `far`. Lower
-    /// bands (nearer) have higher factors, so approaching only adds points.
+    /// The first band whose linear factor is at or below the floor.
+    fn floor_band(&self) -> i64 {
+        let span = (self.far - self.near).max(1e-6);
+        ((1.0 - self.floor.clamp(0.0, 1.0)) * span / self.step())
+            .ceil()
+            .clamp(0.0, 1e6) as i64
+    }
+
+    /// The density factor of a band: 1 for band 0, falling linearly to the floor at `far`.
+    /// Lower bands (nearer) have higher factors, so approaching only adds points.
     pub fn factor(&self, band: i64) -> f64 {
-        (1.0 - band as f64 * self.step() / (self.far - self.near).max(1e-6)).clamp(0.0, 1.0)
+        let linear = 1.0 - band as f64 * self.step() / (self.far - self.near).max(1e-6);
+        linear.max(self.floor).clamp(0.0, 1.0)
     }
 
     /// The band of `chunk` for `viewers`.
@@ -414,10 +448,7 @@ mod tests {
 
     #[test]
     fn falloff_bands_quantize_distance_and_only_add_on_approach() {
-        let f = Falloff {
-            near: 20.0,
-            far: 100.0,
-        };
+        let f = Falloff::new(20.0, 100.0);
         assert_eq!(f.band(0.0), 0);
         assert_eq!(f.band(20.0), 0);
         assert_eq!(f.band(29.9), 0);
@@ -440,11 +471,13 @@ mod tests {
         let chunk = ChunkCoord { x: 0, y: 0 };
         assert_eq!(f.chunk_band(chunk, 10.0, &viewers), f.band(45.0));
         // Degenerate settings stay finite.
-        let flat = Falloff {
-            near: 50.0,
-            far: 50.0,
-        };
+        let flat = Falloff::new(50.0, 50.0);
         assert!(flat.factor(flat.band(60.0)).is_finite());
+        assert!(
+            flat.with_floor(f64::NAN)
+                .factor(flat.band(60.0))
+                .is_finite()
+        );
         assert_eq!(
             nearest_first(
                 [ChunkCoord { x: 5, y: 0 }, ChunkCoord { x: 0, y: 0 }],
@@ -453,6 +486,29 @@ mod tests {
             ),
             [ChunkCoord { x: 0, y: 0 }, ChunkCoord { x: 5, y: 0 }]
         );
+    }
+
+    #[test]
+    fn a_floor_keeps_a_fraction_of_the_density_to_the_load_distance() {
+        let f = Falloff::new(20.0, 100.0).with_floor(0.2);
+        assert_eq!(f.factor(f.band(0.0)), 1.0);
+        assert!((f.factor(f.band(70.0)) - 0.5).abs() < 0.13);
+        // From where the linear fall-off reaches the floor, chunks stay in one band with
+        // the floor's factor: moving far away never re-queries them.
+        let last = f.band(90.0);
+        assert_eq!(f.factor(last), 0.2);
+        for d in [90.0, 100.0, 500.0, 1e9] {
+            assert_eq!(f.band(d), last, "{d}");
+        }
+        assert!(f.band(85.0) < last && f.factor(f.band(85.0)) > 0.2);
+        // Approaching still only adds.
+        let mut before = f64::INFINITY;
+        for d in (0..1500).map(|i| i as f64 * 0.1) {
+            let factor = f.factor(f.band(d));
+            assert!(factor <= before && factor >= 0.2);
+            before = factor;
+        }
+        assert_eq!(Falloff::new(1.0, 2.0).with_floor(7.0).floor, 1.0);
     }
 
     #[test]

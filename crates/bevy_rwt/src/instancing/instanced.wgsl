@@ -14,12 +14,14 @@ struct Chunk {
     tip_color: vec4<f32>,
     // Colour variation, roughness, wind response, fade band.
     params: vec4<f32>,
-    // Fall-off near, far, enabled.
+    // Fall-off near, far, enabled, floor.
     falloff: vec4<f32>,
     // Wind direction (x, z), strength, frequency.
     wind: vec4<f32>,
     // Wind speed.
     wind_motion: vec4<f32>,
+    // Height fraction where the tip colour starts, unused.
+    shading: vec4<f32>,
 };
 
 @group(2) @binding(0) var<uniform> chunk: Chunk;
@@ -68,7 +70,7 @@ fn growth(root: vec3<f32>, appear: f32) -> f32 {
     }
     let distance = length(root.xz - view.world_position.xz);
     let span = max(chunk.falloff.y - chunk.falloff.x, 1e-3);
-    let factor = clamp(1.0 - (distance - chunk.falloff.x) / span, 0.0, 1.0);
+    let factor = max(chunk.falloff.w, clamp(1.0 - (distance - chunk.falloff.x) / span, 0.0, 1.0));
     return clamp((factor - appear) / chunk.params.w, 0.0, 1.0);
 }
 
@@ -106,7 +108,8 @@ fn vertex(in: Vertex) -> VertexOutput {
 #endif
 
     let variation = (tint - 0.5) * chunk.params.x;
-    let shade = mix(chunk.base_color, chunk.tip_color, t);
+    let from = chunk.shading.x;
+    let shade = mix(chunk.base_color, chunk.tip_color, clamp((t - from) / (1.0 - from), 0.0, 1.0));
     var out: VertexOutput;
     out.world_position = vec4<f32>(world, 1.0);
     out.clip_position = position_world_to_clip(world);

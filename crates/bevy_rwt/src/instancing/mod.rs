@@ -51,6 +51,10 @@ pub struct InstancedMaterial {
     /// grows from nothing to full size while the factor rises by this much past the one at
     /// which its point appears.
     pub fade_band: f32,
+    /// Height fraction (0..1) below which the colour is the base colour; the tip colour
+    /// blends in above it. 0 for grass (a gradient from root to tip); near 1 for flowers (a
+    /// green stem under a coloured head).
+    pub tip_from: f32,
 }
 
 impl Default for InstancedMaterial {
@@ -62,6 +66,7 @@ impl Default for InstancedMaterial {
             roughness: 0.8,
             wind_response: 0.25,
             fade_band: 0.1,
+            tip_from: 0.0,
         }
     }
 }
@@ -167,9 +172,9 @@ pub struct InstancedChunk {
     pub mesh_top: f32,
     /// Largest scale of the class's instances (for the chunk's bounds).
     pub max_scale: f32,
-    /// Level-of-detail fall-off of the layer (`near`, `far`), for the shader's fade; `None`
-    /// when the layer has none (instances stay at full size).
-    pub falloff: Option<(f32, f32)>,
+    /// Level-of-detail fall-off of the layer (`near`, `far`, `floor`), for the shader's
+    /// fade; `None` when the layer has none (instances stay at full size).
+    pub falloff: Option<(f32, f32, f32)>,
     /// The instances (shared with the render world without copying).
     pub buffer: Arc<InstanceBuffer>,
 }

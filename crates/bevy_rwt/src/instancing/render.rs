@@ -46,12 +46,14 @@ struct ChunkUniform {
     tip_color: [f32; 4],
     /// Colour variation, roughness, wind response, fade band.
     params: [f32; 4],
-    /// Fall-off near, far, and 1 when the layer has one.
+    /// Fall-off near, far, 1 when the layer has one, and its floor.
     falloff: [f32; 4],
     /// Wind direction (x, z), strength, frequency.
     wind: [f32; 4],
     /// Wind speed.
     wind_motion: [f32; 4],
+    /// Height fraction where the tip colour starts, unused.
+    shading: [f32; 4],
 }
 
 /// A chunk as the render world sees it (its extraction is part of [`InstancedChunk`]'s
@@ -80,7 +82,9 @@ impl ExtractComponent for InstancedChunk {
         let origin = transform.translation();
         let m = &chunk.material;
         let (lo, hi) = chunk.buffer.bounds;
-        let (near, far, on) = chunk.falloff.map_or((0.0, 1.0, 0.0), |(n, f)| (n, f, 1.0));
+        let (near, far, on, floor) = chunk
+            .falloff
+            .map_or((0.0, 1.0, 0.0, 0.0), |(n, f, floor)| (n, f, 1.0, floor));
         Some(ExtractedChunk {
             buffer: chunk.buffer.clone(),
             mesh: chunk.mesh.id(),
@@ -94,7 +98,8 @@ impl ExtractComponent for InstancedChunk {
                     m.wind_response,
                     m.fade_band.max(1e-3),
                 ],
-                falloff: [near, far, on, 0.0],
+                falloff: [near, far, on, floor],
+                shading: [m.tip_from.clamp(0.0, 0.99), 0.0, 0.0, 0.0],
                 ..default()
             },
             centre: origin + (lo + hi) * 0.5,

@@ -10,6 +10,7 @@
 //!     load_distance: 256.0,
 //!     unload_distance: 320.0,
 //!     falloff: (40.0, 200.0),
+//!     falloff_floor: 0.1,
 //!     classes: [
 //!         (density: Noise(seed: 1, frequency: 0.02, octaves: 4, base: 0.2, amplitude: 0.8, scale: 0.4),
 //!          mesh: Cone(radius: 0.6, height: 2.5), material: Color(0.15, 0.4, 0.15)),
@@ -146,6 +147,8 @@ pub struct InstancedMaterialDescription {
     pub wind_response: f32,
     /// See [`InstancedMaterial::fade_band`].
     pub fade_band: f32,
+    /// See [`InstancedMaterial::tip_from`].
+    pub tip_from: f32,
 }
 
 impl Default for InstancedMaterialDescription {
@@ -162,6 +165,7 @@ impl Default for InstancedMaterialDescription {
             roughness: m.roughness,
             wind_response: m.wind_response,
             fade_band: m.fade_band,
+            tip_from: m.tip_from,
         }
     }
 }
@@ -177,6 +181,7 @@ impl InstancedMaterialDescription {
             roughness: self.roughness,
             wind_response: self.wind_response,
             fade_band: self.fade_band,
+            tip_from: self.tip_from,
         }
     }
 }
@@ -233,6 +238,9 @@ pub struct LayerDescription {
     /// Density fall-off `(near, far)`.
     #[serde(default)]
     pub falloff: Option<(f64, f64)>,
+    /// Fraction of the density kept beyond the fall-off's `far` (see [`Falloff::floor`]).
+    #[serde(default)]
+    pub falloff_floor: f64,
     /// Flat ground height.
     #[serde(default)]
     pub height: f32,
@@ -377,7 +385,9 @@ impl LayerDescription {
                 near_distance: defaults.near_distance,
             })
             .with_height(HeightSource::Constant(self.height));
-        layer.falloff = self.falloff.map(|(near, far)| Falloff { near, far });
+        layer.falloff = self
+            .falloff
+            .map(|(near, far)| Falloff::new(near, far).with_floor(self.falloff_floor));
         layer.exclusion = self.exclusion.as_ref().map(|e| e.to_density(&mut image));
         layer.height_range = self.height_range;
         layer.max_slope = self.max_slope;
@@ -481,13 +491,7 @@ mod tests {
         );
         assert_eq!(layer.tile_size, 4.0);
         assert_eq!(layer.streaming.load_distance, 48.0);
-        assert_eq!(
-            layer.falloff,
-            Some(Falloff {
-                near: 20.0,
-                far: 60.0
-            })
-        );
+        assert_eq!(layer.falloff, Some(Falloff::new(20.0, 60.0)));
         assert!(layer.exclusion.is_none());
         let excluded = MEADOW.replace(
             "falloff: (20.0, 60.0),",

@@ -12,6 +12,7 @@ pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
 pub use status::{AssetStatus, ScatterLayerStatus};
 
 use crate::instancing::{InstancedLook, InstancedMaterial};
+use bevy::camera::visibility::VisibilityRange;
 use bevy::prelude::*;
 use rwt_core::density::{Constant, Density, NoiseDensity};
 use rwt_core::streaming::{Falloff, StreamingConfig};
@@ -141,6 +142,46 @@ pub struct ScatterClass {
     pub scale: f32,
     /// Random scale variation, hashed per instance: scale in `scale * (1 +- variation)`.
     pub scale_variation: f32,
+    /// A cheaper look from some distance on (for [`ClassLook::Mesh`] classes).
+    pub lod: Option<MeshLod>,
+}
+
+/// The far level of detail of a mesh class: from `distance` to the camera on, instances show
+/// this mesh and material instead of the class's, crossfading (Bevy's dithered
+/// [`VisibilityRange`]) over `crossfade` around `distance`. Each instance then has one child
+/// entity holding the far look.
+#[derive(Clone, Debug)]
+pub struct MeshLod {
+    /// The far mesh, standing on the same origin as the near one.
+    pub mesh: Handle<Mesh>,
+    /// The far material.
+    pub material: Handle<StandardMaterial>,
+    /// Distance of the switch.
+    pub distance: f32,
+    /// Width of the crossfade band centred on `distance`.
+    pub crossfade: f32,
+}
+
+impl MeshLod {
+    /// The visibility ranges of the near and the far look.
+    pub fn ranges(&self) -> (VisibilityRange, VisibilityRange) {
+        let half = (0.5 * self.crossfade).clamp(0.0, 0.99 * self.distance.max(0.0));
+        let switch = (self.distance - half).max(0.0)..self.distance + half;
+        let near = VisibilityRange {
+            start_margin: 0.0..0.0,
+            end_margin: switch.clone(),
+            use_aabb: false,
+        };
+        let far = VisibilityRange {
+            start_margin: switch,
+            end_margin: Self::NEVER..Self::NEVER,
+            use_aabb: false,
+        };
+        (near, far)
+    }
+
+    /// A distance no camera reaches (the far look never fades out).
+    const NEVER: f32 = 1.0e9;
 }
 
 impl ScatterClass {
@@ -180,12 +221,30 @@ impl ScatterClass {
         )
     }
 
+    /// Shows `mesh` and `material` instead from `distance` on, crossfading over a tenth of
+    /// the distance (see [`MeshLod`]). Only [`ClassLook::Mesh`] classes have levels of detail.
+    pub fn with_lod(
+        mut self,
+        mesh: Handle<Mesh>,
+        material: Handle<StandardMaterial>,
+        distance: f32,
+    ) -> Self {
+        self.lod = Some(MeshLod {
+            mesh,
+            material,
+            distance,
+            crossfade: 0.1 * distance,
+        });
+        self
+    }
+
     fn with_look(density: LayerDensity, look: ClassLook) -> Self {
         Self {
             density,
             look,
             scale: 1.0,
             scale_variation: 0.2,
+            lod: None,
         }
     }
 }
@@ -341,9 +400,17 @@ impl ScatterLayer {
         self
     }
 
-    /// Sets the density fall-off with distance.
+    /// Sets the density fall-off with distance: full to `near`, none from `far` on.
     pub fn with_falloff(mut self, near: f64, far: f64) -> Self {
-        self.falloff = Some(Falloff { near, far });
+        self.falloff = Some(Falloff::new(near, far));
+        self
+    }
+
+    /// Sets the density fall-off with distance: full to `near`, falling to `floor` (a
+    /// fraction of the full density) at `far` and staying there to the load distance, so
+    /// that distant hills keep a sparse forest instead of going bare.
+    pub fn with_falloff_floor(mut self, near: f64, far: f64, floor: f64) -> Self {
+        self.falloff = Some(Falloff::new(near, far).with_floor(floor));
         self
     }
 

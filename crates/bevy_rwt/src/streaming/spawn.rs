@@ -108,8 +108,8 @@ fn spawn_instance(
     };
     // One bundle for the common case: an insert after the spawn would move every instance
     // to a second archetype.
-    match &class.look {
-        ClassLook::Mesh { mesh, material } => commands
+    match (&class.look, &class.lod) {
+        (ClassLook::Mesh { mesh, material }, None) => commands
             .spawn((
                 instance,
                 Mesh3d(mesh.clone()),
@@ -117,13 +117,30 @@ fn spawn_instance(
                 transform,
             ))
             .id(),
-        ClassLook::Custom(insert) => {
+        (ClassLook::Mesh { mesh, material }, Some(lod)) => {
+            let (near, far) = lod.ranges();
+            commands
+                .spawn((
+                    instance,
+                    Mesh3d(mesh.clone()),
+                    MeshMaterial3d(material.clone()),
+                    transform,
+                    near,
+                    children![(
+                        Mesh3d(lod.mesh.clone()),
+                        MeshMaterial3d(lod.material.clone()),
+                        far,
+                    )],
+                ))
+                .id()
+        }
+        (ClassLook::Custom(insert), _) => {
             let mut custom = commands.spawn((instance, transform));
             insert(&mut custom);
             custom.id()
         }
         // Packed in the generation task instead; never queued for spawning.
-        ClassLook::Instanced(_) => commands.spawn((instance, transform)).id(),
+        (ClassLook::Instanced(_), _) => commands.spawn((instance, transform)).id(),
     }
 }
 
@@ -205,7 +222,9 @@ impl Upload<'_> {
             material: look.material.clone(),
             mesh_top: mesh_bounds.1.y.max(1e-3),
             max_scale,
-            falloff: layer.falloff.map(|f| (f.near as f32, f.far as f32)),
+            falloff: layer
+                .falloff
+                .map(|f| (f.near as f32, f.far as f32, f.floor as f32)),
             buffer: packed.buffer,
         };
         let aabb = component.aabb(mesh_bounds);

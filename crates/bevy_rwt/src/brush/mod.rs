@@ -1,0 +1,212 @@
+//! The density brush: paint the maps a layer streams from, in the running game.
+//!
+//! [`RwtBrushPlugin`] turns the cursor into a brush on the ground: it casts the cursor's ray
+//! against the selected layer's [`crate::HeightSource`], paints into (left button) or erases
+//! from (right button) the selected class's density map, and tells the plugin which region
+//! changed ([`crate::DensityMapPainted`]), so only the chunks under the stroke re-scatter.
+//! The wheel sets the size, a key the strength, digit keys the class; recent strokes can be
+//! undone; the maps save to PNG files (with a RON index) and load again, in this game or
+//! another one whose layers have the same names. A gizmo circle shows the brush when Bevy's
+//! gizmos are there.
+//!
+//! Everything the mouse does is also a message, for scripts, tools and tests:
+//! [`PaintDab`] paints one dab, [`BrushCommand`] undoes, saves and loads.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use bevy_rwt::brush::{BrushTarget, DensityBrush, RwtBrushPlugin};
+//! use bevy_rwt::prelude::*;
+//!
+//! fn setup(mut commands: Commands, mut images: ResMut<Assets<Image>>, mut brush: ResMut<DensityBrush>) {
+//!     // A blank 512 x 512 map over 512 x 512 m: flowers grow where it is painted.
+//!     let (map, density) = bevy_rwt::brush::blank_map(&mut images, 512, Vec2::splat(-256.0), Vec2::splat(512.0), 4.0);
+//!     let flowers = commands.spawn((
+//!         Name::new("flowers"),
+//!         ScatterLayer::new(vec![ScatterClass::instanced(density, Handle::default(), InstancedMaterial::default())]),
+//!     )).id();
+//!     let _ = map;
+//!     brush.targets.push(BrushTarget::new(flowers, 0, "flowers"));
+//!     brush.enabled = true;
+//! }
+//!
+//! App::new()
+//!     .add_plugins((DefaultPlugins, RwtPlugin::default(), RwtBrushPlugin))
+//!     .add_systems(Startup, setup)
+//!     .run();
+//! ```
+
+mod paint;
+mod persist;
+mod plugin;
+mod ray;
+
+pub use paint::blank_map;
+pub use persist::{PaintedMapEntry, PaintedMaps};
+pub use plugin::RwtBrushPlugin;
+pub use ray::ground_hit;
+
+use bevy::prelude::*;
+use std::path::PathBuf;
+
+/// A class whose density map the brush paints: the class `class` of the layer on `layer`,
+/// shown to the player as `name`. Its density must be a [`crate::LayerDensity::Image`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct BrushTarget {
+    /// The layer entity.
+    pub layer: Entity,
+    /// The class index in the layer.
+    pub class: usize,
+    /// Name shown in HUDs, and the file name of its map when saved.
+    pub name: String,
+}
+
+impl BrushTarget {
+    /// The class `class` of `layer`, called `name`.
+    pub fn new(layer: Entity, class: usize, name: impl Into<String>) -> Self {
+        Self {
+            layer,
+            class,
+            name: name.into(),
+        }
+    }
+}
+
+/// The keys and buttons of the brush (`None` turns one off).
+#[derive(Clone, Debug)]
+pub struct BrushKeys {
+    /// Turns the brush on and off.
+    pub toggle: Option<KeyCode>,
+    /// Paints while held.
+    pub paint: MouseButton,
+    /// Erases while held.
+    pub erase: MouseButton,
+    /// Cycles through [`DensityBrush::STRENGTHS`].
+    pub strength: Option<KeyCode>,
+    /// Undoes the last stroke.
+    pub undo: Option<KeyCode>,
+    /// Saves the maps to [`DensityBrush::save_dir`].
+    pub save: Option<KeyCode>,
+    /// Loads the maps from [`DensityBrush::save_dir`].
+    pub load: Option<KeyCode>,
+    /// Whether the wheel sets the size, and digits 1-9 select the target.
+    pub wheel_and_digits: bool,
+}
+
+impl Default for BrushKeys {
+    fn default() -> Self {
+        Self {
+            toggle: Some(KeyCode::KeyB),
+            paint: MouseButton::Left,
+            erase: MouseButton::Right,
+            strength: Some(KeyCode::KeyT),
+            undo: Some(KeyCode::KeyZ),
+            save: Some(KeyCode::F5),
+            load: Some(KeyCode::F9),
+            wheel_and_digits: true,
+        }
+    }
+}
+
+/// The brush's settings and state.
+#[derive(Resource, Clone, Debug)]
+pub struct DensityBrush {
+    /// Whether the cursor paints (the mouse is the game's otherwise).
+    pub enabled: bool,
+    /// The maps it can paint.
+    pub targets: Vec<BrushTarget>,
+    /// Index of the selected target.
+    pub selected: usize,
+    /// Radius in world units.
+    pub radius: f32,
+    /// Smallest and largest radius the wheel reaches.
+    pub radius_range: (f32, f32),
+    /// Map value added per second at the brush centre (erasing removes as much).
+    pub strength: f32,
+    /// Strokes kept for undo.
+    pub undo_depth: usize,
+    /// Where [`BrushCommand::Save`] and [`BrushCommand::Load`] from the keys go.
+    pub save_dir: PathBuf,
+    /// Key bindings.
+    pub keys: BrushKeys,
+    /// The ground point under the cursor (updated while enabled).
+    pub cursor: Option<Vec3>,
+    /// Outcome of the last command or dab that could fail.
+    pub last: Option<Result<String, BrushError>>,
+}
+
+impl DensityBrush {
+    /// The strengths the strength key cycles through.
+    pub const STRENGTHS: [f32; 4] = [0.25, 0.5, 1.0, 2.0];
+
+    /// The selected target.
+    pub fn target(&self) -> Option<&BrushTarget> {
+        self.targets.get(self.selected)
+    }
+}
+
+impl Default for DensityBrush {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            targets: Vec::new(),
+            selected: 0,
+            radius: 6.0,
+            radius_range: (0.5, 200.0),
+            strength: 1.0,
+            undo_depth: 32,
+            save_dir: PathBuf::from("painted"),
+            keys: BrushKeys::default(),
+            cursor: None,
+            last: None,
+        }
+    }
+}
+
+/// One dab of paint: adds `amount` (negative erases) at `centre` (ground x, z) of target
+/// `target`'s map, fading smoothly to nothing at `radius`. Dabs in consecutive frames make
+/// one stroke (one undo step).
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct PaintDab {
+    /// Index into [`DensityBrush::targets`].
+    pub target: usize,
+    /// Ground position (x, z).
+    pub centre: Vec2,
+    /// Radius in world units.
+    pub radius: f32,
+    /// Map value added at the centre.
+    pub amount: f32,
+}
+
+/// What the brush can be asked to do besides painting.
+#[derive(Message, Clone, Debug, PartialEq)]
+pub enum BrushCommand {
+    /// Restores the maps as they were before the last stroke.
+    Undo,
+    /// Writes every target's map as a PNG and an index, [`PaintedMaps`], to the folder.
+    Save(PathBuf),
+    /// Reads maps written by `Save` into the targets with the same layer and class names.
+    Load(PathBuf),
+}
+
+/// Why the brush could not do something.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BrushError {
+    /// The target index is not in [`DensityBrush::targets`].
+    #[error("no brush target {0}")]
+    NoTarget(usize),
+    /// The target's layer entity has no `ScatterLayer`, or no such class.
+    #[error("target {0}: no such layer or class")]
+    NoLayer(String),
+    /// The target's class density is not a painted map.
+    #[error("target {0}: its density is not an image map")]
+    NotPaintable(String),
+    /// The map is not loaded, or its texels cannot be read or written on the CPU.
+    #[error("target {0}: map not loaded or not editable on the CPU")]
+    MapUnavailable(String),
+    /// Nothing to undo.
+    #[error("nothing to undo")]
+    NothingToUndo,
+    /// Reading or writing files failed.
+    #[error("{0}")]
+    Io(String),
+}

@@ -1,0 +1,257 @@
+//! Dabs of paint on a map's texels, and what a stroke needs to be undone.
+
+use crate::layers::LayerDensity;
+use bevy::asset::RenderAssetUsages;
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use rwt_core::Rect;
+
+/// A black `size x size` map over the ground rectangle `min..min + size_world` and the
+/// density that reads it (`scale` instances per square unit where it is white): a canvas for
+/// the brush. The map is linear 8-bit RGBA, kept on the CPU so that it can be painted.
+pub fn blank_map(
+    images: &mut Assets<Image>,
+    size: u32,
+    min: Vec2,
+    size_world: Vec2,
+    scale: f64,
+) -> (Handle<Image>, LayerDensity) {
+    let image = Image::new_fill(
+        Extent3d {
+            width: size.max(1),
+            height: size.max(1),
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        &[0, 0, 0, 255],
+        TextureFormat::Rgba8Unorm,
+        RenderAssetUsages::MAIN_WORLD | RenderAssetUsages::RENDER_WORLD,
+    );
+    let handle = images.add(image);
+    let density = LayerDensity::Image {
+        image: handle.clone(),
+        min,
+        size: size_world,
+        scale,
+    };
+    (handle, density)
+}
+
+/// Where a map lies on the ground.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct MapPlacement {
+    pub min: Vec2,
+    pub size: Vec2,
+}
+
+impl MapPlacement {
+    /// Ground position of the centre of texel `(x, y)` of a `w x h` map (row 0 at max z).
+    fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> Vec2 {
+        Vec2::new(
+            self.min.x + (x as f32 + 0.5) / w as f32 * self.size.x,
+            self.min.y + self.size.y - (y as f32 + 0.5) / h as f32 * self.size.y,
+        )
+    }
+
+    /// Texel columns and rows whose centres may lie within `radius` of `centre`.
+    fn texel_span(&self, centre: Vec2, radius: f32, w: u32, h: u32) -> (u32, u32, u32, u32) {
+        let to_x = |g: f32| (g - self.min.x) / self.size.x * w as f32;
+        let to_y = |g: f32| (self.min.y + self.size.y - g) / self.size.y * h as f32;
+        let clamp = |v: f32, n: u32| v.clamp(0.0, n as f32) as u32;
+        let (x0, x1) = (
+            to_x(centre.x - radius).floor(),
+            to_x(centre.x + radius).ceil(),
+        );
+        let (y0, y1) = (
+            to_y(centre.y + radius).floor(),
+            to_y(centre.y - radius).ceil(),
+        );
+        (clamp(x0, w), clamp(x1, w), clamp(y0, h), clamp(y1, h))
+    }
+}
+
+/// The value the layer reads from a texel: the linear luminance (the red channel of
+/// one-channel maps).
+pub(super) fn texel_value(image: &Image, x: u32, y: u32) -> Option<f32> {
+    let c = image.get_color_at(x, y).ok()?.to_linear();
+    Some(match image.texture_descriptor.format {
+        TextureFormat::R8Unorm | TextureFormat::R16Unorm | TextureFormat::R32Float => c.red,
+        _ => 0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue,
+    })
+}
+
+/// Writes a grey of value `v` (linear) to a texel.
+pub(super) fn set_texel_value(image: &mut Image, x: u32, y: u32, v: f32) -> bool {
+    image.set_color_at(x, y, Color::linear_rgb(v, v, v)).is_ok()
+}
+
+/// A map's texel values before a stroke changed them, and the ground the stroke covered.
+#[derive(Default, Debug, Clone)]
+pub(super) struct StrokeRecord {
+    /// Per map: texel index to its value before the stroke.
+    pub before: HashMap<AssetId<Image>, HashMap<u32, f32>>,
+    /// Per map: the ground the stroke's dabs covered.
+    pub regions: HashMap<AssetId<Image>, Rect>,
+}
+
+impl StrokeRecord {
+    fn note(&mut self, map: AssetId<Image>, texel: u32, value: f32) {
+        self.before
+            .entry(map)
+            .or_default()
+            .entry(texel)
+            .or_insert(value);
+    }
+
+    fn cover(&mut self, map: AssetId<Image>, region: Rect) {
+        let merged = match self.regions.get(&map) {
+            Some(r) => {
+                Rect::new(r.min().min(region.min()), r.max().max(region.max())).unwrap_or(region)
+            }
+            None => region,
+        };
+        self.regions.insert(map, merged);
+    }
+
+    /// Whether the stroke changed nothing.
+    pub fn is_empty(&self) -> bool {
+        self.before.values().all(HashMap::is_empty)
+    }
+}
+
+/// Adds `amount` (negative erases) to the texels within `radius` of `centre`, weighted by a
+/// smooth bump (1 at the centre, 0 at the radius), clamped to `0..=1`. Notes each changed
+/// texel's old value in `record`; returns the ground region changed, `None` when nothing
+/// changed (outside the map, or already full or empty), or `Err` for a map whose texels
+/// cannot be read.
+pub(super) fn dab(
+    image: &mut Image,
+    id: AssetId<Image>,
+    at: MapPlacement,
+    centre: Vec2,
+    radius: f32,
+    amount: f32,
+    record: &mut StrokeRecord,
+) -> Result<Option<Rect>, ()> {
+    let (w, h) = (image.width(), image.height());
+    let radius = radius.max(1e-3);
+    let (x0, x1, y0, y1) = at.texel_span(centre, radius, w, h);
+    let mut changed = false;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let d = at.texel_centre(x, y, w, h).distance(centre) / radius;
+            if d >= 1.0 {
+                continue;
+            }
+            let weight = (1.0 - d * d).powi(2);
+            let old = texel_value(image, x, y).ok_or(())?;
+            let new = (old + amount * weight).clamp(0.0, 1.0);
+            if (new - old).abs() < 1e-4 {
+                continue;
+            }
+            record.note(id, y * w + x, old);
+            if !set_texel_value(image, x, y, new) {
+                return Err(());
+            }
+            changed = true;
+        }
+    }
+    if !changed {
+        return Ok(None);
+    }
+    let region = ground_rect(centre - Vec2::splat(radius), centre + Vec2::splat(radius));
+    if let Some(r) = region {
+        record.cover(id, r);
+    }
+    Ok(region)
+}
+
+/// Puts back the texel values a stroke changed in one map.
+pub(super) fn restore(image: &mut Image, before: &HashMap<u32, f32>) {
+    let w = image.width().max(1);
+    for (&texel, &value) in before {
+        set_texel_value(image, texel % w, texel / w, value);
+    }
+}
+
+pub(super) fn ground_rect(min: Vec2, max: Vec2) -> Option<Rect> {
+    Rect::new(
+        glam::DVec2::new(min.x as f64, min.y as f64),
+        glam::DVec2::new(max.x as f64, max.y as f64),
+    )
+    .ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn canvas(format: TextureFormat) -> Image {
+        Image::new_fill(
+            Extent3d {
+                width: 32,
+                height: 32,
+                depth_or_array_layers: 1,
+            },
+            TextureDimension::D2,
+            &vec![0; format.block_copy_size(None).unwrap() as usize],
+            format,
+            RenderAssetUsages::MAIN_WORLD,
+        )
+    }
+
+    #[test]
+    fn a_dab_paints_a_smooth_disc_and_a_stroke_restores() {
+        let at = MapPlacement {
+            min: Vec2::ZERO,
+            size: Vec2::splat(32.0),
+        };
+        for format in [
+            TextureFormat::Rgba8Unorm,
+            TextureFormat::Rgba8UnormSrgb,
+            TextureFormat::R8Unorm,
+            TextureFormat::R32Float,
+        ] {
+            let mut image = canvas(format);
+            let id = AssetId::default();
+            let mut record = StrokeRecord::default();
+            let centre = Vec2::new(10.5, 20.5);
+            let changed = dab(&mut image, id, at, centre, 4.0, 0.6, &mut record).unwrap();
+            assert!(changed.is_some(), "{format:?}");
+            // Row 0 is the max-z edge: ground (10.5, 20.5) is the centre of texel (10, 11).
+            let peak = texel_value(&image, 10, 11).unwrap();
+            let edge = texel_value(&image, 13, 11).unwrap();
+            let outside = texel_value(&image, 15, 11).unwrap();
+            assert!((peak - 0.6).abs() < 0.03, "{format:?} {peak}");
+            assert!(edge > 0.0 && edge < peak, "{format:?} {edge}");
+            assert_eq!(outside, 0.0);
+            // Erasing more than there is stops at 0; restoring brings back the blank map.
+            dab(&mut image, id, at, centre, 4.0, -5.0, &mut record).unwrap();
+            assert_eq!(texel_value(&image, 10, 11).unwrap(), 0.0);
+            restore(&mut image, &record.before[&id]);
+            assert!((0..32).all(|y| (0..32).all(|x| texel_value(&image, x, y) == Some(0.0))));
+        }
+    }
+
+    #[test]
+    fn dabs_off_the_map_change_nothing() {
+        let at = MapPlacement {
+            min: Vec2::ZERO,
+            size: Vec2::splat(32.0),
+        };
+        let mut image = canvas(TextureFormat::Rgba8Unorm);
+        let mut record = StrokeRecord::default();
+        let far = Vec2::new(-100.0, 500.0);
+        let id = AssetId::default();
+        assert_eq!(
+            dab(&mut image, id, at, far, 4.0, 1.0, &mut record),
+            Ok(None)
+        );
+        assert_eq!(
+            dab(&mut image, id, at, Vec2::ONE, 0.0, 1.0, &mut record),
+            Ok(None)
+        );
+        assert!(record.is_empty());
+    }
+}

@@ -1,0 +1,388 @@
+//! The brush plugin: cursor, input, dabs, strokes and their undo, files, the gizmo circle.
+
+use super::paint::{MapPlacement, StrokeRecord, dab, restore};
+use super::persist::{INDEX_FILE, PaintedMapEntry, PaintedMaps, file_name, read_map, write_map};
+use super::{BrushCommand, BrushError, BrushTarget, DensityBrush, PaintDab, ground_hit};
+use crate::layers::{LayerDensity, ScatterLayer};
+use crate::streaming::DensityMapPainted;
+use crate::viewers::RwtViewer;
+use bevy::input::mouse::AccumulatedMouseScroll;
+use bevy::prelude::*;
+use bevy::window::PrimaryWindow;
+use std::collections::VecDeque;
+use std::path::Path;
+
+/// Paints density maps with the mouse (see [`crate::brush`]). Needs [`crate::RwtPlugin`];
+/// draws its circle when Bevy's gizmos are there, reads the mouse and keyboard when Bevy's
+/// input is.
+pub struct RwtBrushPlugin;
+
+impl Plugin for RwtBrushPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<DensityBrush>()
+            .init_resource::<BrushHistory>()
+            .add_message::<PaintDab>()
+            .add_message::<BrushCommand>()
+            .add_message::<DensityMapPainted>()
+            .add_systems(
+                Update,
+                (locate_cursor, brush_input, apply_dabs, apply_commands)
+                    .chain()
+                    .before(crate::RwtSystems::Viewers),
+            );
+    }
+
+    fn finish(&self, app: &mut App) {
+        if app
+            .world()
+            .contains_resource::<bevy::gizmos::config::GizmoConfigStore>()
+        {
+            app.add_systems(PostUpdate, draw_circle);
+        }
+    }
+}
+
+/// Strokes: the one being painted and the finished ones that can be undone.
+#[derive(Resource, Default)]
+struct BrushHistory {
+    open: Option<StrokeRecord>,
+    done: VecDeque<StrokeRecord>,
+}
+
+impl BrushHistory {
+    fn close(&mut self, depth: usize) {
+        if let Some(stroke) = self.open.take().filter(|s| !s.is_empty()) {
+            self.done.push_back(stroke);
+            while self.done.len() > depth.max(1) {
+                self.done.pop_front();
+            }
+        }
+    }
+}
+
+/// A target's map and where it lies.
+struct TargetMap {
+    image: Handle<Image>,
+    at: MapPlacement,
+    scale: f64,
+}
+
+fn target_map(
+    brush: &DensityBrush,
+    index: usize,
+    layers: &Query<&ScatterLayer>,
+) -> Result<TargetMap, BrushError> {
+    let target = brush
+        .targets
+        .get(index)
+        .ok_or(BrushError::NoTarget(index))?;
+    let density = layers
+        .get(target.layer)
+        .ok()
+        .and_then(|l| l.classes.get(target.class))
+        .map(|c| &c.density)
+        .ok_or_else(|| BrushError::NoLayer(target.name.clone()))?;
+    match density {
+        LayerDensity::Image {
+            image,
+            min,
+            size,
+            scale,
+        } => Ok(TargetMap {
+            image: image.clone(),
+            at: MapPlacement {
+                min: *min,
+                size: *size,
+            },
+            scale: *scale,
+        }),
+        _ => Err(BrushError::NotPaintable(target.name.clone())),
+    }
+}
+
+/// The ground point under the cursor, on the selected target's layer.
+fn locate_cursor(
+    mut brush: ResMut<DensityBrush>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    cameras: Query<(&Camera, &GlobalTransform, Has<RwtViewer>)>,
+    layers: Query<&ScatterLayer>,
+    images: Res<Assets<Image>>,
+) {
+    if !brush.enabled {
+        brush.cursor = None;
+        return;
+    }
+    let cursor = windows.iter().find_map(Window::cursor_position);
+    let camera = cameras
+        .iter()
+        .filter(|(c, ..)| c.is_active)
+        .max_by_key(|(.., viewer)| *viewer);
+    let height = brush
+        .target()
+        .and_then(|t| layers.get(t.layer).ok())
+        .and_then(|l| l.height.resolve(&images));
+    let hit = match (cursor, camera, height) {
+        (Some(cursor), Some((camera, transform, _)), Some(height)) => camera
+            .viewport_to_world(transform, cursor)
+            .ok()
+            .and_then(|ray| ground_hit(ray.origin, *ray.direction, &*height, 5000.0)),
+        _ => None,
+    };
+    if brush.cursor != hit {
+        brush.cursor = hit;
+    }
+}
+
+/// Keys, wheel and buttons to brush settings, [`PaintDab`]s and [`BrushCommand`]s.
+#[allow(clippy::too_many_arguments)]
+fn brush_input(
+    mut brush: ResMut<DensityBrush>,
+    keys: Option<Res<ButtonInput<KeyCode>>>,
+    buttons: Option<Res<ButtonInput<MouseButton>>>,
+    scroll: Option<Res<AccumulatedMouseScroll>>,
+    time: Res<Time>,
+    mut dabs: MessageWriter<PaintDab>,
+    mut commands: MessageWriter<BrushCommand>,
+) {
+    let Some(keys) = keys else { return };
+    let k = brush.keys.clone();
+    let pressed = |key: Option<KeyCode>| key.is_some_and(|key| keys.just_pressed(key));
+    if pressed(k.toggle) {
+        brush.enabled = !brush.enabled;
+    }
+    if !brush.enabled {
+        return;
+    }
+    if pressed(k.strength) {
+        let next = DensityBrush::STRENGTHS
+            .iter()
+            .position(|s| *s > brush.strength + 1e-6)
+            .unwrap_or(0);
+        brush.strength = DensityBrush::STRENGTHS[next];
+    }
+    for (key, command) in [
+        (k.undo, BrushCommand::Undo),
+        (k.save, BrushCommand::Save(brush.save_dir.clone())),
+        (k.load, BrushCommand::Load(brush.save_dir.clone())),
+    ] {
+        if pressed(key) {
+            commands.write(command);
+        }
+    }
+    if k.wheel_and_digits {
+        select_and_size(&mut brush, &keys, scroll.as_deref());
+    }
+    let Some((buttons, cursor)) = buttons.zip(brush.cursor) else {
+        return;
+    };
+    let sign = match (buttons.pressed(k.paint), buttons.pressed(k.erase)) {
+        (true, false) => 1.0,
+        (false, true) => -1.0,
+        _ => return,
+    };
+    dabs.write(PaintDab {
+        target: brush.selected,
+        centre: cursor.xz(),
+        radius: brush.radius,
+        amount: sign * brush.strength * time.delta_secs().min(0.1),
+    });
+}
+
+/// Digits 1-9 select a target; the wheel scales the radius.
+fn select_and_size(
+    brush: &mut DensityBrush,
+    keys: &ButtonInput<KeyCode>,
+    scroll: Option<&AccumulatedMouseScroll>,
+) {
+    const DIGITS: [KeyCode; 9] = [
+        KeyCode::Digit1,
+        KeyCode::Digit2,
+        KeyCode::Digit3,
+        KeyCode::Digit4,
+        KeyCode::Digit5,
+        KeyCode::Digit6,
+        KeyCode::Digit7,
+        KeyCode::Digit8,
+        KeyCode::Digit9,
+    ];
+    if let Some(i) = DIGITS.iter().position(|d| keys.just_pressed(*d))
+        && i < brush.targets.len()
+    {
+        brush.selected = i;
+    }
+    let wheel = scroll.map_or(0.0, |s| s.delta.y);
+    if wheel != 0.0 {
+        let (lo, hi) = brush.radius_range;
+        brush.radius = (brush.radius * 1.15f32.powf(wheel.clamp(-5.0, 5.0))).clamp(lo, hi);
+    }
+}
+
+/// Paints this frame's dabs into their maps and tells the plugin what changed; dabs in
+/// consecutive frames make one stroke.
+fn apply_dabs(
+    mut brush: ResMut<DensityBrush>,
+    mut history: ResMut<BrushHistory>,
+    mut dabs: MessageReader<PaintDab>,
+    mut painted: MessageWriter<DensityMapPainted>,
+    mut images: ResMut<Assets<Image>>,
+    layers: Query<&ScatterLayer>,
+) {
+    let mut any = false;
+    for d in dabs.read() {
+        any = true;
+        let map = match target_map(&brush, d.target, &layers) {
+            Ok(map) => map,
+            Err(e) => {
+                brush.last = Some(Err(e));
+                continue;
+            }
+        };
+        let record = history.open.get_or_insert_with(StrokeRecord::default);
+        let name = || brush.targets[d.target].name.clone();
+        let Some(mut image) = images.get_mut(&map.image) else {
+            brush.last = Some(Err(BrushError::MapUnavailable(name())));
+            continue;
+        };
+        let id = map.image.id();
+        match dab(&mut image, id, map.at, d.centre, d.radius, d.amount, record) {
+            Ok(Some(region)) => {
+                painted.write(DensityMapPainted { image: id, region });
+            }
+            Ok(None) => {}
+            Err(()) => brush.last = Some(Err(BrushError::MapUnavailable(name()))),
+        }
+    }
+    if !any {
+        let depth = brush.undo_depth;
+        history.close(depth);
+    }
+}
+
+fn apply_commands(
+    mut brush: ResMut<DensityBrush>,
+    mut history: ResMut<BrushHistory>,
+    mut commands: MessageReader<BrushCommand>,
+    mut painted: MessageWriter<DensityMapPainted>,
+    mut images: ResMut<Assets<Image>>,
+    layers: Query<&ScatterLayer>,
+) {
+    for command in commands.read() {
+        let depth = brush.undo_depth;
+        history.close(depth);
+        let outcome = match command {
+            BrushCommand::Undo => undo(&mut history, &mut images, &mut painted),
+            BrushCommand::Save(dir) => save(&brush, &layers, &images, dir),
+            BrushCommand::Load(dir) => {
+                history.done.clear();
+                load(&brush, &layers, &mut images, dir)
+            }
+        };
+        brush.last = Some(outcome);
+    }
+}
+
+fn undo(
+    history: &mut BrushHistory,
+    images: &mut Assets<Image>,
+    painted: &mut MessageWriter<DensityMapPainted>,
+) -> Result<String, BrushError> {
+    let stroke = history.done.pop_back().ok_or(BrushError::NothingToUndo)?;
+    for (id, before) in &stroke.before {
+        if let Some(mut image) = images.get_mut(*id) {
+            restore(&mut image, before);
+            if let Some(region) = stroke.regions.get(id) {
+                painted.write(DensityMapPainted {
+                    image: *id,
+                    region: *region,
+                });
+            }
+        }
+    }
+    Ok(format!("undid a stroke ({} left)", history.done.len()))
+}
+
+fn save(
+    brush: &DensityBrush,
+    layers: &Query<&ScatterLayer>,
+    images: &Assets<Image>,
+    dir: &Path,
+) -> Result<String, BrushError> {
+    std::fs::create_dir_all(dir).map_err(|e| BrushError::Io(format!("{}: {e}", dir.display())))?;
+    let mut index = PaintedMaps::default();
+    for (i, BrushTarget { name, .. }) in brush.targets.iter().enumerate() {
+        let map = target_map(brush, i, layers)?;
+        let image = images
+            .get(&map.image)
+            .ok_or_else(|| BrushError::MapUnavailable(name.clone()))?;
+        let file = file_name(name);
+        write_map(image, &dir.join(&file))?;
+        index.maps.push(PaintedMapEntry {
+            name: name.clone(),
+            file,
+            min: map.at.min.into(),
+            size: map.at.size.into(),
+            scale: map.scale,
+        });
+    }
+    index.write(dir)?;
+    Ok(format!(
+        "saved {} maps to {}",
+        index.maps.len(),
+        dir.join(INDEX_FILE).display()
+    ))
+}
+
+fn load(
+    brush: &DensityBrush,
+    layers: &Query<&ScatterLayer>,
+    images: &mut Assets<Image>,
+    dir: &Path,
+) -> Result<String, BrushError> {
+    let index = PaintedMaps::read(dir)?;
+    let mut loaded = 0;
+    for entry in &index.maps {
+        let Some(i) = brush.targets.iter().position(|t| t.name == entry.name) else {
+            continue;
+        };
+        let map = target_map(brush, i, layers)?;
+        let mut image = images
+            .get_mut(&map.image)
+            .ok_or_else(|| BrushError::MapUnavailable(entry.name.clone()))?;
+        read_map(&mut image, &dir.join(&entry.file))?;
+        loaded += 1;
+    }
+    Ok(format!("loaded {loaded} maps from {}", dir.display()))
+}
+
+/// The brush circle, following the ground.
+fn draw_circle(
+    brush: Res<DensityBrush>,
+    layers: Query<&ScatterLayer>,
+    images: Res<Assets<Image>>,
+    mut gizmos: Gizmos,
+) {
+    let Some(centre) = brush.cursor.filter(|_| brush.enabled) else {
+        return;
+    };
+    let Some(height) = brush
+        .target()
+        .and_then(|t| layers.get(t.layer).ok())
+        .and_then(|l| l.height.resolve(&images))
+    else {
+        return;
+    };
+    let lift = 0.05 + 0.01 * brush.radius;
+    let ring = |r: f32| {
+        (0..=48).map(move |i| {
+            let a = i as f32 / 48.0 * std::f32::consts::TAU;
+            centre.xz() + Vec2::new(a.cos(), a.sin()) * r
+        })
+    };
+    let color = Color::srgb(1.0, 0.85, 0.2);
+    for (r, alpha) in [(brush.radius, 1.0), (brush.radius * 0.5, 0.5)] {
+        gizmos.linestrip(
+            ring(r).map(|p| Vec3::new(p.x, height(p) + lift, p.y)),
+            color.with_alpha(alpha),
+        );
+    }
+}
