@@ -15,6 +15,9 @@ pub struct FlyCamera {
     pub yaw: f32,
     /// Pitch (radians, negative looks down).
     pub pitch: f32,
+    /// Whether the mouse looks (right button) and the wheel sets the speed; off while the
+    /// mouse does something else (a brush).
+    pub mouse: bool,
 }
 
 impl Default for FlyCamera {
@@ -24,6 +27,7 @@ impl Default for FlyCamera {
             sensitivity: 0.003,
             yaw: 0.0,
             pitch: -0.2,
+            mouse: true,
         }
     }
 }
@@ -53,11 +57,11 @@ fn fly(
     mut cameras: Query<(&mut FlyCamera, &mut Transform)>,
 ) {
     for (mut cam, mut transform) in &mut cameras {
-        if buttons.pressed(MouseButton::Right) {
+        if cam.mouse && buttons.pressed(MouseButton::Right) {
             cam.yaw -= motion.delta.x * cam.sensitivity;
             cam.pitch = (cam.pitch - motion.delta.y * cam.sensitivity).clamp(-1.5, 1.5);
         }
-        if scroll.delta.y != 0.0 {
+        if cam.mouse && scroll.delta.y != 0.0 {
             cam.speed = (cam.speed * 1.2f32.powf(scroll.delta.y)).clamp(1.0, 2000.0);
         }
         transform.rotation = cam.rotation();

@@ -6,8 +6,10 @@
 //! saves a screenshot, prints `rwt-smoke: ... instances N` and exits with status 0.
 
 pub mod fly_camera;
+pub mod foliage;
 pub mod hud;
 pub mod smoke;
+pub mod terrain;
 
 use bevy::prelude::*;
 use bevy::window::{PresentMode, WindowResolution};
@@ -16,16 +18,16 @@ use bevy::window::{PresentMode, WindowResolution};
 pub mod prelude {
     pub use crate::fly_camera::{FlyCamera, FlyCameraPlugin};
     pub use crate::hud::{Hud, HudPlugin};
-    pub use crate::smoke::{CountedInstance, LiveInstances, Smoke, SmokePlugin};
+    pub use crate::smoke::{CountedInstance, LiveInstances, Smoke, SmokePlugin, SmokeReport};
     pub use crate::{example_plugins, textons_dir};
 }
 
-/// Bevy's default plugins with a window titled `title`; smaller and without vsync while a
+/// Bevy's default plugins with a 1280 x 720 window titled `title`; without vsync while a
 /// smoke session runs, so software rendering stays quick.
 pub fn example_plugins(title: &str) -> impl PluginGroup {
     let smoke = smoke::Smoke::from_env();
     let (width, height, present_mode) = if smoke.active() {
-        (960, 540, PresentMode::AutoNoVsync)
+        (1280, 720, PresentMode::AutoNoVsync)
     } else {
         (1280, 720, PresentMode::AutoVsync)
     };

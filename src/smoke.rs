@@ -62,6 +62,22 @@ pub struct CountedInstance;
 #[derive(Resource, Default, Debug, Clone, Copy)]
 pub struct LiveInstances(pub usize, pub usize);
 
+/// What the smoke line reports besides the instances: the instances a scripted brush stroke
+/// added or removed (examples that paint set it), and the most generation tasks pending in
+/// any frame of the session.
+#[derive(Resource, Default, Debug, Clone, Copy)]
+pub struct SmokeReport {
+    /// Instances the scripted stroke added or removed; `None` where nothing is painted.
+    pub painted: Option<usize>,
+    /// Most generation tasks pending in one frame.
+    pub pending_max: usize,
+    /// Generation tasks pending now.
+    pub pending: usize,
+    /// Set by an example whose script is not finished: the screenshot waits for it to be
+    /// cleared (at most [`SCREENSHOT_PATIENCE`] frames, then it is taken anyway).
+    pub hold: bool,
+}
+
 /// Runs the smoke session when the environment asks for one; counts instances always.
 pub struct SmokePlugin;
 
@@ -76,6 +92,7 @@ impl Plugin for SmokePlugin {
         }
         app.insert_resource(smoke)
             .init_resource::<LiveInstances>()
+            .init_resource::<SmokeReport>()
             .init_resource::<Shots>()
             .add_systems(First, count_frame)
             .add_systems(Last, (count_instances, finish).chain());
@@ -90,12 +107,15 @@ fn count_frame(mut smoke: ResMut<Smoke>) {
 
 fn count_instances(
     mut live: ResMut<LiveInstances>,
+    mut report: ResMut<SmokeReport>,
     scattered: Query<(), With<ScatterInstance>>,
     counted: Query<(), With<CountedInstance>>,
     stats: Option<Res<RwtStats>>,
 ) {
     live.0 = scattered.iter().len() + counted.iter().len();
-    live.1 = stats.map_or(0, |s| s.live_instanced);
+    live.1 = stats.as_ref().map_or(0, |s| s.live_instanced);
+    report.pending = stats.map_or(0, |s| s.pending_tasks);
+    report.pending_max = report.pending_max.max(report.pending);
 }
 
 /// Frames to wait for a screenshot with something on it before giving up.
@@ -115,6 +135,7 @@ fn finish(
     mut commands: Commands,
     smoke: Res<Smoke>,
     live: Res<LiveInstances>,
+    report: Res<SmokeReport>,
     mut shots: ResMut<Shots>,
     mut exit: MessageWriter<AppExit>,
 ) {
@@ -128,8 +149,14 @@ fn finish(
         }
         return;
     };
-    if smoke.frame == last {
-        shots.next = Some(last);
+    if smoke.frame >= last && shots.next.is_none() && !shots.pending {
+        let waited = smoke.frame - last;
+        if !report.hold || waited >= SCREENSHOT_PATIENCE / 2 {
+            if report.hold {
+                eprintln!("rwt-smoke: the script did not finish in {waited} frames");
+            }
+            shots.next = Some(smoke.frame);
+        }
     }
     if smoke.frame > last + SCREENSHOT_PATIENCE {
         eprintln!(
@@ -147,6 +174,7 @@ fn finish(
         move |captured: On<ScreenshotCaptured>,
               smoke: Res<Smoke>,
               live: Res<LiveInstances>,
+              report: Res<SmokeReport>,
               mut shots: ResMut<Shots>,
               mut exit: MessageWriter<AppExit>| {
             shots.pending = false;
@@ -161,7 +189,7 @@ fn finish(
                 shots.next = Some(smoke.frame + 10);
                 return;
             }
-            exit.write(save(&path, &rgb, *live));
+            exit.write(save(&path, &rgb, *live, *report));
         },
     );
 }
@@ -177,7 +205,12 @@ pub fn luminance_variance(rgb: &image::RgbImage) -> f64 {
     lum.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / lum.len().max(1) as f64
 }
 
-fn save(path: &std::path::Path, rgb: &image::RgbImage, live: LiveInstances) -> AppExit {
+fn save(
+    path: &std::path::Path,
+    rgb: &image::RgbImage,
+    live: LiveInstances,
+    report: SmokeReport,
+) -> AppExit {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         let _ = std::fs::create_dir_all(dir);
     }
@@ -185,13 +218,20 @@ fn save(path: &std::path::Path, rgb: &image::RgbImage, live: LiveInstances) -> A
         eprintln!("rwt-smoke: cannot write {}: {e}", path.display());
         return AppExit::error();
     }
+    let painted = report
+        .painted
+        .map_or(String::new(), |p| format!(" painted {p}"));
     println!(
-        "rwt-smoke: screenshot {} ({}x{}) instances {} instanced {}",
+        "rwt-smoke: screenshot {} ({}x{}) instances {} instanced {}{painted}",
         path.display(),
         rgb.width(),
         rgb.height(),
         live.0,
         live.1
+    );
+    println!(
+        "rwt-smoke: pending tasks max {}, at the screenshot {}",
+        report.pending_max, report.pending
     );
     AppExit::Success
 }

@@ -78,7 +78,7 @@ pub mod viewers;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 pub use diagnostics::RwtStats;
-pub use instancing::{InstancedChunk, InstancedMaterial, RwtInstancingPlugin, RwtWind};
+pub use instancing::{InstancedChunk, InstancedMaterial, RwtFadeIn, RwtInstancingPlugin, RwtWind};
 pub use layers::{
     AssetStatus, ClassLook, GroundPlane, HeightSource, InstanceInserter, LayerDensity, MeshLod,
     ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus,
@@ -93,14 +93,16 @@ pub use viewers::{RwtViewer, ViewCone};
 /// Everything a game needs.
 pub mod prelude {
     #[cfg(feature = "brush")]
-    pub use crate::brush::{BrushCommand, BrushTarget, DensityBrush, PaintDab, RwtBrushPlugin};
+    pub use crate::brush::{
+        BrushCommand, BrushSystems, BrushTarget, DensityBrush, PaintDab, RwtBrushPlugin,
+    };
     pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
     pub use crate::layers::file::{ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{
         AssetStatus, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
-        HeightSource, InstancedChunk, InstancedMaterial, LayerDensity, RwtPlugin, RwtSettings,
-        RwtStats, RwtSystems, RwtViewer, RwtWind, ScatterClass, ScatterInstance, ScatterLayer,
-        ScatterLayerStatus, ViewCone,
+        HeightSource, InstancedChunk, InstancedMaterial, LayerDensity, RwtFadeIn, RwtPlugin,
+        RwtSettings, RwtStats, RwtSystems, RwtViewer, RwtWind, ScatterClass, ScatterInstance,
+        ScatterLayer, ScatterLayerStatus, ViewCone,
     };
     pub use rwt_core::streaming::{Falloff, StreamingConfig};
 }

@@ -48,6 +48,11 @@ pub use ray::ground_hit;
 use bevy::prelude::*;
 use std::path::PathBuf;
 
+/// The brush's systems (cursor, input, dabs, commands), in `Update` before
+/// [`crate::RwtSystems::Viewers`]; a script that places the brush itself runs after them.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct BrushSystems;
+
 /// A class whose density map the brush paints: the class `class` of the layer on `layer`,
 /// shown to the player as `name`. Its density must be a [`crate::LayerDensity::Image`].
 #[derive(Clone, Debug, PartialEq)]

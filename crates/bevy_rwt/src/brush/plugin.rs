@@ -2,7 +2,9 @@
 
 use super::paint::{MapPlacement, StrokeRecord, dab, restore};
 use super::persist::{INDEX_FILE, PaintedMapEntry, PaintedMaps, file_name, read_map, write_map};
-use super::{BrushCommand, BrushError, BrushTarget, DensityBrush, PaintDab, ground_hit};
+use super::{
+    BrushCommand, BrushError, BrushSystems, BrushTarget, DensityBrush, PaintDab, ground_hit,
+};
 use crate::layers::{LayerDensity, ScatterLayer};
 use crate::streaming::DensityMapPainted;
 use crate::viewers::RwtViewer;
@@ -28,6 +30,7 @@ impl Plugin for RwtBrushPlugin {
                 Update,
                 (locate_cursor, brush_input, apply_dabs, apply_commands)
                     .chain()
+                    .in_set(BrushSystems)
                     .before(crate::RwtSystems::Viewers),
             );
     }

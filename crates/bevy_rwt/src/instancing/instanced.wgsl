@@ -108,8 +108,8 @@ fn vertex(in: Vertex) -> VertexOutput {
 #endif
 
     let variation = (tint - 0.5) * chunk.params.x;
-    let from = chunk.shading.x;
-    let shade = mix(chunk.base_color, chunk.tip_color, clamp((t - from) / (1.0 - from), 0.0, 1.0));
+    let tip_start = chunk.shading.x;
+    let shade = mix(chunk.base_color, chunk.tip_color, clamp((t - tip_start) / (1.0 - tip_start), 0.0, 1.0));
     var out: VertexOutput;
     out.world_position = vec4<f32>(world, 1.0);
     out.clip_position = position_world_to_clip(world);

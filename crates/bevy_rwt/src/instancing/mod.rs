@@ -106,6 +106,17 @@ impl Default for RwtWind {
     }
 }
 
+/// Whether instanced classes grow in and out with the level of detail (the default) or
+/// appear and vanish at full size: turn it off to see the popping the fade hides.
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RwtFadeIn(pub bool);
+
+impl Default for RwtFadeIn {
+    fn default() -> Self {
+        Self(true)
+    }
+}
+
 /// One instance as the GPU reads it: 24 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

@@ -1,7 +1,7 @@
 //! The instancing feature plugin: the wind resource, and the render-world systems that draw
 //! every [`InstancedChunk`] with one instanced draw.
 
-use super::{InstancedChunk, InstancedMeshes, RwtWind};
+use super::{InstancedChunk, InstancedMeshes, RwtFadeIn, RwtWind};
 use super::{mesh, render};
 use crate::settings::RwtSystems;
 use bevy::asset::embedded_asset;
@@ -26,6 +26,7 @@ pub struct RwtInstancingPlugin {
 impl Plugin for RwtInstancingPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<RwtWind>()
+            .init_resource::<RwtFadeIn>()
             .init_resource::<InstancedMeshes>()
             .add_systems(
                 self.schedule,
@@ -43,6 +44,7 @@ impl Plugin for RwtInstancingPlugin {
         app.add_plugins((
             ExtractComponentPlugin::<InstancedChunk>::default(),
             ExtractResourcePlugin::<RwtWind>::default(),
+            ExtractResourcePlugin::<RwtFadeIn>::default(),
         ));
         let render_app = app.sub_app_mut(RenderApp);
         render_app

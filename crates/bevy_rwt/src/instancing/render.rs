@@ -4,7 +4,7 @@
 //! fall-off and wind.
 
 use super::mesh::check_topology;
-use super::{GpuInstance, InstanceBuffer, InstancedChunk, RwtWind};
+use super::{GpuInstance, InstanceBuffer, InstancedChunk, RwtFadeIn, RwtWind};
 use bevy::core_pipeline::core_3d::{Transparent3d, TransparentSortingInfo3d};
 use bevy::ecs::query::QueryItem;
 use bevy::ecs::system::{SystemParamItem, lifetimeless::*};
@@ -115,6 +115,14 @@ impl ExtractResource for RwtWind {
     }
 }
 
+impl ExtractResource for RwtFadeIn {
+    type Source = RwtFadeIn;
+
+    fn extract_resource(source: &Self::Source) -> Self {
+        *source
+    }
+}
+
 /// A chunk's GPU resources.
 #[derive(Component)]
 pub(super) struct GpuChunk {
@@ -216,9 +224,9 @@ impl SpecializedMeshPipeline for InstancedPipeline {
     }
 }
 
-/// Makes the GPU resources of new or changed chunks; updates the uniform when the wind
-/// changes.
-#[allow(clippy::type_complexity)]
+/// Makes the GPU resources of new or changed chunks; updates the uniform when the wind or
+/// the fade-in setting changes.
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub(super) fn prepare_chunks(
     mut commands: Commands,
     mut chunks: Query<(Entity, &ExtractedChunk, Option<&mut GpuChunk>)>,
@@ -227,8 +235,10 @@ pub(super) fn prepare_chunks(
     pipeline: Res<InstancedPipeline>,
     cache: Res<PipelineCache>,
     wind: Option<Res<RwtWind>>,
+    fade: Option<Res<RwtFadeIn>>,
 ) {
     let wind = wind.map(|w| *w).unwrap_or_default();
+    let fade = fade.map(|f| *f).unwrap_or_default();
     for (entity, chunk, gpu) in &mut chunks {
         let mut uniform = chunk.uniform;
         uniform.wind = [
@@ -238,6 +248,9 @@ pub(super) fn prepare_chunks(
             wind.frequency,
         ];
         uniform.wind_motion = [wind.speed, 0.0, 0.0, 0.0];
+        if !fade.0 {
+            uniform.falloff[2] = 0.0;
+        }
         match gpu {
             Some(mut gpu) if Arc::ptr_eq(&gpu.source, &chunk.buffer) => {
                 if gpu.uniform != uniform {

@@ -1,0 +1,272 @@
+//! The vegetation: every plant and rock is placed by a `bevy_rwt` layer (none by hand).
+
+use bevy::prelude::*;
+use bevy_rwt::brush::{BrushTarget, DensityBrush};
+use bevy_rwt::instancing::blade_mesh;
+use bevy_rwt::prelude::*;
+use noise::{NoiseFn, Perlin};
+use rwt_core::density::{NoiseDensity, NoiseParams};
+use rwt_examples::foliage;
+use rwt_examples::terrain::{Terrain, WATER};
+
+/// The painted maps: `MAP_TEXELS` a side over `MAP_SIZE` metres centred on the origin.
+const MAP_TEXELS: u32 = 2048;
+const MAP_SIZE: f32 = 4096.0;
+
+/// Flower colours (petals), one painted map and instanced class each.
+const FLOWERS: [(&str, Color); 3] = [
+    ("red flowers", Color::srgb(0.75, 0.08, 0.06)),
+    ("yellow flowers", Color::srgb(0.95, 0.75, 0.12)),
+    ("blue flowers", Color::srgb(0.3, 0.35, 0.9)),
+];
+
+/// Spawns the layers and aims the brush at the flower and bush maps.
+pub fn setup_layers(
+    mut commands: Commands,
+    terrain: Res<Terrain>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    mut images: ResMut<Assets<Image>>,
+    mut brush: ResMut<DensityBrush>,
+) {
+    let white = materials.add(StandardMaterial {
+        perceptual_roughness: 0.9,
+        reflectance: 0.2,
+        ..default()
+    });
+    let trees = trees(&terrain, &mut meshes, &white);
+    commands.spawn((Name::new("trees"), trees));
+    let rocks = rocks(&terrain, &mut meshes, &white);
+    commands.spawn((Name::new("rocks"), rocks));
+    commands.spawn((Name::new("grass"), grass(&terrain, &mut meshes)));
+    let (flowers, flower_targets) = flowers(&terrain, &mut meshes, &mut images);
+    let flowers = commands.spawn((Name::new("flowers"), flowers)).id();
+    let bush_density = painted_map(&mut images, 9, 0.05, 120.0);
+    let bushes = commands
+        .spawn((
+            Name::new("bushes"),
+            bushes(&terrain, bush_density, &mut meshes, &white),
+        ))
+        .id();
+    brush.targets = flower_targets
+        .into_iter()
+        .enumerate()
+        .map(|(class, name)| BrushTarget::new(flowers, class, name))
+        .chain([BrushTarget::new(bushes, 0, "bushes")])
+        .collect();
+    brush.save_dir = std::env::var_os("RWT_PAINT_DIR").map_or("painted".into(), Into::into);
+}
+
+/// A map over the world's painted square, filled with soft patches of noise (`seed`,
+/// patches about `feature` metres across) so that the world starts with meadows; the density
+/// reads `scale` instances per square metre where it is white.
+fn painted_map(images: &mut Assets<Image>, seed: u32, scale: f64, feature: f64) -> LayerDensity {
+    let min = Vec2::splat(-MAP_SIZE / 2.0);
+    let (handle, density) =
+        bevy_rwt::brush::blank_map(images, MAP_TEXELS, min, Vec2::splat(MAP_SIZE), scale);
+    let noise = Perlin::new(seed);
+    let mut image = images.get_mut(&handle).expect("just added");
+    let data = image.data.as_mut().expect("a CPU-side map");
+    let texel = (MAP_SIZE / MAP_TEXELS as f32) as f64;
+    for (i, px) in data.chunks_exact_mut(4).enumerate() {
+        let (x, y) = (
+            (i as u32 % MAP_TEXELS) as f64,
+            (i as u32 / MAP_TEXELS) as f64,
+        );
+        let n = noise.get([x * texel / feature, y * texel / feature]);
+        let v = ((n - 0.15) * 2.5).clamp(0.0, 1.0);
+        let byte = (v * v * 255.0) as u8;
+        px.copy_from_slice(&[byte, byte, byte, 255]);
+    }
+    density
+}
+
+/// The forests' noise seeds and bases, one per species.
+pub const FORESTS: [(u32, f64); 3] = [(11, -0.1), (12, -0.2), (13, -0.35)];
+
+/// The density of one species' forest (trees per square metre).
+pub fn forest(seed: u32, base: f64) -> NoiseDensity {
+    NoiseDensity::new(NoiseParams {
+        seed,
+        frequency: 1.0 / 650.0,
+        octaves: 4,
+        base,
+        amplitude: 1.9,
+        scale: 0.01,
+    })
+}
+
+/// Forests of three species from fractal noise; near and far meshes crossfade at 180 m.
+/// The fall-off keeps a fifth of the forest out to 2.6 km, so distant hills stay wooded.
+fn trees(
+    terrain: &Terrain,
+    meshes: &mut Assets<Mesh>,
+    material: &Handle<StandardMaterial>,
+) -> ScatterLayer {
+    let [a, b, c] = FORESTS.map(|(seed, base)| LayerDensity::Noise(forest(seed, base)));
+    let species = [
+        (foliage::conifer(), a),
+        (foliage::broadleaf(), b),
+        (foliage::birch(), c),
+    ];
+    let classes = species
+        .into_iter()
+        .map(|(tree, density)| {
+            let near = meshes.add(tree.near);
+            let far = meshes.add(tree.far);
+            let mut class = ScatterClass::new(density, near, material.clone()).with_lod(
+                far,
+                material.clone(),
+                180.0,
+            );
+            class.scale_variation = 0.3;
+            class
+        })
+        .collect();
+    ScatterLayer::new(classes)
+        .with_seed(1)
+        .with_tile_size(128.0)
+        .with_streaming(StreamingConfig {
+            chunk_size: 256.0,
+            load_distance: 2600.0,
+            unload_distance: 2800.0,
+            near_distance: 200.0,
+        })
+        .with_falloff_floor(350.0, 1400.0, 0.2)
+        .with_height(terrain.source())
+        .with_height_range(WATER + 1.5, 112.0)
+        .with_max_slope(0.6)
+}
+
+/// Boulders, more of them on slopes' noise-chosen patches.
+fn rocks(
+    terrain: &Terrain,
+    meshes: &mut Assets<Mesh>,
+    material: &Handle<StandardMaterial>,
+) -> ScatterLayer {
+    let density = LayerDensity::Noise(NoiseDensity::new(NoiseParams {
+        seed: 21,
+        frequency: 1.0 / 300.0,
+        octaves: 3,
+        base: -0.2,
+        amplitude: 1.5,
+        scale: 0.004,
+    }));
+    let mut class = ScatterClass::new(density, meshes.add(foliage::rock()), material.clone());
+    class.scale = 1.1;
+    class.scale_variation = 0.6;
+    ScatterLayer::new(vec![class])
+        .with_seed(4)
+        .with_tile_size(64.0)
+        .with_streaming(StreamingConfig {
+            chunk_size: 64.0,
+            load_distance: 700.0,
+            unload_distance: 780.0,
+            near_distance: 80.0,
+        })
+        .with_falloff(200.0, 700.0)
+        .with_height(terrain.source())
+        .with_height_range(WATER - 2.0, 200.0)
+}
+
+/// Bushes from a painted map (up to 0.05 per square metre).
+fn bushes(
+    terrain: &Terrain,
+    density: LayerDensity,
+    meshes: &mut Assets<Mesh>,
+    material: &Handle<StandardMaterial>,
+) -> ScatterLayer {
+    let mut class = ScatterClass::new(density, meshes.add(foliage::bush()), material.clone());
+    class.scale_variation = 0.4;
+    ScatterLayer::new(vec![class])
+        .with_seed(2)
+        .with_tile_size(64.0)
+        .with_streaming(StreamingConfig {
+            chunk_size: 64.0,
+            load_distance: 500.0,
+            unload_distance: 580.0,
+            near_distance: 80.0,
+        })
+        .with_falloff(150.0, 500.0)
+        .with_height(terrain.source())
+        .with_height_range(WATER + 0.5, 110.0)
+        .with_max_slope(0.8)
+}
+
+/// Grass blades, up to 140 per square metre, drawn from per-chunk instance buffers (no
+/// entity per blade), growing in and out with the level of detail.
+fn grass(terrain: &Terrain, meshes: &mut Assets<Mesh>) -> ScatterLayer {
+    let mut class = ScatterClass::instanced(
+        LayerDensity::Noise(NoiseDensity::new(NoiseParams {
+            seed: 3,
+            frequency: 1.0 / 120.0,
+            octaves: 3,
+            base: 0.45,
+            amplitude: 0.9,
+            scale: 140.0,
+        })),
+        meshes.add(blade_mesh(0.085, 0.6, 0.11)),
+        InstancedMaterial {
+            base_color: Color::srgb(0.05, 0.13, 0.025),
+            tip_color: Color::srgb(0.33, 0.47, 0.12),
+            ..default()
+        },
+    );
+    class.scale_variation = 0.35;
+    ScatterLayer::new(vec![class])
+        .with_seed(3)
+        .with_tile_size(4.0)
+        .with_streaming(StreamingConfig {
+            chunk_size: 16.0,
+            load_distance: 120.0,
+            unload_distance: 140.0,
+            near_distance: 24.0,
+        })
+        .with_falloff(35.0, 115.0)
+        .with_height(terrain.source())
+        .with_height_range(WATER + 0.3, 105.0)
+}
+
+/// Flowers in three colours, each from its own painted map (up to 5 per square metre),
+/// instanced; returns the layer and its maps' names (one per class).
+fn flowers(
+    terrain: &Terrain,
+    meshes: &mut Assets<Mesh>,
+    images: &mut Assets<Image>,
+) -> (ScatterLayer, Vec<String>) {
+    let mesh = meshes.add(foliage::flower(0.62));
+    let classes = FLOWERS
+        .iter()
+        .enumerate()
+        .map(|(i, (_, petals))| {
+            let density = painted_map(images, 30 + i as u32, 5.0, 45.0);
+            let mut class = ScatterClass::instanced(
+                density,
+                mesh.clone(),
+                InstancedMaterial {
+                    base_color: Color::srgb(0.1, 0.22, 0.05),
+                    tip_color: *petals,
+                    color_variation: 0.15,
+                    wind_response: 0.2,
+                    tip_from: 0.86,
+                    ..default()
+                },
+            );
+            class.scale_variation = 0.3;
+            class
+        })
+        .collect();
+    let layer = ScatterLayer::new(classes)
+        .with_seed(5)
+        .with_tile_size(8.0)
+        .with_streaming(StreamingConfig {
+            chunk_size: 16.0,
+            load_distance: 100.0,
+            unload_distance: 120.0,
+            near_distance: 24.0,
+        })
+        .with_falloff(30.0, 95.0)
+        .with_height(terrain.source())
+        .with_height_range(WATER + 0.5, 100.0);
+    (layer, FLOWERS.iter().map(|(n, _)| n.to_string()).collect())
+}

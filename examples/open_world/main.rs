@@ -1,0 +1,286 @@
+//! A game scene streamed by `bevy_rwt`: an unbounded hilly world (walk 10 km in any
+//! direction: nothing is precomputed) with dense wind-blown grass and painted flower
+//! meadows drawn from per-chunk instance buffers, bushes, rocks and three tree species as
+//! entities (near and far meshes crossfading), forests thinning to a sparse remainder that
+//! reaches the horizon, and a density brush that paints the flower and bush maps live.
+//!
+//! `cargo run --release --example open_world`
+//! - WASD / arrows fly, Q / E down and up, Shift boosts, hold the right mouse button to
+//!   look, the wheel sets the speed;
+//! - B toggles the brush: left mouse paints, right erases, the wheel sizes it, T sets the
+//!   strength, 1-4 choose the map, Z undoes, F5 saves the maps to `painted/`, F9 loads them;
+//! - V toggles the wind, F the fade-in (see the popping it hides), G chunk outlines.
+
+mod layers;
+mod script;
+
+use bevy::light::CascadeShadowConfigBuilder;
+use bevy::pbr::{DistanceFog, FogFalloff};
+use bevy::prelude::*;
+use bevy_rwt::brush::DensityBrush;
+use bevy_rwt::prelude::*;
+use rwt_examples::prelude::*;
+use rwt_examples::terrain::{GROUND_RECENTRE, Terrain, WATER, ground_centre, ground_mesh};
+
+/// The sky at the horizon; the fog fades into it.
+const SKY: Color = Color::srgb(0.66, 0.77, 0.88);
+
+fn main() {
+    App::new()
+        .insert_resource(ClearColor(SKY))
+        .insert_resource(Terrain::new(2006))
+        .add_plugins((
+            example_plugins("rwt open_world"),
+            SmokePlugin,
+            HudPlugin,
+            FlyCameraPlugin,
+        ))
+        .add_plugins((
+            // Five layers stream at once: more generation tasks in flight per layer.
+            RwtPlugin::default().with_max_tasks(32),
+            RwtGizmosPlugin,
+            RwtBrushPlugin,
+            script::ScriptPlugin,
+        ))
+        .add_systems(Startup, (setup_scene, layers::setup_layers))
+        .add_systems(
+            Update,
+            (stay_above_ground, follow_ground, toggles, hud)
+                .chain()
+                .after(script::ScriptSystems),
+        )
+        .run();
+}
+
+#[derive(Component)]
+struct Ground {
+    centre: Vec2,
+}
+
+#[derive(Component)]
+struct Water;
+
+/// The world around the layers: camera, sun with cascaded shadows, sky light and fog,
+/// ground and water.
+fn setup_scene(
+    mut commands: Commands,
+    terrain: Res<Terrain>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    mut gizmos: ResMut<RwtGizmos>,
+) {
+    *gizmos = RwtGizmos {
+        chunks: false,
+        tiles: false,
+        lift: 60.0,
+    };
+    let start = Vec2::ZERO;
+    commands.spawn((
+        Camera3d::default(),
+        Projection::Perspective(PerspectiveProjection {
+            far: 7000.0,
+            ..default()
+        }),
+        Transform::from_xyz(start.x, terrain.height(start) + 40.0, start.y),
+        FlyCamera {
+            speed: 40.0,
+            ..default()
+        },
+        RwtViewer::default(),
+        DistanceFog {
+            color: SKY,
+            directional_light_color: Color::srgba(1.0, 0.93, 0.78, 0.5),
+            directional_light_exponent: 24.0,
+            falloff: FogFalloff::from_visibility_colors(
+                3200.0,
+                Color::srgb(0.42, 0.52, 0.64),
+                Color::srgb(0.72, 0.8, 0.9),
+            ),
+        },
+    ));
+    commands.spawn((
+        DirectionalLight {
+            illuminance: 11_000.0,
+            shadow_maps_enabled: true,
+            color: Color::srgb(1.0, 0.96, 0.88),
+            ..default()
+        },
+        Transform::from_xyz(0.55, 0.6, 0.35).looking_at(Vec3::ZERO, Vec3::Y),
+        CascadeShadowConfigBuilder {
+            num_cascades: 3,
+            first_cascade_far_bound: 30.0,
+            maximum_distance: 350.0,
+            ..default()
+        }
+        .build(),
+    ));
+    commands.insert_resource(GlobalAmbientLight {
+        color: Color::srgb(0.75, 0.83, 1.0),
+        brightness: 500.0,
+        ..default()
+    });
+    commands.spawn((
+        Ground {
+            centre: Vec2::splat(f32::MAX),
+        },
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(1.0, 1.0))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            perceptual_roughness: 0.95,
+            reflectance: 0.2,
+            ..default()
+        })),
+    ));
+    commands.spawn((
+        Water,
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(14_000.0, 14_000.0))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::srgb(0.1, 0.24, 0.32),
+            perceptual_roughness: 0.12,
+            reflectance: 0.35,
+            ..default()
+        })),
+        Transform::from_xyz(0.0, WATER, 0.0),
+    ));
+}
+
+fn stay_above_ground(terrain: Res<Terrain>, mut camera: Query<&mut Transform, With<FlyCamera>>) {
+    for mut t in &mut camera {
+        let ground = terrain.height(t.translation.xz()).max(WATER) + 1.2;
+        if t.translation.y < ground {
+            t.translation.y = ground;
+        }
+    }
+}
+
+/// Rebuilds the ground mesh (and moves the water) under the camera when it strays from the
+/// mesh's centre; the near grid stays on a fixed lattice, so it does not swim.
+fn follow_ground(
+    terrain: Res<Terrain>,
+    camera: Query<&Transform, With<FlyCamera>>,
+    mut ground: Query<(&mut Ground, &Mesh3d), Without<Water>>,
+    mut water: Query<&mut Transform, (With<Water>, Without<FlyCamera>)>,
+    mut meshes: ResMut<Assets<Mesh>>,
+) {
+    let Ok(eye) = camera.single() else {
+        return;
+    };
+    let here = ground_centre(eye.translation.xz());
+    for mut w in &mut water {
+        w.translation.x = here.x;
+        w.translation.z = here.y;
+    }
+    for (mut g, mesh) in &mut ground {
+        if g.centre.distance(eye.translation.xz()) > GROUND_RECENTRE {
+            g.centre = here;
+            if let Some(mut m) = meshes.get_mut(&mesh.0) {
+                *m = ground_mesh(&terrain, here);
+            }
+        }
+    }
+}
+
+/// V wind, F fade-in, G chunk outlines; the mouse is the brush's while it is on.
+fn toggles(
+    keys: Res<ButtonInput<KeyCode>>,
+    brush: Res<DensityBrush>,
+    mut gizmos: ResMut<RwtGizmos>,
+    mut wind: ResMut<RwtWind>,
+    mut fade: ResMut<RwtFadeIn>,
+    mut cameras: Query<&mut FlyCamera>,
+) {
+    if keys.just_pressed(KeyCode::KeyG) {
+        gizmos.chunks = !gizmos.chunks;
+    }
+    if keys.just_pressed(KeyCode::KeyV) {
+        wind.strength = if wind.strength > 0.0 { 0.0 } else { 0.5 };
+    }
+    if keys.just_pressed(KeyCode::KeyF) {
+        fade.0 = !fade.0;
+    }
+    for mut cam in &mut cameras {
+        if cam.mouse == brush.enabled {
+            cam.mouse = !brush.enabled;
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn hud(
+    time: Res<Time>,
+    stats: Res<RwtStats>,
+    brush: Res<DensityBrush>,
+    wind: Res<RwtWind>,
+    fade: Res<RwtFadeIn>,
+    layers: Query<(&Name, &ScatterLayerStatus)>,
+    camera: Query<(&Transform, &FlyCamera)>,
+    mut hud: ResMut<Hud>,
+    mut fps: Local<f32>,
+) {
+    let dt = time.delta_secs().max(1e-4);
+    *fps = if *fps == 0.0 {
+        1.0 / dt
+    } else {
+        *fps * 0.95 + 0.05 / dt
+    };
+    let Ok((t, cam)) = camera.single() else {
+        return;
+    };
+    let on = |b: bool| if b { "on" } else { "off" };
+    let per_layer: Vec<String> = layers
+        .iter()
+        .map(|(name, s)| match (s.live_instances, s.live_instanced) {
+            (n, 0) => format!("{name} {n}"),
+            (0, m) => format!("{name} {m} inst."),
+            (n, m) => format!("{name} {n} + {m} inst."),
+        })
+        .collect();
+    hud.lines = vec![
+        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | V wind, F fade-in, G chunks".into(),
+        format!(
+            "position {:.0}, {:.0} m, altitude {:.0} m, speed {:.0} m/s",
+            t.translation.x, t.translation.z, t.translation.y, cam.speed
+        ),
+        format!("live: {}", per_layer.join(", ")),
+        format!(
+            "entities {}  instanced {}  chunks {}  pending tasks {}  streaming {:.2} ms  {:.0} fps",
+            stats.live_instances,
+            stats.live_instanced,
+            stats.loaded_chunks,
+            stats.pending_tasks,
+            stats.streaming_ms,
+            *fps
+        ),
+        format!(
+            "wind {}  fade-in {}  {}",
+            on(wind.strength > 0.0),
+            on(fade.0),
+            brush_line(&brush)
+        ),
+    ];
+}
+
+fn brush_line(brush: &DensityBrush) -> String {
+    if !brush.enabled {
+        return "brush off (B)".into();
+    }
+    let names: Vec<String> = brush
+        .targets
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let mark = if i == brush.selected { "*" } else { "" };
+            format!("{}{mark}{}", i + 1, t.name)
+        })
+        .collect();
+    let last = match &brush.last {
+        Some(Ok(s)) => s.clone(),
+        Some(Err(e)) => format!("error: {e}"),
+        None => String::new(),
+    };
+    format!(
+        "brush: {} | radius {:.1} m (wheel), strength {} (T), Z undo, F5 save, F9 load {last}",
+        names.join(" "),
+        brush.radius,
+        brush.strength
+    )
+}

@@ -1,0 +1,221 @@
+//! The scripted session (`RWT_SCREENSHOT`): a 1.5 km flight, then down to the view the
+//! screenshot shows (`RWT_VIEW`: `eye` in the grass, the default; `forest` at a forest
+//! edge; `aerial` to the horizon; `brush` painting from above), and one brush stroke of red
+//! flowers, whose added instances the smoke line reports.
+
+use crate::layers::{FORESTS, forest};
+use bevy::prelude::*;
+use bevy_rwt::brush::{BrushSystems, DensityBrush, PaintDab};
+use bevy_rwt::prelude::*;
+use bevy_rwt::rwt_core::density::Density;
+use rwt_examples::prelude::*;
+use rwt_examples::terrain::{Terrain, WATER};
+
+/// Runs the script while a smoke session is active.
+pub struct ScriptPlugin;
+
+/// The script's systems (after the brush's, so that it can place the brush).
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ScriptSystems;
+
+impl Plugin for ScriptPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(Script::from_env())
+            .configure_sets(Update, ScriptSystems.after(BrushSystems))
+            .add_systems(
+                Update,
+                (fly, stroke)
+                    .chain()
+                    .in_set(ScriptSystems)
+                    .run_if(|s: Res<Smoke>| s.active()),
+            );
+    }
+}
+
+/// The view the script ends in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum View {
+    Eye,
+    Forest,
+    Aerial,
+    Brush,
+}
+
+#[derive(Resource)]
+struct Script {
+    view: View,
+    /// Where the camera ends: position and yaw, pitch.
+    end: Option<(Vec3, f32, f32)>,
+    stroke: Stroke,
+}
+
+/// The scripted stroke: waits for the painted layers to settle, counts their instances,
+/// paints, then reports how many instances it added or removed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Stroke {
+    Waiting,
+    Painting { baseline: usize, dabs: u32 },
+    Done { baseline: usize },
+}
+
+impl Script {
+    fn from_env() -> Self {
+        let view = match std::env::var("RWT_VIEW").as_deref() {
+            Ok("forest") => View::Forest,
+            Ok("aerial") => View::Aerial,
+            Ok("brush") => View::Brush,
+            _ => View::Eye,
+        };
+        Self {
+            view,
+            end: None,
+            stroke: Stroke::Waiting,
+        }
+    }
+}
+
+/// Share of the session spent flying, and landing.
+const FLIGHT: f32 = 0.55;
+const LANDING: f32 = 0.15;
+
+/// The flight path: 1.5 km along a gentle curve; position (x, z) and yaw at `t` in 0..1.
+fn path(t: f32) -> (Vec2, f32) {
+    let along = 1500.0 * t;
+    let p = Vec2::new(-along * (0.3 * t).sin(), -along * (0.3 * t).cos());
+    (p, 0.6 * t)
+}
+
+fn fly(
+    smoke: Res<Smoke>,
+    terrain: Res<Terrain>,
+    mut script: ResMut<Script>,
+    mut camera: Query<(&mut FlyCamera, &mut Transform)>,
+) {
+    let t = (smoke.progress() / FLIGHT).min(1.0);
+    let landing = ((smoke.progress() - FLIGHT) / LANDING).clamp(0.0, 1.0);
+    let (p, yaw) = path(t);
+    let cruise = Vec3::new(p.x, terrain.height(p).max(WATER) + 22.0, p.y);
+    let view = script.view;
+    let (end, end_yaw, end_pitch) = *script
+        .end
+        .get_or_insert_with(|| end_pose(view, &terrain, path(1.0)));
+    let s = landing * landing * (3.0 - 2.0 * landing);
+    for (mut cam, mut transform) in &mut camera {
+        cam.yaw = yaw + (end_yaw - yaw) * s;
+        cam.pitch = -0.12 + (end_pitch + 0.12) * s;
+        transform.translation = cruise.lerp(end, s);
+        transform.rotation = cam.rotation();
+    }
+}
+
+/// Where each view ends, from the end of the flight at `(p, yaw)`.
+fn end_pose(view: View, terrain: &Terrain, (p, yaw): (Vec2, f32)) -> (Vec3, f32, f32) {
+    let ground = |p: Vec2| terrain.height(p).max(WATER);
+    match view {
+        View::Eye => (Vec3::new(p.x, ground(p) + 1.5, p.y), yaw, -0.1),
+        View::Aerial => (Vec3::new(p.x, ground(p) + 230.0, p.y), yaw, -0.16),
+        View::Brush => (Vec3::new(p.x, ground(p) + 16.0, p.y), yaw, -0.62),
+        View::Forest => {
+            let (at, yaw) = forest_edge(terrain, p);
+            (Vec3::new(at.x, ground(at) + 2.0, at.y), yaw, 0.0)
+        }
+    }
+}
+
+/// A place near `p` in open ground that looks at a forest about 60 m ahead, and the yaw
+/// that looks there.
+fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
+    let density = |q: Vec2| -> f64 {
+        let d = glam::DVec2::new(q.x as f64, q.y as f64);
+        FORESTS.iter().map(|&(s, b)| forest(s, b).density(d)).sum()
+    };
+    let mut best = (f64::MIN, p, 0.0);
+    for ring in 0..30 {
+        for k in 0..24 {
+            let a = k as f32 / 24.0 * std::f32::consts::TAU;
+            let at = p + Vec2::from_angle(a) * (ring as f32 * 40.0);
+            for j in 0..8 {
+                let yaw = j as f32 / 8.0 * std::f32::consts::TAU;
+                // FlyCamera looks along -z turned by yaw.
+                let ahead = at + Vec2::new(-yaw.sin(), -yaw.cos()) * 60.0;
+                let dry = terrain.height(at) > WATER + 2.0 && terrain.height(ahead) > WATER + 2.0;
+                let score = density(ahead) - 3.0 * density(at) - 1e-6 * ring as f64;
+                if dry && score > best.0 {
+                    best = (score, at, yaw);
+                }
+            }
+        }
+    }
+    (best.1, best.2)
+}
+
+/// Live instances of the layer the stroke paints, once it has settled.
+fn painted_instances(brush: &DensityBrush, layers: &Query<&ScatterLayerStatus>) -> Option<usize> {
+    let s = layers.get(brush.targets.first()?.layer).ok()?;
+    (s.pending_tasks == 0 && s.queued_spawns == 0).then_some(s.live_instances + s.live_instanced)
+}
+
+/// The scripted stroke, and its count for the smoke line.
+#[allow(clippy::too_many_arguments)]
+fn stroke(
+    smoke: Res<Smoke>,
+    mut script: ResMut<Script>,
+    mut brush: ResMut<DensityBrush>,
+    mut report: ResMut<SmokeReport>,
+    mut paint: MessageWriter<PaintDab>,
+    layers: Query<&ScatterLayerStatus>,
+    camera: Query<&Transform, With<FlyCamera>>,
+    terrain: Res<Terrain>,
+    stats: Res<RwtStats>,
+) {
+    let Ok(eye) = camera.single() else { return };
+    let (ahead, radius, count) = match script.view {
+        View::Brush => (26.0, 6.0, 14),
+        _ => (9.0, 3.5, 6),
+    };
+    let forward = eye.forward().xz().normalize_or_zero();
+    let centre = eye.translation.xz() + forward * ahead;
+    if script.view == View::Brush && smoke.progress() > FLIGHT {
+        brush.enabled = true;
+        brush.radius = radius;
+        let h = terrain.height(centre);
+        brush.cursor = Some(Vec3::new(centre.x, h, centre.y));
+    }
+    let landed = smoke.progress() >= FLIGHT + LANDING;
+    let settled = painted_instances(&brush, &layers);
+    let before = script.stroke;
+    script.stroke = match script.stroke {
+        Stroke::Waiting => match settled.filter(|_| landed) {
+            Some(baseline) => Stroke::Painting { baseline, dabs: 0 },
+            None => Stroke::Waiting,
+        },
+        Stroke::Painting { baseline, dabs } if dabs < count => {
+            let side = eye.right().xz() * radius * (dabs as f32 / count as f32 - 0.5);
+            paint.write(PaintDab {
+                target: 0,
+                centre: centre + side,
+                radius,
+                amount: 0.5,
+            });
+            Stroke::Painting {
+                baseline,
+                dabs: dabs + 1,
+            }
+        }
+        Stroke::Painting { baseline, .. } => Stroke::Done { baseline },
+        Stroke::Done { baseline } => {
+            if let Some(now) = settled {
+                report.painted = Some(now.abs_diff(baseline));
+            }
+            Stroke::Done { baseline }
+        }
+    };
+    if std::mem::discriminant(&before) != std::mem::discriminant(&script.stroke) {
+        eprintln!(
+            "rwt-smoke: frame {}: stroke {:?}, pending tasks {}",
+            smoke.frame, script.stroke, stats.pending_tasks
+        );
+    }
+    // The screenshot waits for the stroke's count and for streaming to settle.
+    report.hold = report.painted.is_none() || stats.pending_tasks > 0;
+}
