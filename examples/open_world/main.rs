@@ -92,7 +92,7 @@ fn setup_scene(
             directional_light_color: Color::srgba(1.0, 0.93, 0.78, 0.5),
             directional_light_exponent: 24.0,
             falloff: FogFalloff::from_visibility_colors(
-                3200.0,
+                4500.0,
                 Color::srgb(0.42, 0.52, 0.64),
                 Color::srgb(0.72, 0.8, 0.9),
             ),
@@ -257,6 +257,10 @@ fn hud(
             brush_line(&brush)
         ),
     ];
+    if brush.enabled {
+        hud.lines
+            .push("wheel radius, T strength, Z undo, F5 save, F9 load, 1-4 map".into());
+    }
 }
 
 fn brush_line(brush: &DensityBrush) -> String {
@@ -278,7 +282,7 @@ fn brush_line(brush: &DensityBrush) -> String {
         None => String::new(),
     };
     format!(
-        "brush: {} | radius {:.1} m (wheel), strength {} (T), Z undo, F5 save, F9 load {last}",
+        "brush: {} | radius {:.1} m, strength {} {last}",
         names.join(" "),
         brush.radius,
         brush.strength

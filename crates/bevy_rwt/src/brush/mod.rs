@@ -135,6 +135,8 @@ pub struct DensityBrush {
     pub keys: BrushKeys,
     /// The ground point under the cursor (updated while enabled).
     pub cursor: Option<Vec3>,
+    /// Height of the gizmo circle above the ground (above the grass, so that it shows).
+    pub circle_lift: f32,
     /// Outcome of the last command or dab that could fail.
     pub last: Option<Result<String, BrushError>>,
 }
@@ -162,6 +164,7 @@ impl Default for DensityBrush {
             save_dir: PathBuf::from("painted"),
             keys: BrushKeys::default(),
             cursor: None,
+            circle_lift: 0.8,
             last: None,
         }
     }

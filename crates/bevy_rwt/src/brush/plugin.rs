@@ -374,7 +374,7 @@ fn draw_circle(
     else {
         return;
     };
-    let lift = 0.05 + 0.01 * brush.radius;
+    let lift = brush.circle_lift;
     let ring = |r: f32| {
         (0..=48).map(move |i| {
             let a = i as f32 / 48.0 * std::f32::consts::TAU;
