@@ -493,6 +493,16 @@ mod tests {
         assert_eq!(layer.streaming.load_distance, 48.0);
         assert_eq!(layer.falloff, Some(Falloff::new(20.0, 60.0)));
         assert!(layer.exclusion.is_none());
+        let floored = MEADOW.replace(
+            "falloff: (20.0, 60.0),",
+            "falloff: (20.0, 60.0), falloff_floor: 0.25,",
+        );
+        let floored = LayerDescription::from_ron(&floored).unwrap().to_layer(
+            |_| Handle::default(),
+            |_| Handle::default(),
+            |_| Handle::default(),
+        );
+        assert_eq!(floored.falloff.map(|f| f.floor), Some(0.25));
         let excluded = MEADOW.replace(
             "falloff: (20.0, 60.0),",
             "falloff: (20.0, 60.0), exclusion: Image(path: \"roads.png\", min: (0.0, 0.0), size: (8.0, 8.0), scale: 1.0),",
