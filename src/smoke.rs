@@ -74,7 +74,7 @@ pub struct SmokeReport {
     /// Generation tasks pending now.
     pub pending: usize,
     /// Set by an example whose script is not finished: the screenshot waits for it to be
-    /// cleared (at most [`SCREENSHOT_PATIENCE`] frames, then it is taken anyway).
+    /// cleared (at most 450 frames, then it is taken anyway).
     pub hold: bool,
 }
 
