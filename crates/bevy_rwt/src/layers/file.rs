@@ -31,7 +31,7 @@ use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::Falloff;
 use rwt_core::streaming::StreamingConfig;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// A layer loaded from a `.layer.ron` file.
 #[derive(Asset, TypePath, Clone, Debug)]
@@ -45,7 +45,7 @@ pub struct ScatterLayerAsset(pub ScatterLayer);
 pub struct ScatterLayerSource(pub Handle<ScatterLayerAsset>);
 
 /// A density in a layer file.
-#[derive(Deserialize, Clone, Debug, PartialEq)]
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub enum DensityDescription {
     /// Instances per square unit.
     Constant(f64),
@@ -65,7 +65,7 @@ pub enum DensityDescription {
 }
 
 /// A mesh in a layer file: an asset path or a primitive.
-#[derive(Deserialize, Clone, Debug, PartialEq)]
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub enum MeshDescription {
     /// Asset path, e.g. `"models/tree.glb#Mesh0/Primitive0"`.
     Path(String),
@@ -120,7 +120,7 @@ impl MeshDescription {
 
 /// A material in a layer file: an asset path or a plain colour (linear RGB) for entity
 /// classes, or the shading of an instanced class.
-#[derive(Deserialize, Clone, Debug, PartialEq)]
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub enum MaterialDescription {
     /// Asset path, e.g. `"models/tree.glb#Material0"`.
     Path(String),
@@ -132,7 +132,7 @@ pub enum MaterialDescription {
 
 /// The shading of an instanced class in a layer file (colours linear RGB); each field
 /// defaults to [`InstancedMaterial::default`]'s.
-#[derive(Deserialize, Clone, Debug, PartialEq)]
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 #[serde(default)]
 pub struct InstancedMaterialDescription {
     /// Colour at the root.
@@ -195,7 +195,7 @@ fn variation() -> f32 {
 }
 
 /// A class in a layer file.
-#[derive(Deserialize, Clone, Debug, PartialEq)]
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct ClassDescription {
     /// Where and how densely the class grows.
     pub density: DensityDescription,
@@ -216,7 +216,7 @@ fn default_tile() -> f64 {
 }
 
 /// A whole layer file.
-#[derive(Deserialize, Clone, Debug, PartialEq)]
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct LayerDescription {
     /// Classes sharing the layer's point set.
     pub classes: Vec<ClassDescription>,
@@ -288,9 +288,22 @@ pub enum LayerFileError {
     /// Valid RON with values out of range.
     #[error("invalid layer: {0}")]
     Invalid(String),
+    /// The description could not be written as RON.
+    #[error("cannot write layer file: {0}")]
+    Write(String),
 }
 
 impl LayerDescription {
+    /// The layer file text: what [`LayerDescription::from_ron`] reads back (optional fields
+    /// as plain values).
+    pub fn to_ron(&self) -> Result<String, LayerFileError> {
+        let config = ron::ser::PrettyConfig::default().extensions(
+            ron::extensions::Extensions::IMPLICIT_SOME
+                | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES,
+        );
+        ron::ser::to_string_pretty(self, config).map_err(|e| LayerFileError::Write(e.to_string()))
+    }
+
     /// Parses and checks a layer file.
     pub fn from_ron(text: &str) -> Result<Self, LayerFileError> {
         // Optional fields take plain values (`falloff: (40.0, 200.0)`, not `Some(..)`), and
@@ -477,6 +490,26 @@ mod tests {
              mesh: Sphere(radius: 0.3), material: Color(0.6, 0.2, 0.2), scale: 1.5),
         ],
     )"#;
+
+    #[test]
+    fn a_layer_file_writes_and_reads_back_the_same() {
+        let with_all = MEADOW.replace(
+            "falloff: (20.0, 60.0),",
+            "falloff: (20.0, 60.0), falloff_floor: 0.25, exclusion: Image(path: \"roads.png\", min: (0.0, 0.0), size: (8.0, 8.0), scale: 1.0),",
+        );
+        let with_all = with_all.replace(
+            "classes: [",
+            r#"classes: [
+            (density: Image(path: "m.png", min: (0.0, 0.0), size: (8.0, 8.0), scale: 2.0),
+             mesh: Blade(width: 0.1, height: 0.6), material: Instanced(tip: (0.3, 0.5, 0.1), tip_from: 0.8)),
+            (density: Constant(1.0), mesh: Path("a.glb#Mesh0/Primitive0"), material: Path("a.glb#Material0")),"#,
+        );
+        let d = LayerDescription::from_ron(&with_all).unwrap();
+        assert_eq!(d.classes.len(), 4);
+        let text = d.to_ron().unwrap();
+        assert!(!text.contains("Some("), "{text}");
+        assert_eq!(LayerDescription::from_ron(&text).unwrap(), d);
+    }
 
     #[test]
     fn parses_a_layer_file() {
