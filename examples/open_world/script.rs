@@ -125,9 +125,10 @@ fn end_pose(view: View, terrain: &Terrain, (p, yaw): (Vec2, f32)) -> (Vec3, f32,
 /// A place near `p` in open ground that looks at a forest about 60 m ahead, and the yaw
 /// that looks there.
 fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
+    let forests = FORESTS.map(|(seed, base)| forest(seed, base));
     let density = |q: Vec2| -> f64 {
         let d = glam::DVec2::new(q.x as f64, q.y as f64);
-        FORESTS.iter().map(|&(s, b)| forest(s, b).density(d)).sum()
+        forests.iter().map(|f| f.density(d)).sum()
     };
     let mut best = (f64::MIN, p, 0.0);
     for ring in 0..30 {

@@ -112,6 +112,32 @@ fn erasing_removes_what_was_painted() {
 }
 
 #[test]
+fn dabs_that_change_nothing_leave_the_map_and_its_chunks_alone() {
+    let (mut app, _) = painted_app();
+    let before = instances(&mut app);
+    // Erasing a blank map, and painting off the map: no texel changes.
+    for centre in [Vec2::new(10.0, 10.0), Vec2::new(1_000.0, 1_000.0)] {
+        app.world_mut().write_message(PaintDab {
+            target: 0,
+            centre,
+            radius: 8.0,
+            amount: -1.0,
+        });
+        for _ in 0..3 {
+            app.update();
+            let pending = app.world().resource::<RwtStats>().pending_tasks;
+            assert_eq!(pending, 0, "a dab that changed nothing re-scattered chunks");
+        }
+    }
+    assert_eq!(instances(&mut app), before);
+    // Nothing to undo either.
+    assert_eq!(
+        command(&mut app, BrushCommand::Undo),
+        Err(BrushError::NothingToUndo)
+    );
+}
+
+#[test]
 fn maps_save_and_load_into_another_world() {
     let dir = std::env::temp_dir().join(format!("rwt-brush-{}", std::process::id()));
     let (mut app, _) = painted_app();

@@ -1,6 +1,6 @@
 //! Dabs of paint on a map's texels, and what a stroke needs to be undone.
 
-use crate::layers::LayerDensity;
+use crate::layers::{LayerDensity, ground_rect, texel_luminance};
 use bevy::asset::RenderAssetUsages;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -71,18 +71,8 @@ impl MapPlacement {
     }
 }
 
-/// The value the layer reads from a texel: the linear luminance (the red channel of
-/// one-channel maps).
-pub(super) fn texel_value(image: &Image, x: u32, y: u32) -> Option<f32> {
-    let c = image.get_color_at(x, y).ok()?.to_linear();
-    Some(match image.texture_descriptor.format {
-        TextureFormat::R8Unorm | TextureFormat::R16Unorm | TextureFormat::R32Float => c.red,
-        _ => 0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue,
-    })
-}
-
 /// Writes a grey of value `v` (linear) to a texel.
-pub(super) fn set_texel_value(image: &mut Image, x: u32, y: u32, v: f32) -> bool {
+pub(super) fn set_texel_luminance(image: &mut Image, x: u32, y: u32, v: f32) -> bool {
     image.set_color_at(x, y, Color::linear_rgb(v, v, v)).is_ok()
 }
 
@@ -120,24 +110,30 @@ impl StrokeRecord {
     }
 }
 
-/// Adds `amount` (negative erases) to the texels within `radius` of `centre`, weighted by a
-/// smooth bump (1 at the centre, 0 at the radius), clamped to `0..=1`. Notes each changed
-/// texel's old value in `record`; returns the ground region changed, `None` when nothing
-/// changed (outside the map, or already full or empty), or `Err` for a map whose texels
-/// cannot be read.
+/// What a dab does to a map: the texels it changes and the ground it covers.
+#[derive(Debug, Default, PartialEq)]
+pub(super) struct Dab {
+    /// Texel index, old value, new value.
+    changes: Vec<(u32, f32, f32)>,
+    region: Option<Rect>,
+}
+
+/// The dab adding `amount` (negative erases) to the texels within `radius` of `centre`,
+/// weighted by a smooth bump (1 at the centre, 0 at the radius), clamped to `0..=1`: read
+/// only, so that a dab changing nothing (outside the map, or already full or empty) leaves
+/// the map unmodified (a modified map is re-read and re-scattered). `Err` for a map whose
+/// texels cannot be read.
 pub(super) fn dab(
-    image: &mut Image,
-    id: AssetId<Image>,
+    image: &Image,
     at: MapPlacement,
     centre: Vec2,
     radius: f32,
     amount: f32,
-    record: &mut StrokeRecord,
-) -> Result<Option<Rect>, ()> {
+) -> Result<Dab, ()> {
     let (w, h) = (image.width(), image.height());
     let radius = radius.max(1e-3);
     let (x0, x1, y0, y1) = at.texel_span(centre, radius, w, h);
-    let mut changed = false;
+    let mut changes = Vec::new();
     for y in y0..y1 {
         for x in x0..x1 {
             let d = at.texel_centre(x, y, w, h).distance(centre) / radius;
@@ -145,42 +141,55 @@ pub(super) fn dab(
                 continue;
             }
             let weight = (1.0 - d * d).powi(2);
-            let old = texel_value(image, x, y).ok_or(())?;
+            let old = texel_luminance(image, x, y).ok_or(())?;
             let new = (old + amount * weight).clamp(0.0, 1.0);
-            if (new - old).abs() < 1e-4 {
-                continue;
+            if (new - old).abs() >= 1e-4 {
+                changes.push((y * w + x, old, new));
             }
-            record.note(id, y * w + x, old);
-            if !set_texel_value(image, x, y, new) {
-                return Err(());
-            }
-            changed = true;
         }
     }
-    if !changed {
-        return Ok(None);
+    let region = ground_rect(centre - Vec2::splat(radius), Vec2::splat(2.0 * radius));
+    Ok(Dab { changes, region })
+}
+
+impl Dab {
+    /// Whether the dab changes no texel.
+    pub fn is_empty(&self) -> bool {
+        self.changes.is_empty()
     }
-    let region = ground_rect(centre - Vec2::splat(radius), centre + Vec2::splat(radius));
-    if let Some(r) = region {
-        record.cover(id, r);
+
+    /// Writes the dab into map `id`, noting each changed texel's old value in `record`;
+    /// returns the ground region changed (`None` when nothing changed), or `Err` for a map
+    /// whose texels cannot be written.
+    pub fn apply(
+        &self,
+        image: &mut Image,
+        id: AssetId<Image>,
+        record: &mut StrokeRecord,
+    ) -> Result<Option<Rect>, ()> {
+        if self.is_empty() {
+            return Ok(None);
+        }
+        let w = image.width().max(1);
+        for &(texel, old, new) in &self.changes {
+            record.note(id, texel, old);
+            if !set_texel_luminance(image, texel % w, texel / w, new) {
+                return Err(());
+            }
+        }
+        if let Some(r) = self.region {
+            record.cover(id, r);
+        }
+        Ok(self.region)
     }
-    Ok(region)
 }
 
 /// Puts back the texel values a stroke changed in one map.
 pub(super) fn restore(image: &mut Image, before: &HashMap<u32, f32>) {
     let w = image.width().max(1);
     for (&texel, &value) in before {
-        set_texel_value(image, texel % w, texel / w, value);
+        set_texel_luminance(image, texel % w, texel / w, value);
     }
-}
-
-pub(super) fn ground_rect(min: Vec2, max: Vec2) -> Option<Rect> {
-    Rect::new(
-        glam::DVec2::new(min.x as f64, min.y as f64),
-        glam::DVec2::new(max.x as f64, max.y as f64),
-    )
-    .ok()
 }
 
 #[cfg(test)]
@@ -201,6 +210,19 @@ mod tests {
         )
     }
 
+    /// A dab read from and written into `image`.
+    fn paint(
+        image: &mut Image,
+        id: AssetId<Image>,
+        at: MapPlacement,
+        centre: Vec2,
+        radius: f32,
+        amount: f32,
+        record: &mut StrokeRecord,
+    ) -> Result<Option<Rect>, ()> {
+        dab(image, at, centre, radius, amount)?.apply(image, id, record)
+    }
+
     #[test]
     fn a_dab_paints_a_smooth_disc_and_a_stroke_restores() {
         let at = MapPlacement {
@@ -217,20 +239,20 @@ mod tests {
             let id = AssetId::default();
             let mut record = StrokeRecord::default();
             let centre = Vec2::new(10.5, 20.5);
-            let changed = dab(&mut image, id, at, centre, 4.0, 0.6, &mut record).unwrap();
+            let changed = paint(&mut image, id, at, centre, 4.0, 0.6, &mut record).unwrap();
             assert!(changed.is_some(), "{format:?}");
             // Row 0 is the max-z edge: ground (10.5, 20.5) is the centre of texel (10, 11).
-            let peak = texel_value(&image, 10, 11).unwrap();
-            let edge = texel_value(&image, 13, 11).unwrap();
-            let outside = texel_value(&image, 15, 11).unwrap();
+            let peak = texel_luminance(&image, 10, 11).unwrap();
+            let edge = texel_luminance(&image, 13, 11).unwrap();
+            let outside = texel_luminance(&image, 15, 11).unwrap();
             assert!((peak - 0.6).abs() < 0.03, "{format:?} {peak}");
             assert!(edge > 0.0 && edge < peak, "{format:?} {edge}");
             assert_eq!(outside, 0.0);
             // Erasing more than there is stops at 0; restoring brings back the blank map.
-            dab(&mut image, id, at, centre, 4.0, -5.0, &mut record).unwrap();
-            assert_eq!(texel_value(&image, 10, 11).unwrap(), 0.0);
+            paint(&mut image, id, at, centre, 4.0, -5.0, &mut record).unwrap();
+            assert_eq!(texel_luminance(&image, 10, 11).unwrap(), 0.0);
             restore(&mut image, &record.before[&id]);
-            assert!((0..32).all(|y| (0..32).all(|x| texel_value(&image, x, y) == Some(0.0))));
+            assert!((0..32).all(|y| (0..32).all(|x| texel_luminance(&image, x, y) == Some(0.0))));
         }
     }
 
@@ -245,13 +267,14 @@ mod tests {
         let far = Vec2::new(-100.0, 500.0);
         let id = AssetId::default();
         assert_eq!(
-            dab(&mut image, id, at, far, 4.0, 1.0, &mut record),
+            paint(&mut image, id, at, far, 4.0, 1.0, &mut record),
             Ok(None)
         );
         assert_eq!(
-            dab(&mut image, id, at, Vec2::ONE, 0.0, 1.0, &mut record),
+            paint(&mut image, id, at, Vec2::ONE, 0.0, 1.0, &mut record),
             Ok(None)
         );
         assert!(record.is_empty());
+        assert!(dab(&image, at, far, 4.0, 1.0).unwrap().is_empty());
     }
 }

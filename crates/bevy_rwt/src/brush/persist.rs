@@ -1,7 +1,8 @@
 //! Painted maps on disk: one 16-bit grey PNG per target and a RON index of where each lies.
 
 use super::BrushError;
-use super::paint::{set_texel_value, texel_value};
+use super::paint::set_texel_luminance;
+use crate::layers::texel_luminance;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -72,7 +73,7 @@ pub(super) fn write_map(image: &Image, path: &Path) -> Result<(), BrushError> {
     let mut pixels = Vec::with_capacity((w * h) as usize);
     for y in 0..h {
         for x in 0..w {
-            let v = texel_value(image, x, y).ok_or_else(|| {
+            let v = texel_luminance(image, x, y).ok_or_else(|| {
                 BrushError::Io(format!("{}: map texels unreadable", path.display()))
             })?;
             pixels.push((v.clamp(0.0, 1.0) * 65535.0).round() as u16);
@@ -101,7 +102,7 @@ pub(super) fn read_map(image: &mut Image, path: &Path) -> Result<(), BrushError>
         )));
     }
     for (x, y, p) in png.enumerate_pixels() {
-        if !set_texel_value(image, x, y, p[0] as f32 / 65535.0) {
+        if !set_texel_luminance(image, x, y, p[0] as f32 / 65535.0) {
             return Err(io("target map not writable".into()));
         }
     }

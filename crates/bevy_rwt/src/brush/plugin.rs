@@ -5,8 +5,9 @@ use super::persist::{INDEX_FILE, PaintedMapEntry, PaintedMaps, file_name, read_m
 use super::{
     BrushCommand, BrushError, BrushSystems, BrushTarget, DensityBrush, PaintDab, ground_hit,
 };
-use crate::layers::{LayerDensity, ScatterLayer};
+use crate::layers::{HeightFn, LayerDensity, ScatterLayer};
 use crate::streaming::DensityMapPainted;
+use crate::streaming::LayerState;
 use crate::viewers::RwtViewer;
 use bevy::input::mouse::AccumulatedMouseScroll;
 use bevy::prelude::*;
@@ -103,13 +104,18 @@ fn target_map(
     }
 }
 
+/// The selected target's ground, as the layer's chunks are generated with.
+fn target_height(brush: &DensityBrush, layers: &Query<&LayerState>) -> Option<HeightFn> {
+    let target = brush.target()?;
+    layers.get(target.layer).ok()?.height().cloned()
+}
+
 /// The ground point under the cursor, on the selected target's layer.
 fn locate_cursor(
     mut brush: ResMut<DensityBrush>,
     windows: Query<&Window, With<PrimaryWindow>>,
     cameras: Query<(&Camera, &GlobalTransform, Has<RwtViewer>)>,
-    layers: Query<&ScatterLayer>,
-    images: Res<Assets<Image>>,
+    layers: Query<&LayerState>,
 ) {
     if !brush.enabled {
         brush.cursor = None;
@@ -120,10 +126,7 @@ fn locate_cursor(
         .iter()
         .filter(|(c, ..)| c.is_active)
         .max_by_key(|(.., viewer)| *viewer);
-    let height = brush
-        .target()
-        .and_then(|t| layers.get(t.layer).ok())
-        .and_then(|l| l.height.resolve(&images));
+    let height = target_height(&brush, &layers);
     let hit = match (cursor, camera, height) {
         (Some(cursor), Some((camera, transform, _)), Some(height)) => camera
             .viewport_to_world(transform, cursor)
@@ -241,18 +244,34 @@ fn apply_dabs(
             }
         };
         let record = history.open.get_or_insert_with(StrokeRecord::default);
-        let name = || brush.targets[d.target].name.clone();
-        let Some(mut image) = images.get_mut(&map.image) else {
-            brush.last = Some(Err(BrushError::MapUnavailable(name())));
-            continue;
+        let unavailable = || {
+            Some(Err(BrushError::MapUnavailable(
+                brush.targets[d.target].name.clone(),
+            )))
         };
-        let id = map.image.id();
-        match dab(&mut image, id, map.at, d.centre, d.radius, d.amount, record) {
+        // Read first: the map is only modified (and re-read, its chunks re-scattered) when
+        // the dab changes a texel.
+        let planned = images
+            .get(&map.image)
+            .ok_or(())
+            .and_then(|image| dab(image, map.at, d.centre, d.radius, d.amount));
+        let written = match planned {
+            Ok(planned) if planned.is_empty() => Ok(None),
+            Ok(planned) => match images.get_mut(&map.image) {
+                Some(mut image) => planned.apply(&mut image, map.image.id(), record),
+                None => Err(()),
+            },
+            Err(()) => Err(()),
+        };
+        match written {
             Ok(Some(region)) => {
-                painted.write(DensityMapPainted { image: id, region });
+                painted.write(DensityMapPainted {
+                    image: map.image.id(),
+                    region,
+                });
             }
             Ok(None) => {}
-            Err(()) => brush.last = Some(Err(BrushError::MapUnavailable(name()))),
+            Err(()) => brush.last = unavailable(),
         }
     }
     if !any {
@@ -358,20 +377,11 @@ fn load(
 }
 
 /// The brush circle, following the ground.
-fn draw_circle(
-    brush: Res<DensityBrush>,
-    layers: Query<&ScatterLayer>,
-    images: Res<Assets<Image>>,
-    mut gizmos: Gizmos,
-) {
+fn draw_circle(brush: Res<DensityBrush>, layers: Query<&LayerState>, mut gizmos: Gizmos) {
     let Some(centre) = brush.cursor.filter(|_| brush.enabled) else {
         return;
     };
-    let Some(height) = brush
-        .target()
-        .and_then(|t| layers.get(t.layer).ok())
-        .and_then(|l| l.height.resolve(&images))
-    else {
+    let Some(height) = target_height(&brush, &layers) else {
         return;
     };
     let lift = brush.circle_lift;

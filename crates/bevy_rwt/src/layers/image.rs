@@ -13,8 +13,7 @@ pub fn from_bevy_image(image: &Image, min: Vec2, size: Vec2, scale: f64) -> Opti
         let mut values = Vec::with_capacity((w * h) as usize);
         for y in 0..h {
             for x in 0..w {
-                let c = image.get_color_at(x, y).ok()?.to_linear();
-                values.push(0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue);
+                values.push(texel_luminance(image, x, y)?);
             }
         }
         Some(values)
@@ -29,6 +28,13 @@ pub fn from_bevy_image(image: &Image, min: Vec2, size: Vec2, scale: f64) -> Opti
         scale,
     )
     .ok()
+}
+
+/// The value a layer reads from texel `(x, y)`: its linear luminance (Bevy reads one-channel
+/// formats as a grey, so their value is the channel's); `None` for unreadable texels.
+pub(crate) fn texel_luminance(image: &Image, x: u32, y: u32) -> Option<f32> {
+    let c = image.get_color_at(x, y).ok()?.to_linear();
+    Some(0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue)
 }
 
 /// Linear luminance straight from the bytes of the common 8-bit formats (painted maps are
@@ -94,8 +100,7 @@ mod tests {
             let fast = luminance_fast(&img).unwrap();
             for y in 0..8 {
                 for x in 0..8 {
-                    let c = img.get_color_at(x, y).unwrap().to_linear();
-                    let slow = 0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue;
+                    let slow = texel_luminance(&img, x, y).unwrap();
                     assert!(
                         (fast[(y * 8 + x) as usize] - slow).abs() < 1e-3,
                         "{format:?} {x} {y}"

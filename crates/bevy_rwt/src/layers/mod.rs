@@ -7,6 +7,7 @@ mod plugin;
 mod status;
 
 pub use image::from_bevy_image;
+pub(crate) use image::texel_luminance;
 pub use plugin::RwtLayersPlugin;
 pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
 pub use status::{AssetStatus, ScatterLayerStatus};
@@ -286,7 +287,7 @@ impl std::fmt::Debug for HeightSource {
 }
 
 /// The ground rectangle `min..min + size`, when it is finite and not inverted.
-fn ground_rect(min: Vec2, size: Vec2) -> Option<rwt_core::Rect> {
+pub(crate) fn ground_rect(min: Vec2, size: Vec2) -> Option<rwt_core::Rect> {
     let min = glam::DVec2::new(min.x as f64, min.y as f64);
     let size = glam::DVec2::new(size.x as f64, size.y as f64);
     rwt_core::Rect::new(min, min + size).ok()

@@ -19,7 +19,7 @@ mod spawn;
 pub use plugin::RwtStreamingPlugin;
 
 use crate::instancing::{InstancedClasses, PackedClass};
-use crate::layers::{ScatterLayer, ScatterLayerStatus};
+use crate::layers::{HeightFn, ScatterLayer, ScatterLayerStatus};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::tasks::Task;
@@ -121,6 +121,12 @@ pub(crate) struct LayerState {
 }
 
 impl LayerState {
+    /// The layer's ground height as its chunks are generated with (`None` until resolved,
+    /// e.g. while a heightmap loads).
+    pub(crate) fn height(&self) -> Option<&HeightFn> {
+        self.sources.height()
+    }
+
     /// Live instances of the layer: those its chunks hold, plus those waiting in the
     /// despawn queue (still in the world until their turn comes).
     fn live(&self) -> usize {
