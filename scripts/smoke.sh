@@ -3,7 +3,8 @@
 # scripted session (RWT_SCREENSHOT), and fails when an example exits with an error, its
 # screenshot is missing or blank (luminance variance < 20), or it reports 0 instances
 # (entities and instanced together), or open_world has fewer than a million instanced blades
-# or its scripted brush stroke changed no instance (`painted 0`).
+# or its scripted brush stroke changed no instance (`painted 0`) or its brush did not save
+# the painted maps and layer files.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -72,6 +73,10 @@ for run in "${runs[@]}"; do
         fi
         if [ "${painted:-0}" -eq 0 ]; then
             echo "FAIL $name: the scripted brush stroke changed no instance"; failed=1
+        fi
+        grep -E '^rwt-smoke: brush' "$out/$name.log" || true
+        if ! grep -qE '^rwt-smoke: brush saved 4 maps and 2 layer files' "$out/$name.log"; then
+            echo "FAIL $name: the brush did not save the painted maps and layer files"; failed=1
         fi
     fi
     if [ $docs = 1 ] && [ $failed = 0 ]; then

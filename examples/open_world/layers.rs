@@ -3,6 +3,7 @@
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushTarget, DensityBrush};
 use bevy_rwt::instancing::blade_mesh;
+use bevy_rwt::layers::file::NamedAssets;
 use bevy_rwt::prelude::*;
 use noise::{NoiseFn, Perlin};
 use rwt_core::density::{NoiseDensity, NoiseParams};
@@ -28,24 +29,29 @@ pub fn setup_layers(
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut images: ResMut<Assets<Image>>,
     mut brush: ResMut<DensityBrush>,
+    names: Res<NamedAssets>,
 ) {
     let white = materials.add(StandardMaterial {
         perceptual_roughness: 0.9,
         reflectance: 0.2,
         ..default()
     });
-    let trees = trees(&terrain, &mut meshes, &white);
+    // Named, so that the brush writes the painted layers as layer files (F5).
+    let ground = terrain.source();
+    names.insert_height("terrain", &ground);
+    names.insert_material("white", white.clone());
+    let trees = trees(&ground, &mut meshes, &white);
     commands.spawn((Name::new("trees"), trees));
-    let rocks = rocks(&terrain, &mut meshes, &white);
+    let rocks = rocks(&ground, &mut meshes, &white);
     commands.spawn((Name::new("rocks"), rocks));
-    commands.spawn((Name::new("grass"), grass(&terrain, &mut meshes)));
-    let (flowers, flower_targets) = flowers(&terrain, &mut meshes, &mut images);
+    commands.spawn((Name::new("grass"), grass(&ground, &mut meshes)));
+    let (flowers, flower_targets) = flowers(&ground, &mut meshes, &names, &mut images);
     let flowers = commands.spawn((Name::new("flowers"), flowers)).id();
     let bush_density = painted_map(&mut images, 9, 0.05, 120.0);
     let bushes = commands
         .spawn((
             Name::new("bushes"),
-            bushes(&terrain, bush_density, &mut meshes, &white),
+            bushes(&ground, bush_density, &mut meshes, &names, &white),
         ))
         .id();
     brush.targets = flower_targets
@@ -99,7 +105,7 @@ pub fn forest(seed: u32, base: f64) -> NoiseDensity {
 /// Forests of three species from fractal noise; near and far meshes crossfade at 180 m.
 /// The fall-off keeps a fifth of the forest out to 2.6 km, so distant hills stay wooded.
 fn trees(
-    terrain: &Terrain,
+    ground: &HeightSource,
     meshes: &mut Assets<Mesh>,
     material: &Handle<StandardMaterial>,
 ) -> ScatterLayer {
@@ -133,14 +139,14 @@ fn trees(
             near_distance: 200.0,
         })
         .with_falloff_floor(350.0, 1400.0, 0.2)
-        .with_height(terrain.source())
+        .with_height(ground.clone())
         .with_height_range(WATER + 1.5, 112.0)
         .with_max_slope(0.6)
 }
 
 /// Boulders, more of them on slopes' noise-chosen patches.
 fn rocks(
-    terrain: &Terrain,
+    ground: &HeightSource,
     meshes: &mut Assets<Mesh>,
     material: &Handle<StandardMaterial>,
 ) -> ScatterLayer {
@@ -165,18 +171,21 @@ fn rocks(
             near_distance: 80.0,
         })
         .with_falloff(200.0, 700.0)
-        .with_height(terrain.source())
+        .with_height(ground.clone())
         .with_height_range(WATER - 2.0, 200.0)
 }
 
 /// Bushes from a painted map (up to 0.05 per square metre).
 fn bushes(
-    terrain: &Terrain,
+    ground: &HeightSource,
     density: LayerDensity,
     meshes: &mut Assets<Mesh>,
+    names: &NamedAssets,
     material: &Handle<StandardMaterial>,
 ) -> ScatterLayer {
-    let mut class = ScatterClass::new(density, meshes.add(foliage::bush()), material.clone());
+    let mesh = meshes.add(foliage::bush());
+    names.insert_mesh("bush", mesh.clone());
+    let mut class = ScatterClass::new(density, mesh, material.clone());
     class.scale_variation = 0.4;
     ScatterLayer::new(vec![class])
         .with_seed(2)
@@ -188,14 +197,14 @@ fn bushes(
             near_distance: 80.0,
         })
         .with_falloff(150.0, 500.0)
-        .with_height(terrain.source())
+        .with_height(ground.clone())
         .with_height_range(WATER + 0.5, 110.0)
         .with_max_slope(0.8)
 }
 
 /// Grass blades, up to 140 per square metre, drawn from per-chunk instance buffers (no
 /// entity per blade), growing in and out with the level of detail.
-fn grass(terrain: &Terrain, meshes: &mut Assets<Mesh>) -> ScatterLayer {
+fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
     let mut class = ScatterClass::instanced(
         LayerDensity::Noise(NoiseDensity::new(NoiseParams {
             seed: 3,
@@ -223,18 +232,20 @@ fn grass(terrain: &Terrain, meshes: &mut Assets<Mesh>) -> ScatterLayer {
             near_distance: 24.0,
         })
         .with_falloff(35.0, 115.0)
-        .with_height(terrain.source())
+        .with_height(ground.clone())
         .with_height_range(WATER + 0.3, 105.0)
 }
 
 /// Flowers in three colours, each from its own painted map (up to 5 per square metre),
 /// instanced; returns the layer and its maps' names (one per class).
 fn flowers(
-    terrain: &Terrain,
+    ground: &HeightSource,
     meshes: &mut Assets<Mesh>,
+    names: &NamedAssets,
     images: &mut Assets<Image>,
 ) -> (ScatterLayer, Vec<String>) {
     let mesh = meshes.add(foliage::flower(0.62));
+    names.insert_mesh("flower", mesh.clone());
     let classes = FLOWERS
         .iter()
         .enumerate()
@@ -266,7 +277,7 @@ fn flowers(
             near_distance: 24.0,
         })
         .with_falloff(30.0, 95.0)
-        .with_height(terrain.source())
+        .with_height(ground.clone())
         .with_height_range(WATER + 0.5, 100.0);
     (layer, FLOWERS.iter().map(|(n, _)| n.to_string()).collect())
 }

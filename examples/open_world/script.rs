@@ -1,11 +1,12 @@
 //! The scripted session (`RWT_SCREENSHOT`): a 1.5 km flight, then down to the view the
 //! screenshot shows (`RWT_VIEW`: `eye` in the grass, the default; `forest` at a forest
 //! edge; `aerial` to the horizon; `brush` painting from above), and one brush stroke of red
-//! flowers, whose added instances the smoke line reports.
+//! flowers, whose added instances the smoke line reports; then the brush saves the painted
+//! world (maps and layer files) to `RWT_PAINT_DIR`.
 
 use crate::layers::{FORESTS, forest};
 use bevy::prelude::*;
-use bevy_rwt::brush::{BrushSystems, DensityBrush, PaintDab};
+use bevy_rwt::brush::{BrushCommand, BrushSystems, DensityBrush, PaintDab};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::density::Density;
 use rwt_examples::prelude::*;
@@ -24,7 +25,7 @@ impl Plugin for ScriptPlugin {
             .configure_sets(Update, ScriptSystems.after(BrushSystems))
             .add_systems(
                 Update,
-                (fly, stroke)
+                (fly, stroke, save_painting)
                     .chain()
                     .in_set(ScriptSystems)
                     .run_if(|s: Res<Smoke>| s.active()),
@@ -47,6 +48,15 @@ struct Script {
     /// Where the camera ends: position and yaw, pitch.
     end: Option<(Vec3, f32, f32)>,
     stroke: Stroke,
+    save: Save,
+}
+
+/// The save after the stroke.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Save {
+    NotYet,
+    Asked,
+    Reported,
 }
 
 /// The scripted stroke: waits for the painted layers to settle, counts their instances,
@@ -70,6 +80,7 @@ impl Script {
             view,
             end: None,
             stroke: Stroke::Waiting,
+            save: Save::NotYet,
         }
     }
 }
@@ -219,4 +230,31 @@ fn stroke(
     }
     // The screenshot waits for the stroke's count and for streaming to settle.
     report.hold = report.painted.is_none() || stats.pending_tasks > 0;
+}
+
+/// Saves the painted world once the stroke is counted, and reports how it went.
+fn save_painting(
+    mut script: ResMut<Script>,
+    mut brush: ResMut<DensityBrush>,
+    mut report: ResMut<SmokeReport>,
+    mut commands: MessageWriter<BrushCommand>,
+) {
+    match script.save {
+        Save::NotYet if report.painted.is_some() => {
+            brush.last = None;
+            commands.write(BrushCommand::Save(brush.save_dir.clone()));
+            script.save = Save::Asked;
+        }
+        Save::Asked => {
+            if let Some(outcome) = &brush.last {
+                match outcome {
+                    Ok(done) => eprintln!("rwt-smoke: brush {done}"),
+                    Err(e) => eprintln!("rwt-smoke: brush save failed: {e}"),
+                }
+                script.save = Save::Reported;
+            }
+        }
+        _ => {}
+    }
+    report.hold |= script.save != Save::Reported;
 }

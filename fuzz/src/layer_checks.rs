@@ -3,7 +3,7 @@
 
 use bevy::prelude::Handle;
 use bevy_rwt::LayerDensity;
-use bevy_rwt::layers::file::LayerDescription;
+use bevy_rwt::layers::file::{LayerDescription, NamedAssets};
 use bevy_rwt::rwt_core::density::{Density, sanitize};
 use bevy_rwt::rwt_core::query::{Rect, Sampler};
 use bevy_rwt::rwt_core::streaming::{ChunkSet, Viewer};
@@ -27,11 +27,15 @@ pub fn layer_file(data: &[u8]) -> bool {
     let Ok(description) = LayerDescription::from_ron(text) else {
         return false;
     };
-    let layer = description.to_layer(
+    // With no names registered, a file naming a mesh, material or ground is rejected.
+    let Ok(layer) = description.to_layer(
+        &NamedAssets::default(),
         |_| Handle::default(),
         |_| Handle::default(),
         |_| Handle::default(),
-    );
+    ) else {
+        return false;
+    };
     // Streaming around a viewer at the origin stays bounded and terminates.
     let mut chunks = ChunkSet::default();
     let viewer = Viewer::omni(DVec2::ZERO);

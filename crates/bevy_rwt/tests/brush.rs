@@ -4,6 +4,7 @@ mod common;
 
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushError, PaintedMaps};
+use bevy_rwt::layers::file::NamedAssets;
 use bevy_rwt::prelude::*;
 use common::*;
 
@@ -21,7 +22,10 @@ fn painted_app() -> (App, Handle<Image>) {
         Vec2::splat(128.0),
         1.0,
     );
-    let meadow = app.world_mut().spawn(layer(density)).id();
+    let meadow = app
+        .world_mut()
+        .spawn((Name::new("meadow"), layer(density)))
+        .id();
     let constant = app
         .world_mut()
         .spawn(layer(LayerDensity::Constant(0.0)))
@@ -144,13 +148,15 @@ fn maps_save_and_load_into_another_world() {
     stroke(&mut app, 0, Vec2::new(-30.0, 25.0), 0.8, 2);
     tick_app(&mut app, 2_000);
     let painted = instances(&mut app);
+    assert!(!painted.is_empty());
     // The non-image target cannot be saved: keep only the paintable one.
     app.world_mut()
         .resource_mut::<DensityBrush>()
         .targets
         .truncate(1);
+    name_marker_assets(&app);
     let saved = command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
-    assert!(saved.contains("saved 1 maps"), "{saved}");
+    assert!(saved.contains("saved 1 maps and 1 layer files"), "{saved}");
     let index = PaintedMaps::read(&dir).unwrap();
     assert_eq!(index.maps.len(), 1);
     assert_eq!(
@@ -163,6 +169,62 @@ fn maps_save_and_load_into_another_world() {
     assert!(loaded.contains("loaded 1 maps"), "{loaded}");
     tick_app(&mut fresh, 2_000);
     assert_eq!(instances(&mut fresh), painted);
+
+    // Another game loads the saved layer file, which reads the saved map beside it.
+    assert_eq!(index.layers, ["meadow.layer.ron"]);
+    let mut game = app_reading_with(&dir, |app| {
+        app.add_plugins(RwtBrushPlugin);
+    });
+    name_marker_assets(&game);
+    spawn_viewer(&mut game, Vec3::ZERO);
+    let file = game
+        .world()
+        .resource::<AssetServer>()
+        .load(&index.layers[0]);
+    let meadow = game.world_mut().spawn(ScatterLayerSource(file)).id();
+    let loaded = run_until(&mut game, 5_000, |app| {
+        app.world()
+            .get::<ScatterLayerStatus>(meadow)
+            .map(|s| &s.assets)
+            == Some(&AssetStatus::Ready)
+            && app.world().get::<ScatterLayer>(meadow).is_some()
+    });
+    assert!(
+        loaded,
+        "{:?}",
+        game.world().get::<ScatterLayerStatus>(meadow)
+    );
+    tick_app(&mut game, 2_000);
+    assert_eq!(instances(&mut game), painted);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Names the test layers' mesh and material (the default handles), as a game names the
+/// assets its layers share with layer files.
+fn name_marker_assets(app: &App) {
+    let names = app.world().resource::<NamedAssets>();
+    names.insert_mesh("marker", Handle::default());
+    names.insert_material("marker", Handle::default());
+}
+
+#[test]
+fn layers_a_file_cannot_name_still_save_their_maps() {
+    let dir = std::env::temp_dir().join(format!("rwt-brush-unnamed-{}", std::process::id()));
+    let (mut app, _) = painted_app();
+    app.world_mut()
+        .resource_mut::<DensityBrush>()
+        .targets
+        .truncate(1);
+    let err = command(&mut app, BrushCommand::Save(dir.clone())).unwrap_err();
+    match &err {
+        BrushError::LayerNotSaved(why) => {
+            assert!(why.starts_with("meadow: ") && why.contains("mesh"), "{why}")
+        }
+        other => panic!("{other:?}"),
+    }
+    let index = PaintedMaps::read(&dir).unwrap();
+    assert_eq!((index.maps.len(), index.layers.len()), (1, 0));
+    assert!(dir.join(&index.maps[0].file).exists());
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -2,7 +2,6 @@
 
 mod common;
 
-use bevy::asset::AssetPlugin;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use common::*;
@@ -66,36 +65,6 @@ fn a_layer_file_loads_and_reloads() {
     let ratio = second as f64 / first as f64;
     assert!((ratio - 3.0).abs() < 0.25, "{first} -> {second}");
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// A headless app that reads assets from `dir`.
-fn app_reading(dir: &std::path::Path) -> App {
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin {
-            file_path: dir.to_string_lossy().into_owned(),
-            ..Default::default()
-        },
-        RwtPlugin::default().with_spawn_budget(50_000),
-    ))
-    .init_asset::<Mesh>()
-    .init_asset::<StandardMaterial>();
-    app.finish();
-    app.cleanup();
-    app
-}
-
-/// Runs frames until `done` holds (or `max` frames).
-fn run_until(app: &mut App, max: usize, done: impl Fn(&App) -> bool) -> bool {
-    for _ in 0..max {
-        app.update();
-        if done(app) {
-            return true;
-        }
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    false
 }
 
 #[test]

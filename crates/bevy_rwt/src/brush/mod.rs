@@ -190,7 +190,11 @@ pub struct PaintDab {
 pub enum BrushCommand {
     /// Restores the maps as they were before the last stroke.
     Undo,
-    /// Writes every target's map as a PNG and an index, [`PaintedMaps`], to the folder.
+    /// Writes every target's map as a PNG, a layer file (`*.layer.ron`) per target layer
+    /// that reads the maps from beside it, and an index, [`PaintedMaps`], to the folder. The
+    /// folder is a painted world another game loads: put it in the assets and load the layer
+    /// files (see [`crate::layers::file`]; what they name must be in its
+    /// [`crate::layers::file::NamedAssets`]).
     Save(PathBuf),
     /// Reads maps written by `Save` into the targets with the same layer and class names.
     Load(PathBuf),
@@ -217,4 +221,8 @@ pub enum BrushError {
     /// Reading or writing files failed.
     #[error("{0}")]
     Io(String),
+    /// The maps were saved, but these layers (name: reason) have no layer file: they use
+    /// something a layer file cannot name (see [`crate::layers::file::NamedAssets`]).
+    #[error("maps saved; no layer file for {0}")]
+    LayerNotSaved(String),
 }

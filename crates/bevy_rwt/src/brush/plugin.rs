@@ -1,19 +1,18 @@
 //! The brush plugin: cursor, input, dabs, strokes and their undo, files, the gizmo circle.
 
 use super::paint::{MapPlacement, StrokeRecord, dab, restore};
-use super::persist::{INDEX_FILE, PaintedMapEntry, PaintedMaps, file_name, read_map, write_map};
-use super::{
-    BrushCommand, BrushError, BrushSystems, BrushTarget, DensityBrush, PaintDab, ground_hit,
-};
+use super::persist::{load, save};
+use super::{BrushCommand, BrushError, BrushSystems, DensityBrush, PaintDab, ground_hit};
+use crate::layers::file::NamedAssets;
 use crate::layers::{HeightFn, LayerDensity, ScatterLayer};
 use crate::streaming::DensityMapPainted;
 use crate::streaming::LayerState;
 use crate::viewers::RwtViewer;
+use bevy::ecs::system::SystemParam;
 use bevy::input::mouse::AccumulatedMouseScroll;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use std::collections::VecDeque;
-use std::path::Path;
 
 /// Paints density maps with the mouse (see [`crate::brush`]). Needs [`crate::RwtPlugin`];
 /// draws its circle when Bevy's gizmos are there, reads the mouse and keyboard when Bevy's
@@ -65,13 +64,13 @@ impl BrushHistory {
 }
 
 /// A target's map and where it lies.
-struct TargetMap {
-    image: Handle<Image>,
-    at: MapPlacement,
-    scale: f64,
+pub(super) struct TargetMap {
+    pub(super) image: Handle<Image>,
+    pub(super) at: MapPlacement,
+    pub(super) scale: f64,
 }
 
-fn target_map(
+pub(super) fn target_map(
     brush: &DensityBrush,
     index: usize,
     layers: &Query<&ScatterLayer>,
@@ -280,6 +279,13 @@ fn apply_dabs(
     }
 }
 
+/// What saving layer files reads: the names of assets and of layers.
+#[derive(SystemParam)]
+struct LayerFiles<'w, 's> {
+    names: Res<'w, NamedAssets>,
+    layer_names: Query<'w, 's, &'static Name, With<ScatterLayer>>,
+}
+
 fn apply_commands(
     mut brush: ResMut<DensityBrush>,
     mut history: ResMut<BrushHistory>,
@@ -287,13 +293,17 @@ fn apply_commands(
     mut painted: MessageWriter<DensityMapPainted>,
     mut images: ResMut<Assets<Image>>,
     layers: Query<&ScatterLayer>,
+    files: LayerFiles,
 ) {
     for command in commands.read() {
         let depth = brush.undo_depth;
         history.close(depth);
         let outcome = match command {
             BrushCommand::Undo => undo(&mut history, &mut images, &mut painted),
-            BrushCommand::Save(dir) => save(&brush, &layers, &images, dir),
+            BrushCommand::Save(dir) => {
+                let layer_name = |e: Entity| files.layer_names.get(e).ok().map(|n| n.to_string());
+                save(&brush, &layers, layer_name, &files.names, &images, dir)
+            }
             BrushCommand::Load(dir) => {
                 history.done.clear();
                 load(&brush, &layers, &mut images, dir)
@@ -321,59 +331,6 @@ fn undo(
         }
     }
     Ok(format!("undid a stroke ({} left)", history.done.len()))
-}
-
-fn save(
-    brush: &DensityBrush,
-    layers: &Query<&ScatterLayer>,
-    images: &Assets<Image>,
-    dir: &Path,
-) -> Result<String, BrushError> {
-    std::fs::create_dir_all(dir).map_err(|e| BrushError::Io(format!("{}: {e}", dir.display())))?;
-    let mut index = PaintedMaps::default();
-    for (i, BrushTarget { name, .. }) in brush.targets.iter().enumerate() {
-        let map = target_map(brush, i, layers)?;
-        let image = images
-            .get(&map.image)
-            .ok_or_else(|| BrushError::MapUnavailable(name.clone()))?;
-        let file = file_name(name);
-        write_map(image, &dir.join(&file))?;
-        index.maps.push(PaintedMapEntry {
-            name: name.clone(),
-            file,
-            min: map.at.min.into(),
-            size: map.at.size.into(),
-            scale: map.scale,
-        });
-    }
-    index.write(dir)?;
-    Ok(format!(
-        "saved {} maps to {}",
-        index.maps.len(),
-        dir.join(INDEX_FILE).display()
-    ))
-}
-
-fn load(
-    brush: &DensityBrush,
-    layers: &Query<&ScatterLayer>,
-    images: &mut Assets<Image>,
-    dir: &Path,
-) -> Result<String, BrushError> {
-    let index = PaintedMaps::read(dir)?;
-    let mut loaded = 0;
-    for entry in &index.maps {
-        let Some(i) = brush.targets.iter().position(|t| t.name == entry.name) else {
-            continue;
-        };
-        let map = target_map(brush, i, layers)?;
-        let mut image = images
-            .get_mut(&map.image)
-            .ok_or_else(|| BrushError::MapUnavailable(entry.name.clone()))?;
-        read_map(&mut image, &dir.join(&entry.file))?;
-        loaded += 1;
-    }
-    Ok(format!("loaded {loaded} maps from {}", dir.display()))
 }
 
 /// The brush circle, following the ground.

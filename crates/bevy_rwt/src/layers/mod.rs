@@ -456,7 +456,9 @@ impl ScatterLayer {
 
 /// The plane a layer lies on. Ground positions `(u, v)` of the point set and the height
 /// `h` of the [`HeightSource`] become these world positions.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub enum GroundPlane {
     /// A 3-D world with y up: `(u, h, v)`, instances turned about y.
     #[default]

@@ -1,7 +1,7 @@
-//! The layers feature plugin: the layer file asset and its loader, layer files applied to
-//! their entities, and the asset status of every layer.
+//! The layers feature plugin: the layer file asset and its loader with the names it reads,
+//! layer files applied to their entities, and the asset status of every layer.
 
-use super::file::{ScatterLayerAsset, ScatterLayerLoader, ScatterLayerSource};
+use super::file::{NamedAssets, ScatterLayerAsset, ScatterLayerLoader, ScatterLayerSource};
 use super::{AssetStatus, ScatterLayer, ScatterLayerStatus};
 use crate::settings::RwtSystems;
 use bevy::asset::{LoadState, UntypedAssetId};
@@ -16,7 +16,7 @@ pub struct RwtLayersPlugin {
 
 impl Plugin for RwtLayersPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(
+        app.init_resource::<NamedAssets>().add_systems(
             self.schedule,
             (apply_layer_assets, watch_layer_files)
                 .chain()
@@ -30,8 +30,10 @@ impl Plugin for RwtLayersPlugin {
         if !app.world().contains_resource::<Assets<Image>>() {
             app.init_asset::<Image>();
         }
+        // The loader shares the registry of the resource (clones share it).
+        let names = app.world().resource::<NamedAssets>().clone();
         app.init_asset::<ScatterLayerAsset>()
-            .register_asset_loader(ScatterLayerLoader);
+            .register_asset_loader(ScatterLayerLoader { names });
     }
 }
 

@@ -27,6 +27,46 @@ pub fn create_app_with(extra: impl FnOnce(&mut App)) -> App {
     app
 }
 
+/// A headless app that reads assets (PNG images too) from `dir`.
+pub fn app_reading(dir: &std::path::Path) -> App {
+    app_reading_with(dir, |_| {})
+}
+
+/// A headless app that reads assets from `dir`; `extra` adds plugins before it is finished.
+pub fn app_reading_with(dir: &std::path::Path, extra: impl FnOnce(&mut App)) -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin {
+            file_path: dir.to_string_lossy().into_owned(),
+            ..Default::default()
+        },
+        bevy::image::ImagePlugin::default(),
+        RwtPlugin::default().with_spawn_budget(50_000),
+    ))
+    .init_asset::<Mesh>()
+    .init_asset::<StandardMaterial>();
+    // The renderer registers the image loader with the GPU's formats; headless, plain ones.
+    use bevy::image::{CompressedImageFormats, ImageLoader};
+    app.register_asset_loader(ImageLoader::new(CompressedImageFormats::empty()));
+    extra(&mut app);
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// Runs frames until `done` holds (or `max` frames).
+pub fn run_until(app: &mut App, max: usize, done: impl Fn(&App) -> bool) -> bool {
+    for _ in 0..max {
+        app.update();
+        if done(app) {
+            return true;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    false
+}
+
 /// Runs frames until nothing is pending or queued (or `max` frames).
 pub fn tick_app(app: &mut App, max: usize) {
     for _ in 0..max {

@@ -23,10 +23,24 @@
 //!     exclusion: Image(path: "maps/roads.png", min: (-128.0, -128.0), size: (256.0, 256.0), scale: 1.0),
 //! )
 //! ```
+//!
+//! Paths are asset paths; one starting with `./` or `../` is relative to the layer file's
+//! folder (what the brush writes, so that a saved folder can move). Meshes, materials and
+//! height functions made in code take part by name (`Named("spruce")`, `ground:
+//! Named("terrain")`) through [`NamedAssets`], and [`LayerDescription::describe`] turns a
+//! layer built in code back into a file.
 
-use super::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+mod describe;
+mod loader;
+mod names;
+#[cfg(test)]
+mod tests;
+
+pub use loader::ScatterLayerLoader;
+pub use names::NamedAssets;
+
+use super::{GroundPlane, HeightSource, LayerDensity, MeshLod, ScatterClass, ScatterLayer};
 use crate::instancing::{InstancedMaterial, blade_mesh};
-use bevy::asset::{AssetLoader, LoadContext, io::Reader};
 use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::Falloff;
@@ -69,6 +83,8 @@ pub enum DensityDescription {
 pub enum MeshDescription {
     /// Asset path, e.g. `"models/tree.glb#Mesh0/Primitive0"`.
     Path(String),
+    /// A mesh the game registered in [`NamedAssets`].
+    Named(String),
     /// A sphere.
     Sphere {
         /// Radius.
@@ -99,10 +115,10 @@ pub enum MeshDescription {
 }
 
 impl MeshDescription {
-    /// The mesh of a primitive, or the asset path to load.
+    /// The mesh of a primitive, or the asset path to load or the name to look up.
     pub fn primitive(&self) -> Result<Mesh, &str> {
         Ok(match self {
-            MeshDescription::Path(path) => return Err(path),
+            MeshDescription::Path(path) | MeshDescription::Named(path) => return Err(path),
             MeshDescription::Sphere { radius } => Mesh::from(Sphere::new(*radius)),
             MeshDescription::Cone { radius, height } => Mesh::from(Cone {
                 radius: *radius,
@@ -124,6 +140,8 @@ impl MeshDescription {
 pub enum MaterialDescription {
     /// Asset path, e.g. `"models/tree.glb#Material0"`.
     Path(String),
+    /// A material the game registered in [`NamedAssets`].
+    Named(String),
     /// A plain colour.
     Color(f32, f32, f32),
     /// The class is instanced (no entity per instance; see [`crate::instancing`]), shaded so.
@@ -153,7 +171,12 @@ pub struct InstancedMaterialDescription {
 
 impl Default for InstancedMaterialDescription {
     fn default() -> Self {
-        let m = InstancedMaterial::default();
+        Self::from(&InstancedMaterial::default())
+    }
+}
+
+impl From<&InstancedMaterial> for InstancedMaterialDescription {
+    fn from(m: &InstancedMaterial) -> Self {
         let linear = |c: Color| {
             let c = c.to_linear();
             (c.red, c.green, c.blue)
@@ -209,6 +232,41 @@ pub struct ClassDescription {
     /// Hashed scale variation.
     #[serde(default = "variation")]
     pub scale_variation: f32,
+    /// A far mesh and material (see [`MeshLod`]).
+    #[serde(default)]
+    pub lod: Option<LodDescription>,
+}
+
+/// The far level of detail of a class in a layer file (see [`MeshLod`]).
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct LodDescription {
+    /// The far mesh.
+    pub mesh: MeshDescription,
+    /// The far material (not `Instanced`).
+    pub material: MaterialDescription,
+    /// Distance of the switch.
+    pub distance: f32,
+    /// Width of the crossfade band; a tenth of the distance when absent.
+    #[serde(default)]
+    pub crossfade: Option<f32>,
+}
+
+/// The ground of a layer file, when it is not flat.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub enum HeightDescription {
+    /// A height function the game registered in [`NamedAssets`].
+    Named(String),
+    /// A heightmap (see [`HeightSource::Image`]).
+    Image {
+        /// Asset path of the image.
+        path: String,
+        /// Ground position of the image's bottom-left corner.
+        min: (f32, f32),
+        /// Ground size of the image.
+        size: (f32, f32),
+        /// Height where the image is white.
+        scale: f32,
+    },
 }
 
 fn default_tile() -> f64 {
@@ -235,15 +293,24 @@ pub struct LayerDescription {
     /// Unload distance.
     #[serde(default)]
     pub unload_distance: Option<f64>,
+    /// Distance within which chunks are generated first (see [`StreamingConfig`]).
+    #[serde(default)]
+    pub near_distance: Option<f64>,
     /// Density fall-off `(near, far)`.
     #[serde(default)]
     pub falloff: Option<(f64, f64)>,
     /// Fraction of the density kept beyond the fall-off's `far` (see [`Falloff::floor`]).
     #[serde(default)]
     pub falloff_floor: f64,
-    /// Flat ground height.
+    /// The plane the layer lies on.
+    #[serde(default)]
+    pub plane: GroundPlane,
+    /// Flat ground height (when there is no `ground`).
     #[serde(default)]
     pub height: f32,
+    /// The ground's height source, when it is not flat.
+    #[serde(default)]
+    pub ground: Option<HeightDescription>,
     /// Allowed ground height range.
     #[serde(default)]
     pub height_range: Option<(f32, f32)>,
@@ -291,6 +358,13 @@ pub enum LayerFileError {
     /// The description could not be written as RON.
     #[error("cannot write layer file: {0}")]
     Write(String),
+    /// A layer built in code uses something a layer file cannot name (see
+    /// [`LayerDescription::describe`]).
+    #[error("cannot describe the layer: {0}")]
+    NotDescribable(String),
+    /// The file names a mesh, material or height function [`NamedAssets`] does not have.
+    #[error("layer file names {0}, which is not registered in NamedAssets")]
+    UnknownName(String),
 }
 
 impl LayerDescription {
@@ -358,36 +432,50 @@ impl LayerDescription {
                 "unload_distance {u} is below load_distance {l}"
             )));
         }
+        for (i, lod) in d
+            .classes
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| Some((i, c.lod.as_ref()?)))
+        {
+            if !(lod.distance.is_finite() && lod.distance > 0.0) {
+                return Err(LayerFileError::Invalid(format!(
+                    "class {i}: lod distance {} must be positive",
+                    lod.distance
+                )));
+            }
+            if matches!(lod.material, MaterialDescription::Instanced(_)) {
+                return Err(LayerFileError::Invalid(format!(
+                    "class {i}: a far material cannot be Instanced"
+                )));
+            }
+        }
         Ok(d)
     }
 
-    /// The layer, with handles made by the given functions (asset loads in a loader;
-    /// `material` is called for the classes that are not instanced only).
+    /// The layer, with named assets from `names` and other handles made by the given
+    /// functions (asset loads in a loader): `mesh` for paths and primitives, `material` for
+    /// paths and colours of classes that are not instanced, `image` for density maps and
+    /// heightmaps.
     pub fn to_layer(
         &self,
-        mut mesh: impl FnMut(&MeshDescription) -> Handle<Mesh>,
-        mut material: impl FnMut(&MaterialDescription) -> Handle<StandardMaterial>,
-        mut image: impl FnMut(&str) -> Handle<Image>,
-    ) -> ScatterLayer {
-        let defaults = StreamingConfig::default();
+        names: &NamedAssets,
+        mesh: impl FnMut(&MeshDescription) -> Handle<Mesh>,
+        material: impl FnMut(&MaterialDescription) -> Handle<StandardMaterial>,
+        image: impl FnMut(&str) -> Handle<Image>,
+    ) -> Result<ScatterLayer, LayerFileError> {
+        let mut handles = Handles {
+            names,
+            mesh,
+            material,
+            image,
+        };
         let classes = self
             .classes
             .iter()
-            .map(|c| {
-                let density = c.density.to_density(&mut image);
-                let class = match &c.material {
-                    MaterialDescription::Instanced(m) => {
-                        ScatterClass::instanced(density, mesh(&c.mesh), m.to_material())
-                    }
-                    other => ScatterClass::new(density, mesh(&c.mesh), material(other)),
-                };
-                ScatterClass {
-                    scale: c.scale,
-                    scale_variation: c.scale_variation,
-                    ..class
-                }
-            })
-            .collect();
+            .map(|c| c.to_class(&mut handles))
+            .collect::<Result<_, _>>()?;
+        let defaults = StreamingConfig::default();
         let mut layer = ScatterLayer::new(classes)
             .with_tile_size(self.tile_size)
             .with_seed(self.seed)
@@ -395,216 +483,119 @@ impl LayerDescription {
                 chunk_size: self.chunk_size.unwrap_or(defaults.chunk_size),
                 load_distance: self.load_distance.unwrap_or(defaults.load_distance),
                 unload_distance: self.unload_distance.unwrap_or(defaults.unload_distance),
-                near_distance: defaults.near_distance,
+                near_distance: self.near_distance.unwrap_or(defaults.near_distance),
             })
-            .with_height(HeightSource::Constant(self.height));
+            .with_height(self.height_source(&mut handles)?);
+        layer.plane = self.plane;
         layer.falloff = self
             .falloff
             .map(|(near, far)| Falloff::new(near, far).with_floor(self.falloff_floor));
-        layer.exclusion = self.exclusion.as_ref().map(|e| e.to_density(&mut image));
+        layer.exclusion = self
+            .exclusion
+            .as_ref()
+            .map(|e| e.to_density(&mut handles.image));
         layer.height_range = self.height_range;
         layer.max_slope = self.max_slope;
-        layer
+        Ok(layer)
     }
-}
 
-/// Loads `.layer.ron` files.
-#[derive(Default, TypePath)]
-pub struct ScatterLayerLoader;
-
-impl AssetLoader for ScatterLayerLoader {
-    type Asset = ScatterLayerAsset;
-    type Settings = ();
-    type Error = LayerFileError;
-
-    async fn load(
+    fn height_source<M, T, I>(
         &self,
-        reader: &mut dyn Reader,
-        _: &(),
-        ctx: &mut LoadContext<'_>,
-    ) -> Result<ScatterLayerAsset, LayerFileError> {
-        let mut bytes = Vec::new();
-        reader.read_to_end(&mut bytes).await?;
-        let text = std::str::from_utf8(&bytes).map_err(|e| LayerFileError::Parse(e.to_string()))?;
-        let description = LayerDescription::from_ron(text)?;
-        // Primitive meshes and plain colours become labelled sub-assets of the layer file.
-        let mut meshes = Vec::new();
-        let mut materials = Vec::new();
-        for (i, c) in description.classes.iter().enumerate() {
-            meshes.push(match c.mesh.primitive() {
-                Ok(m) => ctx.add_labeled_asset(format!("mesh{i}"), m),
-                Err(path) => ctx.load(path.to_string()),
-            });
-            match &c.material {
-                MaterialDescription::Path(p) => materials.push(ctx.load(p.clone())),
-                MaterialDescription::Color(r, g, b) => materials.push(ctx.add_labeled_asset(
-                    format!("material{i}"),
-                    StandardMaterial::from(Color::linear_rgb(*r, *g, *b)),
-                )),
-                MaterialDescription::Instanced(_) => {}
-            }
-        }
-        let mut images = Vec::new();
-        for d in description
-            .classes
-            .iter()
-            .map(|c| &c.density)
-            .chain(description.exclusion.iter())
-        {
-            if let DensityDescription::Image { path, .. } = d {
-                images.push(ctx.load(path.clone()));
-            }
-        }
-        let (mut m, mut t, mut im) = (
-            meshes.into_iter(),
-            materials.into_iter(),
-            images.into_iter(),
-        );
-        Ok(ScatterLayerAsset(description.to_layer(
-            |_| m.next().unwrap_or_default(),
-            |_| t.next().unwrap_or_default(),
-            |_| im.next().unwrap_or_default(),
-        )))
-    }
-
-    fn extensions(&self) -> &[&str] {
-        &["layer.ron"]
+        handles: &mut Handles<M, T, I>,
+    ) -> Result<HeightSource, LayerFileError>
+    where
+        I: FnMut(&str) -> Handle<Image>,
+    {
+        Ok(match &self.ground {
+            None => HeightSource::Constant(self.height),
+            Some(HeightDescription::Named(name)) => handles
+                .names
+                .height(name)
+                .ok_or_else(|| LayerFileError::UnknownName(format!("height {name:?}")))?,
+            Some(HeightDescription::Image {
+                path,
+                min,
+                size,
+                scale,
+            }) => HeightSource::Image {
+                image: (handles.image)(path),
+                min: Vec2::new(min.0, min.1),
+                size: Vec2::new(size.0, size.1),
+                scale: *scale,
+            },
+        })
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::layers::ClassLook;
+/// Where [`LayerDescription::to_layer`] gets its handles.
+struct Handles<'a, M, T, I> {
+    names: &'a NamedAssets,
+    mesh: M,
+    material: T,
+    image: I,
+}
 
-    const MEADOW: &str = r#"(
-        tile_size: 4.0,
-        seed: 9,
-        chunk_size: 16.0,
-        load_distance: 48.0,
-        unload_distance: 64.0,
-        falloff: (20.0, 60.0),
-        classes: [
-            (density: Constant(0.4), mesh: Cone(radius: 0.5, height: 2.0), material: Color(0.1, 0.5, 0.1)),
-            (density: Noise(seed: 1, frequency: 0.1, octaves: 3, base: 0.5, amplitude: 0.5, scale: 0.2),
-             mesh: Sphere(radius: 0.3), material: Color(0.6, 0.2, 0.2), scale: 1.5),
-        ],
-    )"#;
-
-    #[test]
-    fn a_layer_file_writes_and_reads_back_the_same() {
-        let with_all = MEADOW.replace(
-            "falloff: (20.0, 60.0),",
-            "falloff: (20.0, 60.0), falloff_floor: 0.25, exclusion: Image(path: \"roads.png\", min: (0.0, 0.0), size: (8.0, 8.0), scale: 1.0),",
-        );
-        let with_all = with_all.replace(
-            "classes: [",
-            r#"classes: [
-            (density: Image(path: "m.png", min: (0.0, 0.0), size: (8.0, 8.0), scale: 2.0),
-             mesh: Blade(width: 0.1, height: 0.6), material: Instanced(tip: (0.3, 0.5, 0.1), tip_from: 0.8)),
-            (density: Constant(1.0), mesh: Path("a.glb#Mesh0/Primitive0"), material: Path("a.glb#Material0")),"#,
-        );
-        let d = LayerDescription::from_ron(&with_all).unwrap();
-        assert_eq!(d.classes.len(), 4);
-        let text = d.to_ron().unwrap();
-        assert!(!text.contains("Some("), "{text}");
-        assert_eq!(LayerDescription::from_ron(&text).unwrap(), d);
+impl<M, T, I> Handles<'_, M, T, I>
+where
+    M: FnMut(&MeshDescription) -> Handle<Mesh>,
+    T: FnMut(&MaterialDescription) -> Handle<StandardMaterial>,
+{
+    fn mesh(&mut self, d: &MeshDescription) -> Result<Handle<Mesh>, LayerFileError> {
+        match d {
+            MeshDescription::Named(name) => self
+                .names
+                .mesh(name)
+                .ok_or_else(|| LayerFileError::UnknownName(format!("mesh {name:?}"))),
+            other => Ok((self.mesh)(other)),
+        }
     }
 
-    #[test]
-    fn parses_a_layer_file() {
-        let d = LayerDescription::from_ron(MEADOW).unwrap();
-        assert_eq!(d.classes.len(), 2);
-        assert_eq!(d.classes[1].scale, 1.5);
-        assert_eq!(d.classes[0].scale_variation, 0.2);
-        let layer = d.to_layer(
-            |_| Handle::default(),
-            |_| Handle::default(),
-            |_| Handle::default(),
-        );
-        assert_eq!(layer.tile_size, 4.0);
-        assert_eq!(layer.streaming.load_distance, 48.0);
-        assert_eq!(layer.falloff, Some(Falloff::new(20.0, 60.0)));
-        assert!(layer.exclusion.is_none());
-        let floored = MEADOW.replace(
-            "falloff: (20.0, 60.0),",
-            "falloff: (20.0, 60.0), falloff_floor: 0.25,",
-        );
-        let floored = LayerDescription::from_ron(&floored).unwrap().to_layer(
-            |_| Handle::default(),
-            |_| Handle::default(),
-            |_| Handle::default(),
-        );
-        assert_eq!(floored.falloff.map(|f| f.floor), Some(0.25));
-        let excluded = MEADOW.replace(
-            "falloff: (20.0, 60.0),",
-            "falloff: (20.0, 60.0), exclusion: Image(path: \"roads.png\", min: (0.0, 0.0), size: (8.0, 8.0), scale: 1.0),",
-        );
-        let mut loads = Vec::new();
-        let layer = LayerDescription::from_ron(&excluded).unwrap().to_layer(
-            |_| Handle::default(),
-            |_| Handle::default(),
-            |path| {
-                loads.push(path.to_string());
-                Handle::default()
-            },
-        );
-        assert!(matches!(layer.exclusion, Some(LayerDensity::Image { .. })));
-        assert_eq!(loads, ["roads.png"]);
+    fn material(
+        &mut self,
+        d: &MaterialDescription,
+    ) -> Result<Handle<StandardMaterial>, LayerFileError> {
+        match d {
+            MaterialDescription::Named(name) => self
+                .names
+                .material(name)
+                .ok_or_else(|| LayerFileError::UnknownName(format!("material {name:?}"))),
+            other => Ok((self.material)(other)),
+        }
     }
+}
 
-    #[test]
-    fn instanced_classes_in_a_layer_file() {
-        let text = MEADOW.replace(
-            "classes: [",
-            "classes: [(density: Constant(30.0), mesh: Blade(width: 0.08, height: 0.6), \
-             material: Instanced(tip: (0.3, 0.5, 0.1), fade_band: 0.2), scale_variation: 0.3), \
-             (density: Constant(5.0), mesh: Cuboid(size: (0.1, 0.1, 0.1)), material: Instanced()),",
-        );
-        let d = LayerDescription::from_ron(&text).unwrap();
-        let mut materials = 0;
-        let layer = d.to_layer(
-            |_| Handle::default(),
-            |_| {
-                materials += 1;
-                Handle::default()
-            },
-            |_| Handle::default(),
-        );
-        assert_eq!(materials, 2, "entity classes only");
-        let ClassLook::Instanced(look) = &layer.classes[0].look else {
-            panic!("{:?}", layer.classes[0].look);
+impl ClassDescription {
+    fn to_class<M, T, I>(
+        &self,
+        handles: &mut Handles<M, T, I>,
+    ) -> Result<ScatterClass, LayerFileError>
+    where
+        M: FnMut(&MeshDescription) -> Handle<Mesh>,
+        T: FnMut(&MaterialDescription) -> Handle<StandardMaterial>,
+        I: FnMut(&str) -> Handle<Image>,
+    {
+        let density = self.density.to_density(&mut handles.image);
+        let mesh = handles.mesh(&self.mesh)?;
+        let class = match &self.material {
+            MaterialDescription::Instanced(m) => {
+                ScatterClass::instanced(density, mesh, m.to_material())
+            }
+            other => ScatterClass::new(density, mesh, handles.material(other)?),
         };
-        assert_eq!(look.material.tip_color, Color::linear_rgb(0.3, 0.5, 0.1));
-        assert_eq!(look.material.fade_band, 0.2);
-        let defaults = InstancedMaterial::default();
-        assert_eq!(look.material.roughness, defaults.roughness);
-        assert_eq!(layer.classes[0].scale_variation, 0.3);
-        let ClassLook::Instanced(plain) = &layer.classes[1].look else {
-            panic!("{:?}", layer.classes[1].look);
+        let lod = match &self.lod {
+            Some(lod) => Some(MeshLod {
+                mesh: handles.mesh(&lod.mesh)?,
+                material: handles.material(&lod.material)?,
+                distance: lod.distance,
+                crossfade: lod.crossfade.unwrap_or(0.1 * lod.distance),
+            }),
+            None => None,
         };
-        let base = defaults.base_color.to_linear();
-        let read = plain.material.base_color.to_linear();
-        assert!((base.green - read.green).abs() < 1e-6, "{base:?} {read:?}");
-        let blade = d.classes[0].mesh.primitive().unwrap();
-        let (_, hi) = crate::instancing::check_instanced_mesh(&blade)
-            .unwrap()
-            .unwrap();
-        assert!((hi.y - 0.6).abs() < 1e-6);
-    }
-
-    #[test]
-    fn rejects_bad_files_with_reasons() {
-        let err = |t: &str| LayerDescription::from_ron(t).unwrap_err().to_string();
-        assert!(err("(classes: [").contains("invalid layer file"));
-        assert!(err("(classes: [])").contains("at least one class"));
-        let bad_tile = MEADOW.replace("tile_size: 4.0", "tile_size: -1.0");
-        assert!(err(&bad_tile).contains("tile_size"));
-        let inverted = MEADOW.replace("unload_distance: 64.0", "unload_distance: 10.0");
-        assert!(err(&inverted).contains("unload_distance"));
-        let far = MEADOW.replace("load_distance: 48.0", "load_distance: 1e300");
-        assert!(err(&far).contains("more than 256 chunks"), "{}", err(&far));
-        let zero = MEADOW.replace("load_distance: 48.0", "load_distance: 0.0");
-        assert!(err(&zero).contains("load_distance 0 must be positive"));
+        Ok(ScatterClass {
+            scale: self.scale,
+            scale_variation: self.scale_variation,
+            lod,
+            ..class
+        })
     }
 }

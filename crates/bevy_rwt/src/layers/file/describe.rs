@@ -1,0 +1,183 @@
+//! Layers back to layer files: [`LayerDescription::describe`].
+
+use super::{
+    ClassDescription, DensityDescription, HeightDescription, InstancedMaterialDescription,
+    LayerDescription, LayerFileError, LodDescription, MaterialDescription, MeshDescription,
+    NamedAssets,
+};
+use crate::layers::{ClassLook, HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+use bevy::prelude::*;
+
+/// How [`LayerDescription::describe`] names assets.
+struct Namer<'a, I> {
+    names: &'a NamedAssets,
+    image: I,
+}
+
+impl LayerDescription {
+    /// The layer file of `layer`: what [`LayerDescription::to_layer`] turns back into the
+    /// same layer. Meshes, materials and height functions are written by their name in
+    /// `names`, else by their asset path; images by `image_path` when it gives one (e.g.
+    /// where a painted map was saved), else by their asset path. A layer using what has
+    /// neither (a mesh made in code without a name, a custom density or look) is a
+    /// [`LayerFileError::NotDescribable`] naming it.
+    pub fn describe(
+        layer: &ScatterLayer,
+        names: &NamedAssets,
+        image_path: impl FnMut(&Handle<Image>) -> Option<String>,
+    ) -> Result<Self, LayerFileError> {
+        let mut namer = Namer {
+            names,
+            image: image_path,
+        };
+        let classes = layer
+            .classes
+            .iter()
+            .enumerate()
+            .map(|(i, c)| namer.class(c).map_err(|e| in_class(i, e)))
+            .collect::<Result<_, _>>()?;
+        let (height, ground) = namer.height(&layer.height)?;
+        let streaming = &layer.streaming;
+        Ok(Self {
+            classes,
+            tile_size: layer.tile_size,
+            seed: layer.seed,
+            chunk_size: Some(streaming.chunk_size),
+            load_distance: Some(streaming.load_distance),
+            unload_distance: Some(streaming.unload_distance),
+            near_distance: Some(streaming.near_distance),
+            falloff: layer.falloff.map(|f| (f.near, f.far)),
+            falloff_floor: layer.falloff.map_or(0.0, |f| f.floor),
+            plane: layer.plane,
+            height,
+            ground,
+            height_range: layer.height_range,
+            max_slope: layer.max_slope,
+            exclusion: match &layer.exclusion {
+                Some(d) => Some(
+                    namer
+                        .density(d)
+                        .map_err(|e| format!("the exclusion: {e}"))
+                        .map_err(LayerFileError::NotDescribable)?,
+                ),
+                None => None,
+            },
+        })
+    }
+}
+
+fn in_class(i: usize, why: String) -> LayerFileError {
+    LayerFileError::NotDescribable(format!("class {i}: {why}"))
+}
+
+fn asset_path<A: Asset>(handle: &Handle<A>) -> Option<String> {
+    handle.path().map(|p| p.to_string())
+}
+
+impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
+    fn class(&mut self, c: &ScatterClass) -> Result<ClassDescription, String> {
+        let (mesh, material) = match &c.look {
+            ClassLook::Mesh { mesh, material } => (self.mesh(mesh)?, self.material(material)?),
+            ClassLook::Instanced(look) => (
+                self.mesh(&look.mesh)?,
+                MaterialDescription::Instanced(InstancedMaterialDescription::from(&look.material)),
+            ),
+            ClassLook::Custom(_) => return Err("a custom look (code) has no file form".into()),
+        };
+        let lod = match &c.lod {
+            Some(lod) => Some(LodDescription {
+                mesh: self.mesh(&lod.mesh)?,
+                material: self.material(&lod.material)?,
+                distance: lod.distance,
+                crossfade: Some(lod.crossfade),
+            }),
+            None => None,
+        };
+        Ok(ClassDescription {
+            density: self.density(&c.density)?,
+            mesh,
+            material,
+            scale: c.scale,
+            scale_variation: c.scale_variation,
+            lod,
+        })
+    }
+
+    fn mesh(&self, mesh: &Handle<Mesh>) -> Result<MeshDescription, String> {
+        if let Some(name) = self.names.mesh_name(mesh) {
+            return Ok(MeshDescription::Named(name));
+        }
+        asset_path(mesh)
+            .map(MeshDescription::Path)
+            .ok_or_else(|| format!("mesh {:?} has no asset path and no name", mesh.id()))
+    }
+
+    fn material(&self, material: &Handle<StandardMaterial>) -> Result<MaterialDescription, String> {
+        if let Some(name) = self.names.material_name(material) {
+            return Ok(MaterialDescription::Named(name));
+        }
+        asset_path(material)
+            .map(MaterialDescription::Path)
+            .ok_or_else(|| format!("material {:?} has no asset path and no name", material.id()))
+    }
+
+    fn image(&mut self, image: &Handle<Image>) -> Result<String, String> {
+        (self.image)(image)
+            .or_else(|| asset_path(image))
+            .ok_or_else(|| format!("image {:?} has no asset path", image.id()))
+    }
+
+    fn density(&mut self, d: &LayerDensity) -> Result<DensityDescription, String> {
+        Ok(match d {
+            LayerDensity::Constant(v) => DensityDescription::Constant(*v),
+            LayerDensity::Noise(n) => DensityDescription::Noise(n.params()),
+            LayerDensity::Image {
+                image,
+                min,
+                size,
+                scale,
+            } => DensityDescription::Image {
+                path: self.image(image)?,
+                min: (*min).into(),
+                size: (*size).into(),
+                scale: *scale,
+            },
+            LayerDensity::Custom(_) => {
+                return Err("a custom density (code) has no file form".into());
+            }
+        })
+    }
+
+    /// The flat height and the ground description.
+    fn height(
+        &mut self,
+        h: &HeightSource,
+    ) -> Result<(f32, Option<HeightDescription>), LayerFileError> {
+        let not = |why: String| LayerFileError::NotDescribable(format!("the ground: {why}"));
+        Ok(match h {
+            HeightSource::Constant(h) => (*h, None),
+            HeightSource::Function(_) => {
+                let name = self
+                    .names
+                    .height_name(h)
+                    .ok_or_else(|| not("a height function without a name in NamedAssets".into()))?;
+                (0.0, Some(HeightDescription::Named(name)))
+            }
+            HeightSource::Image {
+                image,
+                min,
+                size,
+                scale,
+            } => {
+                let path = self.image(image).map_err(not)?;
+                let ground = HeightDescription::Image {
+                    path,
+                    min: (*min).into(),
+                    size: (*size).into(),
+                    scale: *scale,
+                };
+                (0.0, Some(ground))
+            }
+        })
+    }
+}

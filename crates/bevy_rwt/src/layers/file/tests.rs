@@ -1,0 +1,284 @@
+//! Layer files: parsing, checking, writing and describing layers.
+
+use super::*;
+use crate::layers::ClassLook;
+
+/// The layer of `d` with default handles and no names.
+fn plain(d: &LayerDescription) -> ScatterLayer {
+    d.to_layer(
+        &NamedAssets::default(),
+        |_| Handle::default(),
+        |_| Handle::default(),
+        |_| Handle::default(),
+    )
+    .unwrap()
+}
+
+const MEADOW: &str = r#"(
+    tile_size: 4.0,
+    seed: 9,
+    chunk_size: 16.0,
+    load_distance: 48.0,
+    unload_distance: 64.0,
+    falloff: (20.0, 60.0),
+    classes: [
+        (density: Constant(0.4), mesh: Cone(radius: 0.5, height: 2.0), material: Color(0.1, 0.5, 0.1)),
+        (density: Noise(seed: 1, frequency: 0.1, octaves: 3, base: 0.5, amplitude: 0.5, scale: 0.2),
+         mesh: Sphere(radius: 0.3), material: Color(0.6, 0.2, 0.2), scale: 1.5),
+    ],
+)"#;
+
+#[test]
+fn a_layer_file_writes_and_reads_back_the_same() {
+    let with_all = MEADOW.replace(
+        "falloff: (20.0, 60.0),",
+        "falloff: (20.0, 60.0), falloff_floor: 0.25, exclusion: Image(path: \"roads.png\", min: (0.0, 0.0), size: (8.0, 8.0), scale: 1.0),",
+    );
+    let with_all = with_all.replace(
+        "classes: [",
+        r#"classes: [
+        (density: Image(path: "m.png", min: (0.0, 0.0), size: (8.0, 8.0), scale: 2.0),
+         mesh: Blade(width: 0.1, height: 0.6), material: Instanced(tip: (0.3, 0.5, 0.1), tip_from: 0.8)),
+        (density: Constant(1.0), mesh: Path("a.glb#Mesh0/Primitive0"), material: Path("a.glb#Material0")),"#,
+    );
+    let d = LayerDescription::from_ron(&with_all).unwrap();
+    assert_eq!(d.classes.len(), 4);
+    let text = d.to_ron().unwrap();
+    assert!(!text.contains("Some("), "{text}");
+    assert_eq!(LayerDescription::from_ron(&text).unwrap(), d);
+}
+
+#[test]
+fn parses_a_layer_file() {
+    let d = LayerDescription::from_ron(MEADOW).unwrap();
+    assert_eq!(d.classes.len(), 2);
+    assert_eq!(d.classes[1].scale, 1.5);
+    assert_eq!(d.classes[0].scale_variation, 0.2);
+    let layer = plain(&d);
+    assert_eq!(layer.tile_size, 4.0);
+    assert_eq!(layer.streaming.load_distance, 48.0);
+    assert_eq!(layer.falloff, Some(Falloff::new(20.0, 60.0)));
+    assert!(layer.exclusion.is_none());
+    let floored = MEADOW.replace(
+        "falloff: (20.0, 60.0),",
+        "falloff: (20.0, 60.0), falloff_floor: 0.25,",
+    );
+    let floored = plain(&LayerDescription::from_ron(&floored).unwrap());
+    assert_eq!(floored.falloff.map(|f| f.floor), Some(0.25));
+    let excluded = MEADOW.replace(
+        "falloff: (20.0, 60.0),",
+        "falloff: (20.0, 60.0), exclusion: Image(path: \"roads.png\", min: (0.0, 0.0), size: (8.0, 8.0), scale: 1.0),",
+    );
+    let mut loads = Vec::new();
+    let layer = LayerDescription::from_ron(&excluded)
+        .unwrap()
+        .to_layer(
+            &NamedAssets::default(),
+            |_| Handle::default(),
+            |_| Handle::default(),
+            |path| {
+                loads.push(path.to_string());
+                Handle::default()
+            },
+        )
+        .unwrap();
+    assert!(matches!(layer.exclusion, Some(LayerDensity::Image { .. })));
+    assert_eq!(loads, ["roads.png"]);
+}
+
+#[test]
+fn instanced_classes_in_a_layer_file() {
+    let text = MEADOW.replace(
+        "classes: [",
+        "classes: [(density: Constant(30.0), mesh: Blade(width: 0.08, height: 0.6), \
+         material: Instanced(tip: (0.3, 0.5, 0.1), fade_band: 0.2), scale_variation: 0.3), \
+         (density: Constant(5.0), mesh: Cuboid(size: (0.1, 0.1, 0.1)), material: Instanced()),",
+    );
+    let d = LayerDescription::from_ron(&text).unwrap();
+    let mut materials = 0;
+    let layer = d
+        .to_layer(
+            &NamedAssets::default(),
+            |_| Handle::default(),
+            |_| {
+                materials += 1;
+                Handle::default()
+            },
+            |_| Handle::default(),
+        )
+        .unwrap();
+    assert_eq!(materials, 2, "entity classes only");
+    let ClassLook::Instanced(look) = &layer.classes[0].look else {
+        panic!("{:?}", layer.classes[0].look);
+    };
+    assert_eq!(look.material.tip_color, Color::linear_rgb(0.3, 0.5, 0.1));
+    assert_eq!(look.material.fade_band, 0.2);
+    let defaults = InstancedMaterial::default();
+    assert_eq!(look.material.roughness, defaults.roughness);
+    assert_eq!(layer.classes[0].scale_variation, 0.3);
+    let ClassLook::Instanced(plain) = &layer.classes[1].look else {
+        panic!("{:?}", layer.classes[1].look);
+    };
+    let base = defaults.base_color.to_linear();
+    let read = plain.material.base_color.to_linear();
+    assert!((base.green - read.green).abs() < 1e-6, "{base:?} {read:?}");
+    let blade = d.classes[0].mesh.primitive().unwrap();
+    let (_, hi) = crate::instancing::check_instanced_mesh(&blade)
+        .unwrap()
+        .unwrap();
+    assert!((hi.y - 0.6).abs() < 1e-6);
+}
+
+#[test]
+fn rejects_bad_files_with_reasons() {
+    let err = |t: &str| LayerDescription::from_ron(t).unwrap_err().to_string();
+    assert!(err("(classes: [").contains("invalid layer file"));
+    assert!(err("(classes: [])").contains("at least one class"));
+    let bad_tile = MEADOW.replace("tile_size: 4.0", "tile_size: -1.0");
+    assert!(err(&bad_tile).contains("tile_size"));
+    let inverted = MEADOW.replace("unload_distance: 64.0", "unload_distance: 10.0");
+    assert!(err(&inverted).contains("unload_distance"));
+    let far = MEADOW.replace("load_distance: 48.0", "load_distance: 1e300");
+    assert!(err(&far).contains("more than 256 chunks"), "{}", err(&far));
+    let zero = MEADOW.replace("load_distance: 48.0", "load_distance: 0.0");
+    assert!(err(&zero).contains("load_distance 0 must be positive"));
+}
+
+/// A handle made in code (no asset path).
+fn uuid<A: Asset>(n: u128) -> Handle<A> {
+    Handle::Uuid(bevy::asset::uuid::Uuid::from_u128(n), default())
+}
+
+/// A layer built in code as a game does it: named meshes, materials and ground.
+fn code_layer(names: &NamedAssets, map: &Handle<Image>) -> ScatterLayer {
+    let (bush, far, leaf) = (
+        uuid::<Mesh>(6),
+        uuid::<Mesh>(7),
+        uuid::<StandardMaterial>(8),
+    );
+    names.insert_mesh("bush", bush.clone());
+    names.insert_mesh("bush far", far.clone());
+    names.insert_material("leaf", leaf.clone());
+    let ground = HeightSource::Function(std::sync::Arc::new(|p: Vec2| 0.1 * p.x));
+    names.insert_height("terrain", &ground);
+    let painted = LayerDensity::Image {
+        image: map.clone(),
+        min: Vec2::splat(-8.0),
+        size: Vec2::splat(16.0),
+        scale: 3.0,
+    };
+    let noise = rwt_core::density::NoiseParams {
+        seed: 4,
+        frequency: 0.1,
+        octaves: 2,
+        base: 0.3,
+        amplitude: 0.5,
+        scale: 1.0,
+    };
+    let mut flower = ScatterClass::instanced(
+        painted,
+        bush.clone(),
+        InstancedMaterial {
+            tip_from: 0.8,
+            ..default()
+        },
+    );
+    flower.scale = 0.5;
+    let tree = ScatterClass::new(
+        LayerDensity::Noise(NoiseDensity::new(noise)),
+        bush,
+        leaf.clone(),
+    )
+    .with_lod(far, leaf, 50.0);
+    let mut layer = ScatterLayer::new(vec![flower, tree])
+        .with_seed(11)
+        .with_tile_size(6.0)
+        .with_falloff_floor(10.0, 40.0, 0.3)
+        .with_height(ground)
+        .with_height_range(-2.0, 9.0)
+        .with_max_slope(0.7);
+    layer.exclusion = Some(LayerDensity::Constant(0.0));
+    layer
+}
+
+#[test]
+fn a_layer_built_in_code_describes_itself_and_reads_back_the_same() {
+    let names = NamedAssets::default();
+    let map = uuid::<Image>(9);
+    let layer = code_layer(&names, &map);
+    let saved = |h: &Handle<Image>| (h.id() == map.id()).then(|| "./flowers.png".to_string());
+    let d = LayerDescription::describe(&layer, &names, saved).unwrap();
+    assert_eq!(d.classes[1].mesh, MeshDescription::Named("bush".into()));
+    assert_eq!(d.ground, Some(HeightDescription::Named("terrain".into())));
+    let text = d.to_ron().unwrap();
+    let read = LayerDescription::from_ron(&text).unwrap();
+    assert_eq!(read, d, "{text}");
+    let mut images = Vec::new();
+    let back = read
+        .to_layer(
+            &names,
+            |m| panic!("only named meshes: {m:?}"),
+            |m| panic!("only named materials: {m:?}"),
+            |path| {
+                images.push(path.to_string());
+                map.clone()
+            },
+        )
+        .unwrap();
+    assert_eq!(images, ["./flowers.png"]);
+    let ClassLook::Mesh { material, .. } = &back.classes[1].look else {
+        panic!("{:?}", back.classes[1].look);
+    };
+    assert_eq!(Some(material.id()), names.material("leaf").map(|h| h.id()));
+    let lod = back.classes[1].lod.as_ref().unwrap();
+    assert_eq!((lod.distance, lod.crossfade), (50.0, 5.0));
+    assert_eq!(names.height_name(&back.height).as_deref(), Some("terrain"));
+    assert_eq!(back.falloff, layer.falloff);
+    assert_eq!(back.streaming, layer.streaming);
+    // The layer read back describes itself the same way: nothing was lost on the way.
+    let again = LayerDescription::describe(&back, &names, saved).unwrap();
+    assert_eq!(again, d);
+}
+
+#[test]
+fn what_a_file_cannot_name_is_a_typed_error() {
+    let names = NamedAssets::default();
+    let map = uuid::<Image>(9);
+    let layer = code_layer(&names, &map);
+    let err = LayerDescription::describe(&layer, &names, |_| None).unwrap_err();
+    assert!(
+        matches!(&err, LayerFileError::NotDescribable(why) if why.contains("class 0") && why.contains("image")),
+        "{err}"
+    );
+    let mut unnamed = layer.clone();
+    unnamed.classes[1].look = ClassLook::Mesh {
+        mesh: uuid(99),
+        material: names.material("leaf").unwrap(),
+    };
+    let err = LayerDescription::describe(&unnamed, &names, |_| Some("m.png".into())).unwrap_err();
+    assert!(err.to_string().contains("class 1: mesh"), "{err}");
+    let mut elsewhere = layer.clone();
+    elsewhere.height = HeightSource::Function(std::sync::Arc::new(|_| 0.0));
+    let err = LayerDescription::describe(&elsewhere, &names, |_| Some("m.png".into())).unwrap_err();
+    assert!(err.to_string().contains("the ground"), "{err}");
+    let mut custom = layer.clone();
+    custom.classes[0].density =
+        LayerDensity::Custom(std::sync::Arc::new(rwt_core::density::Constant(1.0)));
+    let err = LayerDescription::describe(&custom, &names, |_| Some("m.png".into())).unwrap_err();
+    assert!(err.to_string().contains("custom density"), "{err}");
+    // A file naming what the game did not register does not load.
+    let text = MEADOW.replace("mesh: Sphere(radius: 0.3)", "mesh: Named(\"oak\")");
+    let err = LayerDescription::from_ron(&text)
+        .unwrap()
+        .to_layer(
+            &names,
+            |_| Handle::default(),
+            |_| Handle::default(),
+            |_| Handle::default(),
+        )
+        .unwrap_err();
+    assert!(
+        matches!(&err, LayerFileError::UnknownName(n) if n.contains("oak")),
+        "{err}"
+    );
+}
