@@ -73,16 +73,25 @@ enum Command {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
-    /// Stipple an image: dots with blue-noise spacing, denser where darker.
+    /// Stipple an image: dots with blue-noise spacing whose ink matches the image's tone.
     Stipple {
         /// Input image.
         image: PathBuf,
-        /// Output .svg or .png.
+        /// Output .svg or .png (antialiased).
         #[arg(long)]
         out: PathBuf,
-        /// Expected number of dots.
-        #[arg(long, default_value_t = 50_000)]
-        points: usize,
+        /// Number of dots (default: one per four image pixels; the radius follows).
+        #[arg(long, conflicts_with = "radius")]
+        points: Option<usize>,
+        /// Dot radius in image pixels (the number of dots follows).
+        #[arg(long)]
+        radius: Option<f64>,
+        /// Darkness exponent: darkness = (contrast * (1 - grey))^gamma.
+        #[arg(long, default_value_t = 1.0)]
+        gamma: f64,
+        /// Darkness multiplier (see --gamma).
+        #[arg(long, default_value_t = 1.0)]
+        contrast: f64,
         /// Tiling seed.
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -185,9 +194,21 @@ fn main() -> ExitCode {
             image,
             out,
             points,
+            radius,
+            gamma,
+            contrast,
             seed,
             scale,
-        } => stipple_cmd::run(&image, &out, points, seed, scale).map(|()| true),
+        } => stipple_cmd::run(&stipple_cmd::StippleArgs {
+            image: &image,
+            out: &out,
+            points,
+            radius,
+            tone: rwt_core::stipple::ToneMap { gamma, contrast },
+            seed,
+            scale,
+        })
+        .map(|()| true),
         Command::Bench { quick } => bench_cmd::run(quick).map(|()| true),
     };
     match result {

@@ -1,88 +1,125 @@
-//! `rwt stipple`: blue-noise stippling of an image, density from darkness (paper figure 11).
+//! `rwt stipple`: blue-noise stippling of an image whose blurred dots keep the image's tone
+//! (paper figure 11), with the tone error printed next to a white-noise stipple's.
 
-use crate::draw::Canvas;
-use glam::DVec2;
-use rwt_core::density::{Density, ImageDensity};
-use rwt_core::query::{Rect, Sampler};
+use rwt_core::stipple::{DotCount, Grey, Stipple, StippleSettings, ToneMap, stipple};
 use rwt_core::tileset::TileSet;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-/// `rwt stipple IMAGE --out FILE [--points N] [--seed S]`.
-pub fn run(image: &Path, out: &Path, points: usize, seed: u64, scale: f64) -> Result<(), String> {
-    let img = image::open(image).map_err(|e| format!("{}: {e}", image.display()))?;
-    let (w, h) = (img.width() as f64, img.height() as f64);
-    let size = DVec2::new(w, h);
-    // World units are pixels; darkness 1 gives `density` points per pixel.
-    let unit = ImageDensity::from_image(&img, None, true, DVec2::ZERO, size, 1.0)
-        .map_err(|e| e.to_string())?;
-    let darkness: f64 = (0..img.height())
-        .flat_map(|y| (0..img.width()).map(move |x| (x, y)))
-        .map(|(x, y)| unit.density(DVec2::new(x as f64 + 0.5, h - y as f64 - 0.5)))
-        .sum();
-    if darkness <= 0.0 {
-        return Err("the image is white: nothing to stipple".into());
-    }
-    let density = points as f64 / darkness;
-    let d = ImageDensity::from_image(&img, None, true, DVec2::ZERO, size, density)
-        .map_err(|e| e.to_string())?;
-    let set = TileSet::embedded();
-    // Tiles sized so that the darkest tone fills a base tile exactly.
-    let tile = (set.points_per_tile as f64 / density).sqrt();
-    let sampler = Sampler::new(&set, seed)
-        .with_tile_size(tile)
-        .with_budget(points.saturating_mul(4).max(1000));
-    let rect = Rect::new(DVec2::ZERO, size).map_err(|e| e.to_string())?;
-    let mut pts = Vec::with_capacity(points + points / 8);
+/// What `rwt stipple` was asked for.
+pub struct StippleArgs<'a> {
+    /// Input image.
+    pub image: &'a Path,
+    /// Output `.png` or `.svg`.
+    pub out: &'a Path,
+    /// Dot count, or `None` to choose it (or the radius).
+    pub points: Option<usize>,
+    /// Dot radius in image pixels, or `None` to choose it.
+    pub radius: Option<f64>,
+    /// Grey to darkness.
+    pub tone: ToneMap,
+    /// Tiling seed.
+    pub seed: u64,
+    /// Output pixels per image pixel.
+    pub scale: f64,
+}
+
+/// Runs `rwt stipple`.
+pub fn run(args: &StippleArgs) -> Result<(), String> {
+    let img = image::open(args.image).map_err(|e| format!("{}: {e}", args.image.display()))?;
+    let luma = img.to_luma32f();
+    let grey = Grey {
+        width: luma.width() as usize,
+        height: luma.height() as usize,
+        values: luma.into_raw(),
+    };
+    let dots = match (args.points, args.radius) {
+        (Some(n), None) => DotCount::Points(n),
+        (None, Some(r)) => DotCount::Radius(r),
+        (None, None) => DotCount::Auto,
+        (Some(_), Some(_)) => return Err("give --points or --radius, not both".into()),
+    };
+    let settings = StippleSettings {
+        dots,
+        tone: args.tone,
+        seed: args.seed,
+        scale: args.scale,
+    };
     let started = Instant::now();
-    sampler
-        .query(rect, &d, &mut pts)
-        .map_err(|e| e.to_string())?;
-    let secs = started.elapsed().as_secs_f64();
+    let s = stipple(&grey, &TileSet::embedded(), &settings).map_err(|e| e.to_string())?;
     say!(
-        "{} points in {:.1} ms ({:.1} million points per second)",
-        pts.len(),
-        secs * 1e3,
-        pts.len() as f64 / secs / 1e6
+        "{} dots of radius {:.3} px in {:.1} ms",
+        s.dots.len(),
+        s.radius,
+        started.elapsed().as_secs_f64() * 1e3
     );
-    // Dots a little under half the spacing of the darkest tone.
-    let radius = 0.42 / density.sqrt();
+    report_tone(&s, &grey, args.scale, args.seed);
+    write(&s, args.out, args.scale)?;
+    say!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Prints the mean grey and the tone error of the stipple and of a white-noise stipple.
+fn report_tone(s: &Stipple, grey: &Grey, scale: f64, seed: u64) {
+    let rendered = s.render(&s.dots, scale);
+    let target = 1.0 - s.target.mean();
+    let mapped = if (target - grey.mean()).abs() > 5e-4 {
+        format!(", after --gamma/--contrast {target:.3}")
+    } else {
+        String::new()
+    };
+    say!(
+        "mean grey: image {:.3}{mapped}, stipple {:.3}",
+        grey.mean(),
+        1.0 - rendered.mean()
+    );
+    let r = s.tone_report(scale, seed);
+    say!(
+        "tone error (blur {:.2} px, the mean dot spacing): blue noise {:.4} (PSNR {:.2} dB), white noise {:.4} (PSNR {:.2} dB), {:+.2} dB",
+        r.sigma,
+        r.blue.mean_abs,
+        r.blue.psnr,
+        r.white.mean_abs,
+        r.white.psnr,
+        r.blue.psnr - r.white.psnr
+    );
+}
+
+/// Writes the stipple as antialiased PNG or as SVG circles.
+fn write(s: &Stipple, out: &Path, scale: f64) -> Result<(), String> {
     let ext = out
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
+    let io = |e: String| format!("{}: {e}", out.display());
     if ext == "svg" {
+        let (w, h) = (s.target.width, s.target.height);
         let mut svg = format!(
             "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 {w} {h}\" width=\"{}\" height=\"{}\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
-            w * scale,
-            h * scale
+            w as f64 * scale,
+            h as f64 * scale
         );
-        for p in &pts {
+        for p in &s.dots {
             let _ = writeln!(
                 svg,
-                "<circle cx=\"{:.3}\" cy=\"{:.3}\" r=\"{radius:.3}\"/>",
-                p.position.x,
-                h - p.position.y
+                "<circle cx=\"{:.3}\" cy=\"{:.3}\" r=\"{:.3}\"/>",
+                p.x, p.y, s.radius
             );
         }
         svg.push_str("</svg>\n");
-        std::fs::write(out, svg).map_err(|e| format!("{}: {e}", out.display()))?;
+        std::fs::write(out, svg).map_err(|e| io(e.to_string()))
     } else {
-        let mut c = Canvas::new((w * scale) as u32, (h * scale) as u32, [255, 255, 255]);
-        for p in &pts {
-            c.disc(
-                p.position.x * scale,
-                (h - p.position.y) * scale,
-                (radius * scale).max(0.7),
-                [0, 0, 0],
-            );
-        }
-        c.image
+        let ink = s.render(&s.dots, scale);
+        let pixels = ink
+            .values
+            .iter()
+            .map(|&v| ((1.0 - v) * 255.0).round() as u8)
+            .collect();
+        image::GrayImage::from_raw(ink.width as u32, ink.height as u32, pixels)
+            .ok_or_else(|| io("raster size".into()))?
             .save(out)
-            .map_err(|e| format!("{}: {e}", out.display()))?;
+            .map_err(|e| io(e.to_string()))
     }
-    say!("wrote {}", out.display());
-    Ok(())
 }

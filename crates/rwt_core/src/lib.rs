@@ -87,6 +87,7 @@ pub mod density;
 mod geometry;
 pub mod query;
 pub mod rng;
+pub mod stipple;
 pub mod streaming;
 pub mod tileset;
 pub mod tiling;

@@ -1,0 +1,200 @@
+//! Tone-true stippling on the project's own photograph-like images (generated here): the
+//! blurred dots keep the image's tone, far closer than white noise with the same dots.
+
+use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
+use rwt_core::stipple::{DotCount, Grey, StippleError, StippleSettings, ToneMap, stipple};
+use rwt_core::tileset::TileSet;
+
+/// A studio shot: a lit, glossy sphere over a graded backdrop with its soft shadow, and a
+/// little film grain.
+fn sphere(size: usize) -> Grey {
+    let grain = Perlin::new(5);
+    let values = pixels(size, |u, v| {
+        let mut g = 0.92 - 0.35 * (1.0 - v) * 0.5;
+        let (sx, sy) = ((u - 0.25) / 0.75, (v + 0.78) / 0.16);
+        if sx * sx + sy * sy < 1.0 {
+            g *= 0.55 + 0.45 * (sx * sx + sy * sy);
+        }
+        let (nx, ny) = (u / 0.72, (v - 0.08) / 0.72);
+        let r2 = nx * nx + ny * ny;
+        if r2 < 1.0 {
+            let nz = (1.0 - r2).sqrt();
+            let lambert = (-0.5 * nx + 0.6 * ny + 0.62 * nz).max(0.0);
+            let spec = (0.9 * nz - 0.3 * nx + 0.3 * ny).max(0.0).powi(40);
+            g = (0.08 + 0.82 * lambert + 0.6 * spec).min(1.0);
+        }
+        g + 0.03 * grain.get([u * 90.0, v * 90.0])
+    });
+    Grey {
+        width: size,
+        height: size,
+        values,
+    }
+}
+
+/// A landscape: sky with clouds, hills in aerial perspective, a dark textured foreground.
+fn landscape(size: usize) -> Grey {
+    let fbm = Fbm::<Perlin>::new(3).set_octaves(5);
+    let values = pixels(size, |u, v| {
+        let n = |x: f64, y: f64| fbm.get([x, y]);
+        let ridge = |k: f64, f: f64, a: f64| k + a * n(u * f + k * 7.0, k);
+        let (far, near) = (ridge(0.25, 1.5, 0.12), ridge(-0.15, 3.0, 0.15));
+        if v > far {
+            // Sky: lighter towards the horizon, soft clouds.
+            (0.75 + 0.2 * (1.0 - v) + 0.18 * n(u * 3.0, v * 6.0)).min(1.0)
+        } else if v > near {
+            0.55 + 0.1 * n(u * 8.0, v * 8.0)
+        } else {
+            // Foreground grass: dark with texture.
+            0.22 + 0.15 * n(u * 30.0, v * 30.0) + 0.1 * (v + 1.0)
+        }
+    });
+    Grey {
+        width: size,
+        height: size,
+        values,
+    }
+}
+
+/// Values of `f(u, v)` over `[-1, 1]^2` (v up), row 0 at the top, clamped to `[0, 1]`.
+fn pixels(size: usize, f: impl Fn(f64, f64) -> f64) -> Vec<f32> {
+    let mut out = Vec::with_capacity(size * size);
+    for y in 0..size {
+        for x in 0..size {
+            let u = (x as f64 + 0.5) / size as f64 * 2.0 - 1.0;
+            let v = 1.0 - (y as f64 + 0.5) / size as f64 * 2.0;
+            out.push(f(u, v).clamp(0.0, 1.0) as f32);
+        }
+    }
+    out
+}
+
+#[test]
+fn blurred_stipples_keep_the_tone_of_photographs() {
+    let set = TileSet::embedded();
+    for (name, image) in [("sphere", sphere(256)), ("landscape", landscape(256))] {
+        let s = stipple(&image, &set, &StippleSettings::default()).unwrap();
+        let report = s.tone_report(2.0, 1);
+        let page = 1.0 - s.render(&s.dots, 2.0).mean();
+        eprintln!(
+            "{name}: {} dots, radius {:.3}, mean grey image {:.3} stipple {page:.3}, {report:?}",
+            s.dots.len(),
+            s.radius,
+            image.mean()
+        );
+        assert!((page - image.mean()).abs() < 0.02, "{name}: mean tone");
+        assert!(report.blue.mean_abs <= 0.03, "{name}: {report:?}");
+        assert!(
+            report.blue.psnr >= report.white.psnr + 3.0,
+            "{name}: {report:?}"
+        );
+        // About one dot per four pixels by default.
+        let ratio = s.dots.len() as f64 / (256.0 * 256.0 / 4.0);
+        assert!((ratio - 1.0).abs() < 0.05, "{name}: {ratio}");
+    }
+}
+
+#[test]
+fn white_stays_white_and_counts_and_radii_are_honoured() {
+    let set = TileSet::embedded();
+    // White on the left half, mid grey on the right.
+    let values = (0..128 * 64)
+        .map(|i| if i % 128 < 64 { 1.0 } else { 0.5 })
+        .collect();
+    let image = Grey {
+        width: 128,
+        height: 64,
+        values,
+    };
+    let with = |dots| StippleSettings {
+        dots,
+        ..StippleSettings::default()
+    };
+    let s = stipple(&image, &set, &with(DotCount::Points(1500))).unwrap();
+    // Dots reach the white half only by the bilinear half-pixel at the edge.
+    assert!(s.dots.iter().all(|d| d.x > 63.0), "a dot in the white");
+    assert!(
+        (s.dots.len() as f64 / 1500.0 - 1.0).abs() < 0.05,
+        "{}",
+        s.dots.len()
+    );
+    let r = stipple(&image, &set, &with(DotCount::Radius(1.5))).unwrap();
+    assert_eq!(r.radius, 1.5);
+    let page = 1.0 - r.render(&r.dots, 2.0).mean();
+    assert!((page - image.mean()).abs() < 0.02, "{page}");
+    // Same seed, same dots; another seed, others.
+    let again = stipple(&image, &set, &with(DotCount::Points(1500))).unwrap();
+    assert_eq!(again.dots, s.dots);
+    let other = StippleSettings {
+        seed: 9,
+        ..with(DotCount::Points(1500))
+    };
+    assert_ne!(stipple(&image, &set, &other).unwrap().dots, s.dots);
+}
+
+#[test]
+fn the_tone_map_darkens_and_lightens() {
+    let set = TileSet::embedded();
+    let image = Grey {
+        width: 64,
+        height: 64,
+        values: vec![0.6; 64 * 64],
+    };
+    let dots_with = |tone| {
+        let settings = StippleSettings {
+            dots: DotCount::Radius(1.0),
+            tone,
+            ..StippleSettings::default()
+        };
+        stipple(&image, &set, &settings).unwrap().dots.len()
+    };
+    let plain = dots_with(ToneMap::default());
+    let contrast = ToneMap {
+        contrast: 1.5,
+        ..ToneMap::default()
+    };
+    let gamma = ToneMap {
+        gamma: 2.0,
+        ..ToneMap::default()
+    };
+    assert!(dots_with(contrast) > plain && dots_with(gamma) < plain);
+    assert_eq!(ToneMap::default().darkness(1.0), 0.0);
+    assert_eq!(contrast.darkness(1.0), 0.0, "white stays white");
+}
+
+#[test]
+fn bad_input_gets_typed_errors() {
+    let set = TileSet::embedded();
+    let white = Grey::filled(16, 16, 1.0);
+    let ok = StippleSettings::default();
+    assert_eq!(stipple(&white, &set, &ok).unwrap_err(), StippleError::White);
+    let grey = Grey::filled(16, 16, 0.5);
+    let radius = StippleSettings {
+        dots: DotCount::Radius(-1.0),
+        ..ok
+    };
+    assert!(matches!(
+        stipple(&grey, &set, &radius),
+        Err(StippleError::Setting(_))
+    ));
+    let nan = StippleSettings {
+        tone: ToneMap {
+            gamma: f64::NAN,
+            contrast: 1.0,
+        },
+        ..ok
+    };
+    assert!(matches!(
+        stipple(&grey, &set, &nan),
+        Err(StippleError::Setting(_))
+    ));
+    let empty = Grey {
+        width: 0,
+        height: 3,
+        values: vec![],
+    };
+    assert!(matches!(
+        stipple(&empty, &set, &ok),
+        Err(StippleError::Image(_))
+    ));
+}
