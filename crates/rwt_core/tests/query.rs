@@ -601,3 +601,22 @@ fn parallel_queries_return_the_serial_points_in_the_serial_order() {
         Err(QueryError::BudgetExceeded { .. })
     ));
 }
+
+#[test]
+fn parallel_progress_counts_every_tile_once() {
+    use std::sync::Mutex;
+    let half = from_fn(|p: DVec2| if p.x > 37.0 { 3.0 } else { 0.0 }, 3.0);
+    let s = sampler(2).with_tile_size(1.5);
+    let rect = square(0.0, 100.0);
+    let seen = Mutex::new(Vec::new());
+    let runs = s
+        .query_par_runs_with_progress(rect, &half, &|f| seen.lock().unwrap().push(f))
+        .unwrap();
+    assert_eq!(runs, s.query_par_runs(rect, &half).unwrap());
+    let seen = seen.into_inner().unwrap();
+    assert!(seen.len() > 10, "{}", seen.len());
+    // Every tile is counted once: the largest report is exactly all of them.
+    let top = seen.iter().copied().fold(0.0, f64::max);
+    assert_eq!(top, 1.0);
+    assert!(seen.iter().all(|f| (0.0..=1.0).contains(f)));
+}

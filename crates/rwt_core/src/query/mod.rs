@@ -78,6 +78,7 @@ pub enum QueryError {
 }
 
 /// Base tiles `[i0, i1) x [j0, j1)` of a query.
+#[derive(Clone, Copy)]
 struct TileRange {
     i0: i64,
     i1: i64,

@@ -8,6 +8,7 @@ use super::{Point, QueryError, Rect, Sampler, TileRange};
 use crate::density::{Density, sanitize};
 use glam::DVec2;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Points each task copies when the runs are joined.
 const JOIN_GRAIN: usize = 1 << 15;
@@ -66,15 +67,51 @@ impl Sampler {
         rect: Rect,
         density: &D,
     ) -> Result<Vec<Vec<Point>>, QueryError> {
+        self.query_par_runs_with_progress(rect, density, &|_| {})
+    }
+
+    /// [`Sampler::query_par_runs`], calling `progress` from the worker threads with the
+    /// fraction (0..=1) of the rectangle's base tiles done so far, as blocks finish.
+    pub fn query_par_runs_with_progress<D: Density + Sync + ?Sized>(
+        &self,
+        rect: Rect,
+        density: &D,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<Vec<Vec<Point>>, QueryError> {
         let Some(range) = self.admit(&rect, density)? else {
+            progress(1.0);
             return Ok(Vec::new());
         };
         Ok(Fork {
             sampler: self,
             rect,
             density,
+            progress: Progress {
+                total: tiles(&range).max(1) as f64,
+                done: AtomicU64::new(0),
+                report: progress,
+            },
         }
         .blocks(range))
+    }
+}
+
+/// Base tiles of a range.
+fn tiles(range: &TileRange) -> u64 {
+    ((range.i1 - range.i0).max(0) as u64).saturating_mul((range.j1 - range.j0).max(0) as u64)
+}
+
+/// Base tiles done, reported as a fraction.
+struct Progress<'a> {
+    total: f64,
+    done: AtomicU64,
+    report: &'a (dyn Fn(f64) + Sync),
+}
+
+impl Progress<'_> {
+    fn finished(&self, range: &TileRange) {
+        let done = self.done.fetch_add(tiles(range), Ordering::Relaxed) + tiles(range);
+        (self.report)((done as f64 / self.total).min(1.0));
     }
 }
 
@@ -83,6 +120,7 @@ struct Fork<'a, D: ?Sized> {
     sampler: &'a Sampler,
     rect: Rect,
     density: &'a D,
+    progress: Progress<'a>,
 }
 
 impl<D: Density + Sync + ?Sized> Fork<'_, D> {
@@ -95,7 +133,9 @@ impl<D: Density + Sync + ?Sized> Fork<'_, D> {
             return Vec::new();
         }
         if i1 - i0 <= LEAF_BLOCK && j1 - j0 <= LEAF_BLOCK {
-            return vec![self.serial(range)];
+            let run = self.serial(range);
+            self.progress.finished(&range);
+            return vec![run];
         }
         let s = self.sampler.tile_size();
         let block = Rect::from_ordered(
@@ -103,10 +143,12 @@ impl<D: Density + Sync + ?Sized> Fork<'_, D> {
             DVec2::new(i1 as f64 * s, j1 as f64 * s),
         );
         let Some(block) = block.intersect(&self.rect) else {
+            self.progress.finished(&range);
             return Vec::new();
         };
         let bound = sanitize(self.density.max_over(block.min(), block.max()));
         if bound.is_nan() || bound <= 0.0 {
+            self.progress.finished(&range);
             return Vec::new();
         }
         let (im, jm) = (i0 + (i1 - i0) / 2, j0 + (j1 - j0) / 2);
