@@ -64,6 +64,41 @@
 //!     .add_systems(Startup, setup)
 //!     .run();
 //! ```
+//!
+//! ## Headless
+//!
+//! The plugin needs no window or renderer: servers and tests run it on `MinimalPlugins`,
+//! and [`RwtStats`] says what streamed.
+//!
+//! ```
+//! use bevy::prelude::*;
+//! use bevy_rwt::prelude::*;
+//!
+//! let mut app = App::new();
+//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugin::default()))
+//!     .init_asset::<Mesh>()
+//!     .init_asset::<StandardMaterial>();
+//! app.finish();
+//! app.cleanup();
+//! app.world_mut().spawn((RwtViewer::all_around(), Transform::default(), GlobalTransform::default()));
+//! let stones = ScatterClass::new(LayerDensity::Constant(0.5), Handle::default(), Handle::default());
+//! let grass = ScatterClass::instanced(LayerDensity::Constant(20.0), Handle::default(), InstancedMaterial::default());
+//! let streaming = StreamingConfig { chunk_size: 16.0, load_distance: 32.0, unload_distance: 40.0, near_distance: 16.0 };
+//! app.world_mut().spawn(ScatterLayer::new(vec![stones, grass]).with_streaming(streaming));
+//! // Chunks are generated on the async compute pool: run frames until they have landed.
+//! for _ in 0..10_000 {
+//!     app.update();
+//!     let stats = app.world().resource::<RwtStats>();
+//!     if stats.live_instances > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
+//!         break;
+//!     }
+//!     std::thread::sleep(std::time::Duration::from_millis(1));
+//! }
+//! let stats = app.world().resource::<RwtStats>();
+//! // About 0.5 stones (entities) and 20 blades (instanced, no entities) per square unit.
+//! let ratio = stats.live_instanced as f64 / stats.live_instances as f64;
+//! assert!((ratio - 40.0).abs() < 4.0, "{stats:?}");
+//! ```
 
 #[cfg(feature = "brush")]
 pub mod brush;
@@ -97,7 +132,7 @@ pub mod prelude {
         BrushCommand, BrushSystems, BrushTarget, DensityBrush, PaintDab, RwtBrushPlugin,
     };
     pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
-    pub use crate::layers::file::{ScatterLayerAsset, ScatterLayerSource};
+    pub use crate::layers::file::{NamedAssets, ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{
         AssetStatus, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
         HeightSource, InstancedChunk, InstancedMaterial, LayerDensity, RwtFadeIn, RwtPlugin,

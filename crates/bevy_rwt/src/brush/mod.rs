@@ -5,8 +5,8 @@
 //! from (right button) the selected class's density map, and tells the plugin which region
 //! changed ([`crate::DensityMapPainted`]), so only the chunks under the stroke re-scatter.
 //! The wheel sets the size, a key the strength, digit keys the class; recent strokes can be
-//! undone; the maps save to PNG files (with a RON index) and load again, in this game or
-//! another one whose layers have the same names. A gizmo circle shows the brush when Bevy's
+//! undone; the maps save to PNG files, with the layer files that read them and a RON index,
+//! and load again, in this game or another one. A gizmo circle shows the brush when Bevy's
 //! gizmos are there.
 //!
 //! Everything the mouse does is also a message, for scripts, tools and tests:
@@ -33,6 +33,39 @@
 //!     .add_plugins((DefaultPlugins, RwtPlugin::default(), RwtBrushPlugin))
 //!     .add_systems(Startup, setup)
 //!     .run();
+//! ```
+//!
+//! A script paints without a mouse (here headless):
+//!
+//! ```
+//! use bevy::prelude::*;
+//! use bevy_rwt::brush::{BrushTarget, DensityBrush, RwtBrushPlugin};
+//! use bevy_rwt::prelude::*;
+//!
+//! let mut app = App::new();
+//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugin::default(), RwtBrushPlugin))
+//!     .init_asset::<Mesh>()
+//!     .init_asset::<StandardMaterial>();
+//! app.finish();
+//! app.cleanup();
+//! let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+//! let (_, density) = bevy_rwt::brush::blank_map(&mut images, 64, Vec2::splat(-32.0), Vec2::splat(64.0), 2.0);
+//! let class = ScatterClass::new(density, Handle::default(), Handle::default());
+//! let layer = app.world_mut().spawn(ScatterLayer::new(vec![class])).id();
+//! app.world_mut().spawn((RwtViewer::all_around(), Transform::default(), GlobalTransform::default()));
+//! app.world_mut().resource_mut::<DensityBrush>().targets.push(BrushTarget::new(layer, 0, "meadow"));
+//! // One dab of 5 m at full strength: about 2 instances per square metre within it.
+//! app.world_mut().write_message(PaintDab { target: 0, centre: Vec2::ZERO, radius: 5.0, amount: 1.0 });
+//! let live = |app: &App| app.world().resource::<RwtStats>().live_instances;
+//! for _ in 0..10_000 {
+//!     app.update();
+//!     let stats = app.world().resource::<RwtStats>();
+//!     if live(&app) > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
+//!         break;
+//!     }
+//!     std::thread::sleep(std::time::Duration::from_millis(1));
+//! }
+//! assert!((20..200).contains(&live(&app)), "{}", live(&app));
 //! ```
 
 mod paint;

@@ -24,6 +24,35 @@
 //! )
 //! ```
 //!
+//! In code, a file is parsed and checked by [`LayerDescription::from_ron`], becomes a
+//! layer with [`LayerDescription::to_layer`], and a layer becomes a file again with
+//! [`LayerDescription::describe`] and [`LayerDescription::to_ron`]:
+//!
+//! ```
+//! use bevy::prelude::*;
+//! use bevy_rwt::layers::file::{LayerDescription, MeshDescription, NamedAssets};
+//! use bevy_rwt::prelude::*;
+//!
+//! let names = NamedAssets::default();
+//! let pine: Handle<Mesh> = Handle::default();
+//! names.insert_mesh("pine", pine.clone());
+//! let text = r#"(classes: [(density: Constant(0.05), mesh: Named("pine"), material: Color(0.1, 0.3, 0.1))],
+//!                tile_size: 32.0, falloff: (100.0, 400.0), falloff_floor: 0.2)"#;
+//! let file = LayerDescription::from_ron(text).unwrap();
+//! let layer = file.to_layer(&names, |_| Handle::default(), |_| Handle::default(), |_| Handle::default()).unwrap();
+//! assert_eq!(layer.tile_size, 32.0);
+//! assert_eq!(layer.falloff.unwrap().floor, 0.2);
+//! // Back to a file: the mesh by its name.
+//! let material = Handle::<StandardMaterial>::default();
+//! let look = ClassLook::Mesh { mesh: pine, material: material.clone() };
+//! names.insert_material("needles", material);
+//! let mut layer = layer;
+//! layer.classes[0].look = look;
+//! let again = LayerDescription::describe(&layer, &names, |_| None).unwrap();
+//! assert_eq!(again.classes[0].mesh, MeshDescription::Named("pine".into()));
+//! assert!(again.to_ron().unwrap().contains("Named(\"needles\")"));
+//! ```
+//!
 //! Paths are asset paths; one starting with `./` or `../` is relative to the layer file's
 //! folder (what the brush writes, so that a saved folder can move). Meshes, materials and
 //! height functions made in code take part by name (`Named("spruce")`, `ground:
