@@ -8,7 +8,8 @@
 //! - WASD / arrows fly, Q / E down and up, Shift boosts, hold the right mouse button to
 //!   look, the wheel sets the speed;
 //! - B toggles the brush: left mouse paints, right erases, the wheel sizes it, T sets the
-//!   strength, 1-4 choose the map, Z undoes, F5 saves the maps to `painted/`, F9 loads them;
+//!   strength, 1-4 choose the map, Z undoes, F5 saves the maps and the flower and bush
+//!   layer files to `painted/` (or `RWT_PAINT_DIR`), F9 loads the maps;
 //! - V toggles the wind, F the fade-in (see the popping it hides), G chunk outlines.
 
 mod layers;
