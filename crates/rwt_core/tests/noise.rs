@@ -51,6 +51,23 @@ fn values_are_the_noise_crates_fbm_bit_for_bit() {
             );
         }
     }
+    // Lattice points, zero and negative integers included (the crate's corner rule differs
+    // from `floor` at or below zero), at frequency 1.
+    let unit = NoiseParams {
+        frequency: 1.0,
+        ..params()[0]
+    };
+    let (ours, theirs) = (NoiseDensity::new(unit), plain(unit));
+    for i in -6..=6 {
+        for j in -6..=6 {
+            for p in [
+                DVec2::new(i as f64, j as f64),
+                DVec2::new(i as f64 * 0.5, j as f64),
+            ] {
+                assert_eq!(ours.density(p).to_bits(), theirs(p).to_bits(), "at {p:?}");
+            }
+        }
+    }
 }
 
 #[test]
