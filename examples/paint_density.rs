@@ -348,13 +348,17 @@ fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<As
 struct MapOverlay;
 
 /// The smoke session: a stroke per class, an eraser stroke, then a save, a clear and a load
-/// (so that the screenshot shows the maps read back from disk).
+/// (so that the screenshot shows the maps read back from disk, once their chunks have
+/// re-scattered).
 fn paint_script(
     smoke: Res<Smoke>,
     mut canvas: ResMut<Canvas>,
     mut done: Local<bool>,
     mut exit: MessageWriter<AppExit>,
+    mut report: ResMut<SmokeReport>,
+    stats: Res<RwtStats>,
 ) {
+    report.hold = !*done || stats.pending_tasks > 0 || stats.queued_spawns > 0;
     let t = smoke.progress() as f64;
     let classes = canvas.setup.classes.len();
     let span = 0.7 / classes as f64;
