@@ -54,15 +54,16 @@ pub fn run(args: &StippleArgs) -> Result<(), String> {
         s.radius,
         started.elapsed().as_secs_f64() * 1e3
     );
-    report_tone(&s, &grey, args.scale, args.seed);
-    write(&s, args.out, args.scale)?;
+    // Rendered once: the tone figures and the PNG are of the same raster.
+    let ink = s.render(&s.dots, args.scale);
+    report_tone(&s, &grey, &ink, args.seed);
+    write(&s, &ink, args.out, args.scale)?;
     say!("wrote {}", args.out.display());
     Ok(())
 }
 
 /// Prints the mean grey and the tone error of the stipple and of a white-noise stipple.
-fn report_tone(s: &Stipple, grey: &Grey, scale: f64, seed: u64) {
-    let rendered = s.render(&s.dots, scale);
+fn report_tone(s: &Stipple, grey: &Grey, rendered: &Grey, seed: u64) {
     let target = 1.0 - s.target.mean();
     let mapped = if (target - grey.mean()).abs() > 5e-4 {
         format!(", after --gamma/--contrast {target:.3}")
@@ -74,7 +75,7 @@ fn report_tone(s: &Stipple, grey: &Grey, scale: f64, seed: u64) {
         grey.mean(),
         1.0 - rendered.mean()
     );
-    let r = s.tone_report(scale, seed);
+    let r = s.tone_report(rendered, seed);
     say!(
         "tone error (blur {:.2} px, the mean dot spacing): blue noise {:.4} (PSNR {:.2} dB), white noise {:.4} (PSNR {:.2} dB), {:+.2} dB",
         r.sigma,
@@ -86,8 +87,8 @@ fn report_tone(s: &Stipple, grey: &Grey, scale: f64, seed: u64) {
     );
 }
 
-/// Writes the stipple as antialiased PNG or as SVG circles.
-fn write(s: &Stipple, out: &Path, scale: f64) -> Result<(), String> {
+/// Writes the stipple as antialiased PNG (`ink`, its rendering) or as SVG circles.
+fn write(s: &Stipple, ink: &Grey, out: &Path, scale: f64) -> Result<(), String> {
     let ext = out
         .extension()
         .and_then(|e| e.to_str())
@@ -111,7 +112,6 @@ fn write(s: &Stipple, out: &Path, scale: f64) -> Result<(), String> {
         svg.push_str("</svg>\n");
         std::fs::write(out, svg).map_err(|e| io(e.to_string()))
     } else {
-        let ink = s.render(&s.dots, scale);
         let pixels = ink
             .values
             .iter()

@@ -74,8 +74,9 @@ fn blurred_stipples_keep_the_tone_of_photographs() {
     let set = TileSet::embedded();
     for (name, image) in [("sphere", sphere(256)), ("landscape", landscape(256))] {
         let s = stipple(&image, &set, &StippleSettings::default()).unwrap();
-        let report = s.tone_report(2.0, 1);
-        let page = 1.0 - s.render(&s.dots, 2.0).mean();
+        let rendered = s.render(&s.dots, 2.0);
+        let report = s.tone_report(&rendered, 1);
+        let page = 1.0 - rendered.mean();
         eprintln!(
             "{name}: {} dots, radius {:.3}, mean grey image {:.3} stipple {page:.3}, {report:?}",
             s.dots.len(),

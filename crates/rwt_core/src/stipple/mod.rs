@@ -16,7 +16,7 @@
 //! let values = (0..w * h).map(|i| 1.0 - (i % w) as f32 / (w - 1) as f32).collect();
 //! let image = Grey { width: w, height: h, values };
 //! let s = stipple(&image, &TileSet::embedded(), &StippleSettings::default()).unwrap();
-//! let report = s.tone_report(2.0, 1);
+//! let report = s.tone_report(&s.render(&s.dots, 2.0), 1);
 //! assert!(report.blue.mean_abs < report.white.mean_abs);
 //! ```
 
@@ -333,17 +333,21 @@ impl Stipple {
         dots
     }
 
-    /// Tone error of this stipple and of a white-noise stipple with the same dots, rendered
-    /// at `scale` and blurred by the mean dot spacing.
-    pub fn tone_report(&self, scale: f64, seed: u64) -> ToneReport {
-        let (w, h) = self.raster_size(scale);
-        let target = self.target.resized(w, h);
+    /// Tone error of this stipple, `rendered` as [`Stipple::render`] draws its dots (at the
+    /// scale to compare at), and of a white-noise stipple with the same dots rendered alike;
+    /// each blurred by the mean dot spacing against the target blurred the same way.
+    pub fn tone_report(&self, rendered: &Grey, seed: u64) -> ToneReport {
+        let scale = rendered.width as f64 / self.target.width as f64;
         let sigma = self.mean_spacing() * scale;
-        let white = self.render(&self.white_noise(seed), scale);
+        let target = self
+            .target
+            .resized(rendered.width, rendered.height)
+            .blurred(sigma);
+        let white = self.render(&self.white_noise(seed), scale).blurred(sigma);
         ToneReport {
             sigma,
-            blue: ToneError::between(&self.render(&self.dots, scale), &target, sigma),
-            white: ToneError::between(&white, &target, sigma),
+            blue: ToneError::of_blurred(&rendered.blurred(sigma), &target),
+            white: ToneError::of_blurred(&white, &target),
         }
     }
 }

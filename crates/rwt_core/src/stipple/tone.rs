@@ -102,7 +102,11 @@ pub struct ToneError {
 impl ToneError {
     /// Compares two rasters of the same size after blurring both by `sigma` pixels.
     pub fn between(stipple: &Grey, target: &Grey, sigma: f64) -> Self {
-        let (a, b) = (stipple.blurred(sigma), target.blurred(sigma));
+        Self::of_blurred(&stipple.blurred(sigma), &target.blurred(sigma))
+    }
+
+    /// Compares two rasters of the same size, both already blurred.
+    pub(super) fn of_blurred(a: &Grey, b: &Grey) -> Self {
         let n = a.values.len().max(1) as f64;
         let (mut abs, mut sq) = (0.0, 0.0);
         for (x, y) in a.values.iter().zip(&b.values) {
