@@ -94,8 +94,8 @@ pub mod tiling;
 pub mod wang;
 
 pub use density::{
-    Constant, Density, DistanceFalloff, Exclude, FnDensity, ImageDensity, Mask, NoiseDensity,
-    NoiseParams, Product, Scale, Sum, SumOf,
+    Constant, Density, DistanceFalloff, Exclude, FnDensity, ImageDensity, LocalModel, Mask,
+    NoiseDensity, NoiseParams, Product, Scale, Sum, SumOf,
 };
 pub use query::{Point, PointId, QueryError, Rect, Sampler};
 pub use tileset::{TileSet, TileSetError};

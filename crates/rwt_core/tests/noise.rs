@@ -129,3 +129,40 @@ fn queries_equal_the_plain_fbm_with_the_loosest_bounds() {
         }
     }
 }
+
+/// Wherever a noise density gives a local model, the model's bounds hold its value at every
+/// point of the rectangle (near the origin and far from it, over cells of many sizes), and
+/// small cells almost always get one.
+#[test]
+fn local_models_bound_the_density() {
+    let mut rng = Rng::new(40, 3);
+    for params in params() {
+        let d = NoiseDensity::new(params);
+        let (mut asked, mut given) = (0, 0);
+        for _ in 0..4_000 {
+            let far = [1.0, 1e3, 1e7][rng.below(3)];
+            let min = DVec2::new(rng.next_f64() - 0.5, rng.next_f64() - 0.5) * far;
+            let side = 0.3 / params.frequency * 4f64.powf(-3.0 * rng.next_f64());
+            let max = min + DVec2::new(side, side * (0.5 + rng.next_f64()));
+            asked += 1;
+            let Some(model) = d.local_model(min, max) else {
+                continue;
+            };
+            given += 1;
+            let (low, high) = model.bounds_over(min, max);
+            for _ in 0..40 {
+                let p = min + (max - min) * DVec2::new(rng.next_f64(), rng.next_f64());
+                let (value, (lo, hi)) = (sanitize(d.density(p)), model.bounds_at(p));
+                assert!(
+                    lo <= value && value <= hi && low <= lo && hi <= high,
+                    "{params:?} over {min}..{max} at {p}: {value} not in {lo}..{hi}"
+                );
+            }
+        }
+        // Cells a quarter of a noise period wide, 4 octaves and fewer: a model nearly always.
+        if params.octaves <= 4 && params.scale > 0.0 {
+            let small = asked as f64 * 0.5;
+            assert!(given as f64 >= small, "{params:?}: {given} of {asked}");
+        }
+    }
+}

@@ -11,12 +11,14 @@
 
 mod combinators;
 mod image;
+mod local;
 mod noise;
 #[cfg(test)]
 mod tests;
 
 pub use self::combinators::{DistanceFalloff, Exclude, Mask, Product, Scale, Sum, SumOf};
 pub use self::image::{ImageDensity, ImageDensityError};
+pub use self::local::LocalModel;
 pub use self::noise::{NoiseDensity, NoiseParams};
 
 use glam::DVec2;
@@ -42,6 +44,14 @@ pub trait Density {
     fn exceeds(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
         sanitize(self.density(p)) * factor > threshold
     }
+    /// A [`LocalModel`] of the density valid over the rectangle `[min, max]`, where the
+    /// density has one cheaper than evaluating it at the rectangle's points: queries decide
+    /// the points of a cell by it and evaluate only those it leaves open. The default, `None`,
+    /// is always right.
+    fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {
+        let _ = (min, max);
+        None
+    }
 }
 
 /// A density behind a pointer is that density: references, boxes and shared pointers (the
@@ -64,6 +74,10 @@ macro_rules! forward_density {
             #[inline]
             fn exceeds(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
                 (**self).exceeds(p, factor, threshold)
+            }
+            #[inline]
+            fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {
+                (**self).local_model(min, max)
             }
         }
     )*};

@@ -7,7 +7,7 @@
 //! order of arithmetic. The core is the crate's `perlin_2d` written out with the table's
 //! lookups inlined (the crate hashes through a slice), which halves its cost.
 
-use super::{Density, sanitize};
+use super::{Density, LocalModel, sanitize};
 use glam::DVec2;
 use noise::permutationtable::{NoiseHasher, PermutationTable};
 use noise::{Fbm, Perlin};
@@ -38,6 +38,16 @@ struct Octave {
     slope: f64,
 }
 
+/// The fBm sum (before normalising) near a rectangle's centre: a plane and a bend per
+/// squared distance, give or take `slack` for the rounding of the inputs.
+struct FbmModel {
+    centre: DVec2,
+    value: f64,
+    gradient: DVec2,
+    curvature: f64,
+    slack: f64,
+}
+
 /// The parameters of a [`NoiseDensity`], as plain (serializable) data.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NoiseParams {
@@ -60,6 +70,11 @@ pub struct NoiseParams {
 /// grid, plus the gradient's own Lipschitz bound between grid points; the grid's largest is
 /// 3.89).
 const PERLIN_GRADIENT_BOUND: f64 = 4.25;
+
+/// Bound of the curvature (the Hessian's largest eigenvalue in magnitude) of the `noise`
+/// crate's 2D Perlin noise before its clamp: proven 19.0 by
+/// `the_perlin_curvature_bound_holds_everywhere` (the grid's largest is 17.8).
+const PERLIN_CURVATURE_BOUND: f64 = 19.5;
 
 /// The `noise` crate's fBm defaults (frequency 1): each octave's weight is the previous one's
 /// times the persistence, and its input the previous one's times the lacunarity.
@@ -224,6 +239,51 @@ impl NoiseDensity {
         (lo, hi)
     }
 
+    /// The fBm as a plane at the rectangle's centre plus a bounded bend, octave by octave:
+    /// each octave's value and gradient at the centre, its curvature bound scaled by its
+    /// weight and its frequency squared. `None` where an octave's clamp to [-1, 1] may act
+    /// inside the rectangle (the bound is for the noise before it), or where inputs wrap.
+    fn fbm_model(&self, min: DVec2, max: DVec2) -> Option<FbmModel> {
+        let centre = (min + max) * 0.5;
+        let radius = (max - min).length() * 0.5;
+        let mut q = self.input(centre)?;
+        if !self.within_wrap(min, max) {
+            return None;
+        }
+        let far = min.abs().max(max.abs()).length();
+        let half = (max - min) * 0.5;
+        let (mut value, mut gradient, mut curvature, mut slack) = (0.0, DVec2::ZERO, 0.0, 0.0);
+        let mut gain = self.params.frequency;
+        for (k, octave) in self.octaves.iter().enumerate() {
+            // A point's input is rounded once per product that made it (frequency, then
+            // the lacunarity per octave): the noise can move by its slope times that.
+            let rounding = (k + 2) as f64 * f64::EPSILON * far * gain.abs();
+            slack += octave.weight * PERLIN_GRADIENT_BOUND * rounding;
+            let (v, g) = perlin_plane(&octave.table, q.x, q.y);
+            // The octave's reach within the rectangle, in its own input units.
+            let r = radius * gain.abs();
+            let bend = 0.5 * PERLIN_CURVATURE_BOUND * r * r;
+            let reach = half * gain.abs() * (1.0 + ROUNDING_MARGIN) + ROUNDING_MARGIN;
+            if !(v.abs() + g.length() * r + bend < 1.0 - ROUNDING_MARGIN
+                || clamp_free(&octave.table, q - reach, q + reach))
+            {
+                return None;
+            }
+            value += octave.weight * v;
+            gradient += g * (octave.weight * gain);
+            curvature += 0.5 * PERLIN_CURVATURE_BOUND * octave.weight * gain * gain;
+            q *= LACUNARITY;
+            gain *= LACUNARITY;
+        }
+        Some(FbmModel {
+            centre,
+            value,
+            gradient,
+            curvature,
+            slack,
+        })
+    }
+
     /// Whether the whole rectangle lies where inputs are not wrapped (where the gradient
     /// bound holds between any two of its points).
     fn within_wrap(&self, min: DVec2, max: DVec2) -> bool {
@@ -275,6 +335,83 @@ fn perlin(table: &[u8; 256], x: f64, y: f64) -> f64 {
     result.clamp(-1.0, 1.0)
 }
 
+/// The corner-gradient combinations (each corner's two bits, corners (0, 0), (1, 0), (0, 1),
+/// (1, 1) from the lowest bits up) whose lattice cell the `noise` crate's Perlin noise never
+/// leaves [-1, 1] on before its clamp: proven by `clamp_free_cells_stay_within_one`.
+const CLAMP_FREE: [u64; 4] = [
+    0xf5ff_ffff_31f7_f7ff,
+    0xffff_efef_f7ff_f7ff,
+    0xffef_ffef_f7f7_ffff,
+    0xffef_ef8c_ffff_ffaf,
+];
+
+/// Most lattice cells per axis [`clamp_free`] looks at.
+const CLAMP_FREE_SPAN: isize = 3;
+
+/// The corner-gradient combination of the lattice cell at `(cx, cy)`, as `perlin` picks it.
+fn corner_combination(table: &[u8; 256], cx: isize, cy: isize) -> usize {
+    let pick = |ox: isize, oy: isize| {
+        let first = table[((cx + ox) & 0xff) as usize] as usize;
+        (table[first ^ ((cy + oy) & 0xff) as usize] & 0b11) as usize
+    };
+    pick(0, 0) | pick(1, 0) << 2 | pick(0, 1) << 4 | pick(1, 1) << 6
+}
+
+/// Whether the noise before its clamp stays within [-1, 1] over the input rectangle
+/// `[min, max]` (so that the clamp never acts there): every lattice cell it touches has a
+/// clamp-free combination of corner gradients.
+fn clamp_free(table: &[u8; 256], min: DVec2, max: DVec2) -> bool {
+    let (x0, y0) = (min.x.floor() as isize, min.y.floor() as isize);
+    let (x1, y1) = (max.x.floor() as isize, max.y.floor() as isize);
+    if x1 - x0 >= CLAMP_FREE_SPAN || y1 - y0 >= CLAMP_FREE_SPAN {
+        return false;
+    }
+    (y0..=y1).all(|cy| {
+        (x0..=x1).all(|cx| {
+            let combo = corner_combination(table, cx, cy);
+            CLAMP_FREE[combo / 64] >> (combo % 64) & 1 == 1
+        })
+    })
+}
+
+/// The `noise` crate's `perlin_2d` before its clamp, and its gradient, at `(x, y)`: the
+/// interpolation of the corner gradients' planes by the quintic curve, differentiated.
+fn perlin_plane(table: &[u8; 256], x: f64, y: f64) -> (f64, DVec2) {
+    const SCALE_FACTOR: f64 = 2.0 / std::f64::consts::SQRT_2;
+    let corner = |v: f64| if v <= 0.0 { v as isize - 1 } else { v as isize };
+    let (cx, cy) = (corner(x), corner(y));
+    let (dx, dy) = (x - cx as f64, y - cy as f64);
+    // Each corner's gradient (+-1, +-1) and its plane's value at (dx, dy).
+    let plane = |ox: isize, oy: isize| {
+        let first = table[((cx + ox) & 0xff) as usize] as usize;
+        let g = match table[first ^ ((cy + oy) & 0xff) as usize] & 0b11 {
+            0 => DVec2::new(1.0, 1.0),
+            1 => DVec2::new(-1.0, 1.0),
+            2 => DVec2::new(1.0, -1.0),
+            _ => DVec2::new(-1.0, -1.0),
+        };
+        (g.dot(DVec2::new(dx - ox as f64, dy - oy as f64)), g)
+    };
+    let quintic = |t: f64| {
+        let t = t.clamp(0.0, 1.0);
+        (
+            t * t * t * (t * (t * 6.0 - 15.0) + 10.0),
+            30.0 * t * t * (t - 1.0) * (t - 1.0),
+        )
+    };
+    let ((sx, dsx), (sy, dsy)) = (quintic(dx), quintic(dy));
+    let ((v00, g00), (v10, g10), (v01, g01), (v11, g11)) =
+        (plane(0, 0), plane(1, 0), plane(0, 1), plane(1, 1));
+    // Along y first, as the crate interpolates: a on the x = 0 side, b on the x = 1 side.
+    let a = v00 + (v01 - v00) * sy;
+    let b = v10 + (v11 - v10) * sy;
+    let da = g00 + (g01 - g00) * sy + DVec2::new(0.0, (v01 - v00) * dsy);
+    let db = g10 + (g11 - g10) * sy + DVec2::new(0.0, (v11 - v10) * dsy);
+    let value = a + (b - a) * sx;
+    let gradient = da + (db - da) * sx + DVec2::new((b - a) * dsx, 0.0);
+    (value * SCALE_FACTOR, gradient * SCALE_FACTOR)
+}
+
 impl Octave {
     /// `weight * perlin(q)`, exactly as the `noise` crate's fBm computes it.
     #[inline(always)]
@@ -297,6 +434,26 @@ impl Density for NoiseDensity {
     fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
         let (lo, hi) = self.fbm_range(min, max);
         self.value_range(lo, hi).0
+    }
+
+    /// The fBm's plane and bend mapped through `scale * (base + amplitude * fbm)`, which is
+    /// affine in the fBm: `None` for a negative or non-finite scale (its clamp at zero
+    /// would not be the model's).
+    fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {
+        let p = &self.params;
+        if !self.finite || p.scale < 0.0 {
+            return None;
+        }
+        let fbm = self.fbm_model(min, max)?;
+        let gain = p.scale * p.amplitude * self.normalise;
+        Some(LocalModel {
+            centre: fbm.centre,
+            value: p.scale * p.base + gain * fbm.value,
+            gradient: fbm.gradient * gain,
+            curvature: fbm.curvature * gain.abs(),
+            margin: gain.abs() * fbm.slack
+                + ROUNDING_MARGIN * p.scale * (p.base.abs() + p.amplitude.abs() + 1.0),
+        })
     }
 
     /// Sums the octaves until the partial sum, give or take what the remaining octaves can
@@ -365,6 +522,117 @@ mod tests {
         let dx = lerp(dax, dbx, sx) + dsx * (b - a);
         let dy = lerp(day, dby, sx);
         std::f64::consts::SQRT_2 * (dx * dx + dy * dy).sqrt()
+    }
+
+    /// The corner gradients of combination `combo` (two bits per corner, as
+    /// [`corner_combination`] packs them).
+    fn gradients(combo: usize) -> [(f64, f64); 4] {
+        let signs = [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)];
+        [0, 1, 2, 3].map(|k| signs[(combo >> (2 * k)) & 3])
+    }
+
+    /// The noise before its clamp on one lattice cell, and its Hessian's entries
+    /// `(xx, xy, yy)`, from the crate's formula differentiated twice.
+    fn perlin_curvature(grads: [(f64, f64); 4], x: f64, y: f64) -> (f64, [f64; 3]) {
+        let corner = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
+        let g = |k: usize| grads[k].0 * (x - corner[k].0) + grads[k].1 * (y - corner[k].1);
+        let ((sx, dsx, ddsx), (sy, dsy, ddsy)) = (quintic(x), quintic(y));
+        // p on the x = 0 side (corners 0 and 2), q on the x = 1 side (corners 1 and 3).
+        let side = |a: usize, b: usize| {
+            let v = (1.0 - sy) * g(a) + sy * g(b);
+            let vx = (1.0 - sy) * grads[a].0 + sy * grads[b].0;
+            let vy = dsy * (g(b) - g(a)) + (1.0 - sy) * grads[a].1 + sy * grads[b].1;
+            let vxy = dsy * (grads[b].0 - grads[a].0);
+            let vyy = ddsy * (g(b) - g(a)) + 2.0 * dsy * (grads[b].1 - grads[a].1);
+            (v, vx, vy, vxy, vyy)
+        };
+        let ((p, px, py, pxy, pyy), (q, qx, qy, qxy, qyy)) = (side(0, 2), side(1, 3));
+        let s = std::f64::consts::SQRT_2;
+        let value = s * ((1.0 - sx) * p + sx * q);
+        let xx = ddsx * (q - p) + 2.0 * dsx * (qx - px);
+        let xy = dsx * (qy - py) + (1.0 - sx) * pxy + sx * qxy;
+        let yy = (1.0 - sx) * pyy + sx * qyy;
+        (value, [s * xx, s * xy, s * yy])
+    }
+
+    /// A proof of [`PERLIN_CURVATURE_BOUND`]: the Hessian's largest eigenvalue magnitude
+    /// over every combination of corner gradients on a grid of spacing `h`, plus what it can
+    /// gain between grid points (the third derivatives bound its change).
+    #[test]
+    fn the_perlin_curvature_bound_holds_everywhere() {
+        let steps = 400;
+        let h = 1.0 / steps as f64;
+        let mut largest: f64 = 0.0;
+        for combo in 0..256 {
+            for i in 0..=steps {
+                for j in 0..=steps {
+                    let (_, [a, b, c]) =
+                        perlin_curvature(gradients(combo), i as f64 * h, j as f64 * h);
+                    let norm = ((a + c) * 0.5).abs() + (((a - c) * 0.5).powi(2) + b * b).sqrt();
+                    largest = largest.max(norm);
+                }
+            }
+        }
+        // Third derivatives from |g| <= 2, |g'| <= 1, the quintic's slope <= 1.875,
+        // curvature <= 5.78 and third derivative <= 60: xxx and yyy below 60 * 4 + 3 * 5.78
+        // * 2, xxy and xyy below 126.3; the Hessian's change per unit step is below the
+        // Frobenius norm of those gradients, times S.
+        let (outer, mixed): (f64, f64) = (274.7, 126.3);
+        let diagonal = outer.hypot(mixed);
+        let change = std::f64::consts::SQRT_2
+            * (2.0 * diagonal * diagonal + 2.0 * mixed.hypot(mixed).powi(2)).sqrt();
+        let proven = largest + change * h * std::f64::consts::FRAC_1_SQRT_2;
+        eprintln!("largest curvature on the grid {largest:.4}, proven bound {proven:.4}");
+        assert!(proven <= PERLIN_CURVATURE_BOUND, "{proven}");
+    }
+
+    /// A proof of [`CLAMP_FREE`]: on every cell marked free, the noise's largest magnitude
+    /// on a grid plus what the gradient bound lets it gain between grid points stays below 1.
+    /// Most combinations are free, or local models would rarely exist.
+    #[test]
+    fn clamp_free_cells_stay_within_one() {
+        let steps = 400;
+        let h = 1.0 / steps as f64;
+        let mut free = 0;
+        for combo in 0..256 {
+            if CLAMP_FREE[combo / 64] >> (combo % 64) & 1 == 0 {
+                continue;
+            }
+            free += 1;
+            let mut largest: f64 = 0.0;
+            for i in 0..=steps {
+                for j in 0..=steps {
+                    let (v, _) = perlin_curvature(gradients(combo), i as f64 * h, j as f64 * h);
+                    largest = largest.max(v.abs());
+                }
+            }
+            let proven = largest + PERLIN_GRADIENT_BOUND * h * std::f64::consts::FRAC_1_SQRT_2;
+            assert!(proven < 1.0, "combination {combo}: {proven}");
+        }
+        assert!(free >= 200, "{free}");
+    }
+
+    /// The plane and gradient of the noise are the crate's value before its clamp and its
+    /// derivative (against central differences), on lattice cells of either sign.
+    #[test]
+    fn perlin_planes_are_the_noise_and_its_slope() {
+        let table = permutation(9);
+        let mut rng = crate::rng::Rng::new(9, 3);
+        let step = 1e-6;
+        for _ in 0..2_000 {
+            let (x, y) = ((rng.next_f64() - 0.5) * 40.0, (rng.next_f64() - 0.5) * 40.0);
+            let (v, g) = perlin_plane(&table, x, y);
+            let clamped = perlin(&table, x, y);
+            assert!((v.clamp(-1.0, 1.0) - clamped).abs() < 1e-12, "{x}, {y}");
+            let dx = (perlin_plane(&table, x + step, y).0 - perlin_plane(&table, x - step, y).0)
+                / (2.0 * step);
+            let dy = (perlin_plane(&table, x, y + step).0 - perlin_plane(&table, x, y - step).0)
+                / (2.0 * step);
+            assert!(
+                (g - DVec2::new(dx, dy)).length() < 1e-5,
+                "{x}, {y}: {g} vs {dx}, {dy}"
+            );
+        }
     }
 
     /// A proof of [`PERLIN_GRADIENT_BOUND`]: the gradient's largest magnitude over every

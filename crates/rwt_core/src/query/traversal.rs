@@ -4,7 +4,7 @@
 use super::point::{Point, PointId};
 use super::prepared::CellPoint;
 use super::{MAX_LEVEL, OFFSET_STREAM, Rect, Sampler};
-use crate::density::{Density, sanitize};
+use crate::density::{Density, LocalModel, sanitize};
 use crate::rng::{hash_words, unit_f64};
 use crate::tiling::base_tile;
 use glam::DVec2;
@@ -44,10 +44,21 @@ impl TileAt {
 }
 
 /// Upper and lower density bounds of each cell of a tile, times the tile's area: how many
-/// of the tile's ranks the cell may show, and how many it shows for sure.
+/// of the tile's ranks the cell may show, and how many it shows for sure; and the density's
+/// local model over the cell, where it has one.
 struct CellBounds {
     limit: [f64; MAX_CELLS],
     low: [f64; MAX_CELLS],
+    model: [Option<LocalModel>; MAX_CELLS],
+}
+
+/// What a tile's parent knows of it: its cell's bounds in the tile's own area units, and
+/// the cell's local model.
+#[derive(Clone, Copy)]
+struct Known {
+    limit: f64,
+    low: f64,
+    model: Option<LocalModel>,
 }
 
 /// A run of ranked points of one cell to emit, with what they share.
@@ -57,6 +68,8 @@ struct Run<'p> {
     limit: f64,
     /// Points whose rank is below this appear without evaluating the density.
     sure: f64,
+    /// Decides most of the other points without evaluating the density.
+    model: Option<LocalModel>,
     /// Added to every rank (the base tile's hashed offset; 0 in subdivisions).
     offset: f64,
     /// The tile the points belong to (their identity and frame).
@@ -116,24 +129,28 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
         if low.is_finite() { low.min(limit) } else { 0.0 }
     }
 
-    /// Visits tile `t` at `at`. `known` is the upper and lower density bounds over its part
-    /// of the query times its area, when the parent has them. Points ranked below the lower
-    /// bound are taken without evaluating the density (the bound guarantees the evaluation
-    /// would take them).
-    fn tile(&mut self, t: u16, at: TileAt, known: Option<(f64, f64)>) {
+    /// Visits tile `t` at `at`, with what its parent knows of it. Points ranked below the
+    /// lower bound are taken without evaluating the density (the bound guarantees the
+    /// evaluation would take them).
+    fn tile(&mut self, t: u16, at: TileAt, known: Option<Known>) {
         let tile_rect = at.rect();
         let Some(clip) = tile_rect.intersect(&self.rect) else {
             return;
         };
         let area = at.side * at.side;
-        let (limit, low) = known.unwrap_or_else(|| {
+        let known = known.unwrap_or_else(|| {
             let limit = sanitize(self.density.max_over(clip.min(), clip.max())) * area;
-            (limit, self.low(&clip, limit, area))
+            Known {
+                limit,
+                low: self.low(&clip, limit, area),
+                model: None,
+            }
         });
+        let limit = known.limit;
         if limit.is_nan() || limit <= 0.0 {
             return;
         }
-        let bounds = self.cell_bounds(at, limit, low, clip != tile_rect);
+        let bounds = self.cell_bounds(at, known, clip != tile_rect);
         if at.level == 0 {
             self.base_points(t, at, &bounds);
         }
@@ -145,13 +162,17 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
     }
 
     /// Per-cell bounds pay off once the tile asks for more than a few points per cell, or
-    /// when it is only partly inside the query; otherwise the tile's bounds serve all cells.
-    fn cell_bounds(&self, at: TileAt, limit: f64, low: f64, clipped: bool) -> CellBounds {
+    /// when it is only partly inside the query; otherwise the tile's bounds (and its
+    /// parent's model) serve all cells. A cell's own local model, where the density has one,
+    /// gives both its bounds and its points' decisions.
+    fn cell_bounds(&self, at: TileAt, known: Known, clipped: bool) -> CellBounds {
         let n = self.sampler.n;
         let cells = (n * n) as usize;
+        let Known { limit, low, model } = known;
         let mut bounds = CellBounds {
             limit: [limit; MAX_CELLS],
             low: [low; MAX_CELLS],
+            model: [model; MAX_CELLS],
         };
         if !(limit > 4.0 * cells as f64 || clipped) {
             return bounds;
@@ -165,14 +186,25 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
                 origin + DVec2::new(a, b) * child_s,
                 origin + DVec2::new(a + 1.0, b + 1.0) * child_s,
             );
-            (bounds.limit[cell], bounds.low[cell]) = match cell_rect.intersect(&self.rect) {
-                None => (0.0, 0.0),
-                Some(r) => {
+            let Some(r) = cell_rect.intersect(&self.rect) else {
+                (bounds.limit[cell], bounds.low[cell]) = (0.0, 0.0);
+                continue;
+            };
+            let cell_model = self.density.local_model(r.min(), r.max());
+            let (max, cell_low) = match cell_model {
+                Some(m) => {
+                    bounds.model[cell] = cell_model;
+                    let (lo, hi) = m.bounds_over(r.min(), r.max());
+                    (hi * area, lo * area)
+                }
+                None => {
                     let max = sanitize(self.density.max_over(r.min(), r.max())) * area;
-                    let cell_max = max.min(limit);
-                    (cell_max, self.low(&r, cell_max, area).max(low))
+                    (max, self.low(&r, max.min(limit), area))
                 }
             };
+            let cell_max = max.min(limit);
+            bounds.limit[cell] = cell_max;
+            bounds.low[cell] = cell_low.min(cell_max).max(low);
         }
         bounds
     }
@@ -190,6 +222,7 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
                 points,
                 limit: bounds.limit[cell] - offset,
                 sure: bounds.low[cell],
+                model: bounds.model[cell],
                 offset,
                 owner: at,
                 area,
@@ -222,6 +255,7 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
                     points,
                     limit: bounds.limit[cell],
                     sure: bounds.low[cell],
+                    model: bounds.model[cell],
                     offset: 0.0,
                     owner: child_at(cell),
                     area,
@@ -234,7 +268,11 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
         for (cell, &child_tile) in tile.children.iter().enumerate() {
             let lim = bounds.limit[cell];
             if lim > full {
-                let known = (lim / cells, bounds.low[cell] / cells);
+                let known = Known {
+                    limit: lim / cells,
+                    low: bounds.low[cell] / cells,
+                    model: bounds.model[cell],
+                };
                 self.tile(child_tile, child_at(cell), Some(known));
             }
         }
@@ -256,8 +294,7 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
                 (o.iy as f64 + cp.frac[1]) * o.side,
             );
             let rank = cp.rank as f64 + run.offset;
-            if self.rect.contains(p) && (rank < run.sure || self.density.exceeds(p, run.area, rank))
-            {
+            if self.rect.contains(p) && (rank < run.sure || self.decide(&run, p, rank)) {
                 (self.emit)(Point {
                     position: p,
                     id: PointId {
@@ -270,6 +307,16 @@ impl<D: Density + ?Sized, F: FnMut(Point)> Visit<'_, D, F> {
                     class: 0,
                 });
             }
+        }
+    }
+
+    /// Whether a point whose rank the bounds leave open appears: by the run's local model
+    /// where it decides, by the density otherwise.
+    #[inline(always)]
+    fn decide(&self, run: &Run, p: DVec2, rank: f64) -> bool {
+        match run.model.and_then(|m| m.decides(p, run.area, rank)) {
+            Some(decided) => decided,
+            None => self.density.exceeds(p, run.area, rank),
         }
     }
 }
