@@ -226,7 +226,7 @@ impl Bench {
         });
         say!(
             "noise (4-octave fBm) over the same world: serial {:.2} ms, parallel {:.2} ms \
-             ({:.2} ms as runs, {:.2}x, before joining them into one vector)",
+             (both into a reused vector); as runs, a fresh vector per block: {:.2} ms, {:.2}x",
             serial * 1e3,
             parallel * 1e3,
             runs * 1e3,

@@ -602,6 +602,30 @@ fn parallel_queries_return_the_serial_points_in_the_serial_order() {
     ));
 }
 
+/// A density that panics on some points makes a parallel query panic (on the caller's
+/// thread, as the serial query would) instead of leaving it waiting for the failed block.
+#[test]
+fn a_density_that_panics_fails_the_parallel_query() {
+    let fragile = from_fn(
+        |p: DVec2| {
+            assert!(p.x < 80.0, "a density that fails far out");
+            4.0
+        },
+        4.0,
+    );
+    let s = sampler(3);
+    for _ in 0..3 {
+        let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            s.query_par(square(0.0, 100.0), &fragile, &mut Vec::new())
+        }));
+        assert!(result.is_err());
+    }
+    // The pool is still usable afterwards.
+    let mut out = Vec::new();
+    s.query_par(square(0.0, 50.0), &fragile, &mut out).unwrap();
+    assert!(!out.is_empty());
+}
+
 #[test]
 fn parallel_progress_counts_every_tile_once() {
     use std::sync::Mutex;

@@ -1,22 +1,23 @@
-//! Parallel queries (feature `parallel`): the serial traversal's block recursion with its
-//! splits forked on rayon. Each branch collects its own points and the branches are joined
-//! in the order the serial traversal visits them, so a parallel query returns exactly the
-//! serial query's points in exactly its order.
+//! Parallel queries (feature `parallel`): the serial traversal's blocks of base tiles,
+//! planned in its order (its splits and its pruning by density bounds), then taken on
+//! rayon's thread pool. [`Sampler::query_par_runs`] returns each block's points as a run;
+//! [`Sampler::query_par`] keeps each block's points compactly and builds them into the
+//! output in order while later blocks are still being computed. Either way the points are
+//! exactly the serial query's, in exactly its order.
 
-use super::traversal::{LEAF_BLOCK, Visit};
+use super::prepared::CellPoint;
+use super::traversal::{Frame, LEAF_BLOCK, Sink, Visit};
 use super::{Point, QueryError, Rect, Sampler, TileRange};
 use crate::density::{Density, sanitize};
 use glam::DVec2;
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
-
-/// Points each task copies when the runs are joined.
-const JOIN_GRAIN: usize = 1 << 15;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Mutex, OnceLock};
 
 impl Sampler {
     /// The points of `rect` for `density`, appended to `out` in the order
     /// [`Sampler::query`] gives them, computed on rayon's thread pool; returns how many.
-    /// Blocks of base tiles are the unit of work, so small queries gain nothing.
+    /// Strips of base tiles are the unit of work, so small queries gain nothing. Between
+    /// calls it keeps up to 32 MiB of scratch memory for the next one.
     ///
     /// ```
     /// use glam::DVec2;
@@ -35,27 +36,14 @@ impl Sampler {
         density: &D,
         out: &mut Vec<Point>,
     ) -> Result<usize, QueryError> {
-        let runs = self.query_par_runs(rect, density)?;
-        // Start of each run in the joined order; the join itself runs in parallel too.
-        let starts: Vec<usize> = runs
-            .iter()
-            .scan(0, |at, r| {
-                let start = *at;
-                *at += r.len();
-                Some(start)
-            })
-            .collect();
-        let count = runs.iter().map(Vec::len).sum();
-        out.par_extend(
-            (0..count)
-                .into_par_iter()
-                .with_min_len(JOIN_GRAIN)
-                .map(|i| {
-                    let run = starts.partition_point(|&s| s <= i) - 1;
-                    runs[run][i - starts[run]]
-                }),
-        );
-        Ok(count)
+        let Some(range) = self.admit(&rect, density)? else {
+            return Ok(0);
+        };
+        let fork = Fork::new(self, rect, density, &|_| {}, &range);
+        let blocks = fork.plan(range, STRIP_ROWS);
+        let before = out.len();
+        fork.build_in_order(&blocks, out);
+        Ok(out.len() - before)
     }
 
     /// The points of [`Sampler::query_par`] as consecutive runs (one per block of base
@@ -82,17 +70,104 @@ impl Sampler {
             progress(1.0);
             return Ok(Vec::new());
         };
-        Ok(Fork {
-            sampler: self,
-            rect,
-            density,
-            progress: Progress {
-                total: tiles(&range).max(1) as f64,
-                done: AtomicU64::new(0),
-                report: progress,
-            },
+        let fork = Fork::new(self, rect, density, progress, &range);
+        let blocks = fork.plan(range, LEAF_BLOCK as usize);
+        Ok(fork.runs(&blocks))
+    }
+}
+
+/// The points a block kept, as their runs' frames and their places in their cell lists
+/// (4 bytes a point), to be built into the output in order: whole points (56 bytes) would
+/// be written, then read and written once more.
+#[derive(Default)]
+struct Kept {
+    /// Each run's frame and the start of its points in `slots`.
+    frames: Vec<(Frame, usize)>,
+    /// Each point's place in its frame's cell list.
+    slots: Vec<u32>,
+    /// Whether the run begun last has no frame in `frames` yet.
+    pending: bool,
+}
+
+/// Kept points' buffers between parallel queries, up to [`SCRATCH_BYTES`]: memory already
+/// paged in, where fresh pages cost the kernel more than the points' bytes cost to write.
+static SCRATCH: Mutex<Vec<Kept>> = Mutex::new(Vec::new());
+
+/// The most memory [`SCRATCH`] keeps between queries (what 3 million points keep).
+const SCRATCH_BYTES: usize = 32 << 20;
+
+impl Sink for Kept {
+    #[inline(always)]
+    fn begin(&mut self, _: &Frame) {
+        self.pending = true;
+    }
+
+    #[inline(always)]
+    fn accept(&mut self, frame: &Frame, slot: usize, _: &CellPoint, _: DVec2) {
+        if self.pending {
+            self.frames.push((*frame, self.slots.len()));
+            self.pending = false;
         }
-        .blocks(range))
+        // A slot is below the ranks of its cell list, which are u32.
+        self.slots.push(slot as u32);
+    }
+}
+
+impl Kept {
+    /// An empty one, with a buffer from [`SCRATCH`] where one is free.
+    fn take() -> Self {
+        let reused = SCRATCH.lock().ok().and_then(|mut free| free.pop());
+        reused.unwrap_or_default()
+    }
+
+    /// Gives the buffers back to [`SCRATCH`], while it holds less than its limit.
+    fn give_back(mut self) {
+        self.frames.clear();
+        self.slots.clear();
+        self.pending = false;
+        if let Ok(mut free) = SCRATCH.lock() {
+            let held: usize = free.iter().map(Kept::bytes).sum();
+            if held + self.bytes() <= SCRATCH_BYTES {
+                free.push(self);
+            }
+        }
+    }
+
+    fn bytes(&self) -> usize {
+        self.frames.capacity() * std::mem::size_of::<(Frame, usize)>()
+            + self.slots.capacity() * std::mem::size_of::<u32>()
+    }
+
+    /// Appends the block's points to `out`, in order, run by run.
+    fn build_into(&self, sampler: &Sampler, out: &mut Vec<Point>) {
+        out.reserve(self.slots.len());
+        for (k, &(frame, start)) in self.frames.iter().enumerate() {
+            let end = self
+                .frames
+                .get(k + 1)
+                .map_or(self.slots.len(), |next| next.1);
+            let list = sampler.cell_list(frame.list);
+            out.extend(self.slots[start..end].iter().map(|&slot| {
+                let cp = &list[slot as usize];
+                frame.point(cp, frame.position(cp))
+            }));
+        }
+    }
+}
+
+/// Rows of base tiles in a unit of parallel work: small enough that the thread building
+/// the output in order never waits long for the next one, or for the last.
+const STRIP_ROWS: usize = 2;
+
+/// Marks a query failed when a block's task unwinds (a density that panicked), so that the
+/// thread building the output stops waiting for that block and the panic goes on up.
+struct FailOnUnwind<'a>(&'a AtomicBool);
+
+impl Drop for FailOnUnwind<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.store(true, Ordering::Release);
+        }
     }
 }
 
@@ -123,19 +198,46 @@ struct Fork<'a, D: ?Sized> {
     progress: Progress<'a>,
 }
 
-impl<D: Density + Sync + ?Sized> Fork<'_, D> {
-    /// The points of base tiles `range`, as runs in serial order (joined once at the end,
-    /// not copied at every split): the serial `Visit::blocks` split, each half on its own
-    /// task, the first half's runs first.
-    fn blocks(&self, range: TileRange) -> Vec<Vec<Point>> {
+impl<'a, D: Density + Sync + ?Sized> Fork<'a, D> {
+    fn new(
+        sampler: &'a Sampler,
+        rect: Rect,
+        density: &'a D,
+        report: &'a (dyn Fn(f64) + Sync),
+        range: &TileRange,
+    ) -> Self {
+        Fork {
+            sampler,
+            rect,
+            density,
+            progress: Progress {
+                total: tiles(range).max(1) as f64,
+                done: AtomicU64::new(0),
+                report,
+            },
+        }
+    }
+
+    /// The blocks of base tiles in `range` that the serial traversal takes whole, in its
+    /// order: its splits, skipping blocks where the density is zero (counted done at once).
+    fn plan(&self, range: TileRange, strip_rows: usize) -> Vec<TileRange> {
+        let mut blocks = Vec::new();
+        self.plan_into(range, strip_rows, &mut blocks);
+        blocks
+    }
+
+    fn plan_into(&self, range: TileRange, strip_rows: usize, blocks: &mut Vec<TileRange>) {
         let TileRange { i0, i1, j0, j1 } = range;
         if i1 <= i0 || j1 <= j0 {
-            return Vec::new();
+            return;
         }
         if i1 - i0 <= LEAF_BLOCK && j1 - j0 <= LEAF_BLOCK {
-            let run = self.serial(range);
-            self.progress.finished(&range);
-            return vec![run];
+            // The traversal takes a leaf row by row, so strips of its rows keep its order.
+            for j in (j0..j1).step_by(strip_rows) {
+                let j1 = (j + strip_rows as i64).min(j1);
+                blocks.push(TileRange { j0: j, j1, ..range });
+            }
+            return;
         }
         let s = self.sampler.tile_size();
         let block = Rect::from_ordered(
@@ -144,33 +246,103 @@ impl<D: Density + Sync + ?Sized> Fork<'_, D> {
         );
         let Some(block) = block.intersect(&self.rect) else {
             self.progress.finished(&range);
-            return Vec::new();
+            return;
         };
         let bound = sanitize(self.density.max_over(block.min(), block.max()));
         if bound.is_nan() || bound <= 0.0 {
             self.progress.finished(&range);
-            return Vec::new();
+            return;
         }
         let (im, jm) = (i0 + (i1 - i0) / 2, j0 + (j1 - j0) / 2);
-        let (first, second) = if i1 - i0 >= j1 - j0 {
-            (TileRange { i1: im, ..range }, TileRange { i0: im, ..range })
+        if i1 - i0 >= j1 - j0 {
+            self.plan_into(TileRange { i1: im, ..range }, strip_rows, blocks);
+            self.plan_into(TileRange { i0: im, ..range }, strip_rows, blocks);
         } else {
-            (TileRange { j1: jm, ..range }, TileRange { j0: jm, ..range })
-        };
-        let (mut a, b) = rayon::join(|| self.blocks(first), || self.blocks(second));
+            self.plan_into(TileRange { j1: jm, ..range }, strip_rows, blocks);
+            self.plan_into(TileRange { j0: jm, ..range }, strip_rows, blocks);
+        }
+    }
+
+    /// The points of `blocks` appended to `out` in order: every block computed on the
+    /// pool (first blocks first) and kept; this thread builds each into `out` as soon as
+    /// it and the blocks before it are done, and computes blocks itself while none is
+    /// ready, so that writing the output overlaps computing it.
+    fn build_in_order(&self, blocks: &[TileRange], out: &mut Vec<Point>) {
+        let kept: Vec<OnceLock<Kept>> = blocks.iter().map(|_| OnceLock::new()).collect();
+        let failed = AtomicBool::new(false);
+        rayon::scope_fifo(|scope| {
+            for (block, slot) in blocks.iter().zip(&kept) {
+                let failed = &failed;
+                scope.spawn_fifo(move |_| {
+                    let _unwinding = FailOnUnwind(failed);
+                    let _ = slot.set(self.kept(*block));
+                });
+            }
+            for slot in &kept {
+                let Some(block) = self.wait_for(slot, &failed) else {
+                    return;
+                };
+                block.build_into(self.sampler, out);
+            }
+        });
+        kept.into_iter()
+            .filter_map(OnceLock::into_inner)
+            .for_each(Kept::give_back);
+    }
+
+    /// The block kept in `slot`, taking pool work while it is not done yet; `None` once a
+    /// block's task has failed.
+    fn wait_for<'k>(&self, slot: &'k OnceLock<Kept>, failed: &AtomicBool) -> Option<&'k Kept> {
+        loop {
+            if let Some(block) = slot.get() {
+                return Some(block);
+            }
+            if failed.load(Ordering::Acquire) {
+                return None;
+            }
+            if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                std::thread::yield_now();
+            }
+        }
+    }
+
+    /// The points of `blocks`, a run each: halves of the list forked on the pool.
+    fn runs(&self, blocks: &[TileRange]) -> Vec<Vec<Point>> {
+        if blocks.is_empty() {
+            return Vec::new();
+        }
+        if let [block] = blocks {
+            let points = self.points(*block);
+            self.progress.finished(block);
+            return vec![points];
+        }
+        let (first, second) = blocks.split_at(blocks.len() / 2);
+        let (mut a, b) = rayon::join(|| self.runs(first), || self.runs(second));
         a.extend(b);
         a
     }
 
     /// The points of a block small enough to take on one thread.
-    fn serial(&self, range: TileRange) -> Vec<Point> {
+    fn points(&self, range: TileRange) -> Vec<Point> {
         let mut points = Vec::new();
-        let mut emit = |p: Point| points.push(p);
+        self.visit(range, &mut |p: Point| points.push(p));
+        points
+    }
+
+    /// The points of a block, kept to be built later.
+    fn kept(&self, range: TileRange) -> Kept {
+        let mut kept = Kept::take();
+        self.visit(range, &mut kept);
+        kept
+    }
+
+    /// The serial traversal of a block.
+    fn visit<F: Sink>(&self, range: TileRange, sink: &mut F) {
         let mut visit = Visit {
             sampler: self.sampler,
             rect: self.rect,
             density: self.density,
-            emit: &mut emit,
+            emit: sink,
         };
         visit.blocks(
             range.i0,
@@ -179,6 +351,5 @@ impl<D: Density + Sync + ?Sized> Fork<'_, D> {
             range.j1,
             self.sampler.tile_size(),
         );
-        points
     }
 }
