@@ -262,16 +262,15 @@ impl NoiseDensity {
             let (v, g) = perlin_plane(&octave.table, q.x, q.y);
             // The octave's reach within the rectangle, in its own input units.
             let r = radius * gain.abs();
-            let bend = 0.5 * PERLIN_CURVATURE_BOUND * r * r;
             let reach = half * gain.abs() * (1.0 + ROUNDING_MARGIN) + ROUNDING_MARGIN;
-            if !(v.abs() + g.length() * r + bend < 1.0 - ROUNDING_MARGIN
-                || clamp_free(&octave.table, q - reach, q + reach))
-            {
+            let (cells_curvature, clamp_free) = lattice_bounds(&octave.table, q - reach, q + reach);
+            let bend = 0.5 * cells_curvature * r * r;
+            if !(clamp_free || v.abs() + g.length() * r + bend < 1.0 - ROUNDING_MARGIN) {
                 return None;
             }
             value += octave.weight * v;
             gradient += g * (octave.weight * gain);
-            curvature += 0.5 * PERLIN_CURVATURE_BOUND * octave.weight * gain * gain;
+            curvature += 0.5 * cells_curvature * octave.weight * gain * gain;
             q *= LACUNARITY;
             gain *= LACUNARITY;
         }
@@ -345,8 +344,28 @@ const CLAMP_FREE: [u64; 4] = [
     0xffef_ef8c_ffff_ffaf,
 ];
 
-/// Most lattice cells per axis [`clamp_free`] looks at.
-const CLAMP_FREE_SPAN: isize = 3;
+/// Each corner-gradient combination's curvature bound on its lattice cell, in tenths (the
+/// noise before its clamp; at most [`PERLIN_CURVATURE_BOUND`]): proven by
+/// `the_perlin_curvature_bounds_hold_everywhere`.
+const CELL_CURVATURE: [u8; 256] = [
+    95, 119, 119, 141, 139, 119, 158, 142, 139, 141, 119, 146, 166, 142, 150, 141, 139, 119, 141,
+    146, 176, 139, 185, 174, 174, 146, 146, 119, 185, 141, 161, 146, 139, 158, 119, 142, 174, 142,
+    142, 121, 176, 185, 139, 174, 185, 146, 158, 142, 166, 150, 142, 141, 185, 158, 146, 142, 185,
+    161, 141, 146, 191, 159, 159, 141, 119, 119, 119, 159, 119, 119, 150, 158, 158, 159, 150, 161,
+    150, 119, 119, 150, 119, 119, 142, 141, 139, 95, 166, 139, 142, 141, 141, 146, 158, 119, 150,
+    119, 141, 159, 142, 146, 146, 141, 141, 142, 185, 191, 166, 185, 161, 159, 150, 158, 142, 119,
+    102, 142, 141, 119, 142, 119, 146, 159, 142, 141, 159, 119, 119, 119, 119, 119, 119, 159, 141,
+    142, 159, 146, 119, 142, 119, 141, 142, 102, 119, 142, 158, 150, 159, 161, 185, 166, 191, 185,
+    142, 141, 141, 146, 146, 142, 159, 141, 119, 150, 119, 158, 146, 141, 141, 142, 139, 166, 95,
+    139, 141, 142, 119, 119, 150, 119, 119, 150, 161, 150, 159, 158, 158, 150, 119, 119, 159, 119,
+    119, 119, 141, 159, 159, 191, 146, 141, 161, 185, 142, 146, 158, 185, 141, 142, 150, 166, 142,
+    158, 146, 185, 174, 139, 185, 176, 121, 142, 142, 174, 142, 119, 158, 139, 146, 161, 141, 185,
+    119, 146, 146, 174, 174, 185, 139, 176, 146, 141, 119, 139, 141, 150, 142, 166, 146, 119, 141,
+    139, 142, 158, 119, 139, 141, 119, 119, 95,
+];
+
+/// Most lattice cells per axis [`lattice_bounds`] looks at.
+const LATTICE_SPAN: isize = 3;
 
 /// The corner-gradient combination of the lattice cell at `(cx, cy)`, as `perlin` picks it.
 fn corner_combination(table: &[u8; 256], cx: isize, cy: isize) -> usize {
@@ -357,21 +376,24 @@ fn corner_combination(table: &[u8; 256], cx: isize, cy: isize) -> usize {
     pick(0, 0) | pick(1, 0) << 2 | pick(0, 1) << 4 | pick(1, 1) << 6
 }
 
-/// Whether the noise before its clamp stays within [-1, 1] over the input rectangle
-/// `[min, max]` (so that the clamp never acts there): every lattice cell it touches has a
-/// clamp-free combination of corner gradients.
-fn clamp_free(table: &[u8; 256], min: DVec2, max: DVec2) -> bool {
+/// Over the lattice cells the input rectangle `[min, max]` touches: the largest curvature
+/// bound of the noise before its clamp, and whether it stays within [-1, 1] there (so that
+/// the clamp never acts); the global bounds where the rectangle spans many cells.
+fn lattice_bounds(table: &[u8; 256], min: DVec2, max: DVec2) -> (f64, bool) {
     let (x0, y0) = (min.x.floor() as isize, min.y.floor() as isize);
     let (x1, y1) = (max.x.floor() as isize, max.y.floor() as isize);
-    if x1 - x0 >= CLAMP_FREE_SPAN || y1 - y0 >= CLAMP_FREE_SPAN {
-        return false;
+    if x1 - x0 >= LATTICE_SPAN || y1 - y0 >= LATTICE_SPAN {
+        return (PERLIN_CURVATURE_BOUND, false);
     }
-    (y0..=y1).all(|cy| {
-        (x0..=x1).all(|cx| {
+    let (mut tenths, mut free) = (0, true);
+    for cy in y0..=y1 {
+        for cx in x0..=x1 {
             let combo = corner_combination(table, cx, cy);
-            CLAMP_FREE[combo / 64] >> (combo % 64) & 1 == 1
-        })
-    })
+            tenths = tenths.max(CELL_CURVATURE[combo]);
+            free &= CLAMP_FREE[combo / 64] >> (combo % 64) & 1 == 1;
+        }
+    }
+    (f64::from(tenths) / 10.0, free)
 }
 
 /// The `noise` crate's `perlin_2d` before its clamp, and its gradient, at `(x, y)`: the
@@ -555,24 +577,13 @@ mod tests {
         (value, [s * xx, s * xy, s * yy])
     }
 
-    /// A proof of [`PERLIN_CURVATURE_BOUND`]: the Hessian's largest eigenvalue magnitude
-    /// over every combination of corner gradients on a grid of spacing `h`, plus what it can
-    /// gain between grid points (the third derivatives bound its change).
+    /// A proof of [`CELL_CURVATURE`] and [`PERLIN_CURVATURE_BOUND`]: each combination of
+    /// corner gradients' largest Hessian eigenvalue magnitude on a grid of spacing `h`,
+    /// plus what it can gain between grid points (the third derivatives bound its change).
     #[test]
-    fn the_perlin_curvature_bound_holds_everywhere() {
+    fn the_perlin_curvature_bounds_hold_everywhere() {
         let steps = 400;
         let h = 1.0 / steps as f64;
-        let mut largest: f64 = 0.0;
-        for combo in 0..256 {
-            for i in 0..=steps {
-                for j in 0..=steps {
-                    let (_, [a, b, c]) =
-                        perlin_curvature(gradients(combo), i as f64 * h, j as f64 * h);
-                    let norm = ((a + c) * 0.5).abs() + (((a - c) * 0.5).powi(2) + b * b).sqrt();
-                    largest = largest.max(norm);
-                }
-            }
-        }
         // Third derivatives from |g| <= 2, |g'| <= 1, the quintic's slope <= 1.875,
         // curvature <= 5.78 and third derivative <= 60: xxx and yyy below 60 * 4 + 3 * 5.78
         // * 2, xxy and xyy below 126.3; the Hessian's change per unit step is below the
@@ -581,9 +592,28 @@ mod tests {
         let diagonal = outer.hypot(mixed);
         let change = std::f64::consts::SQRT_2
             * (2.0 * diagonal * diagonal + 2.0 * mixed.hypot(mixed).powi(2)).sqrt();
-        let proven = largest + change * h * std::f64::consts::FRAC_1_SQRT_2;
-        eprintln!("largest curvature on the grid {largest:.4}, proven bound {proven:.4}");
-        assert!(proven <= PERLIN_CURVATURE_BOUND, "{proven}");
+        let between = change * h * std::f64::consts::FRAC_1_SQRT_2;
+        let mut largest: f64 = 0.0;
+        for (combo, &tenths) in CELL_CURVATURE.iter().enumerate() {
+            let mut cell: f64 = 0.0;
+            for i in 0..=steps {
+                for j in 0..=steps {
+                    let (_, [a, b, c]) =
+                        perlin_curvature(gradients(combo), i as f64 * h, j as f64 * h);
+                    let norm = ((a + c) * 0.5).abs() + (((a - c) * 0.5).powi(2) + b * b).sqrt();
+                    cell = cell.max(norm);
+                }
+            }
+            let proven = cell + between;
+            assert!(
+                proven <= f64::from(tenths) / 10.0,
+                "combination {combo}: {proven}"
+            );
+            largest = largest.max(proven);
+        }
+        eprintln!("largest proven curvature {largest:.4}");
+        assert!(largest <= PERLIN_CURVATURE_BOUND, "{largest}");
+        assert!(f64::from(*CELL_CURVATURE.iter().max().unwrap()) / 10.0 <= PERLIN_CURVATURE_BOUND);
     }
 
     /// A proof of [`CLAMP_FREE`]: on every cell marked free, the noise's largest magnitude
