@@ -91,6 +91,7 @@ fn early_decisions_equal_full_evaluation() {
                     value > threshold,
                     "{params:?} at {p:?}, factor {factor}, threshold {threshold}"
                 );
+                assert_eq!(d.exceeds_near(p, factor, threshold), value > threshold);
             }
         }
     }

@@ -44,6 +44,14 @@ pub trait Density {
     fn exceeds(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
         sanitize(self.density(p)) * factor > threshold
     }
+    /// [`Density::exceeds`] for a point a [`LocalModel`] left open: its density lies close
+    /// to the threshold, where bounds from partial evaluations rarely decide, so a density
+    /// whose `exceeds` tries them may skip them here. Must answer exactly as `exceeds`; the
+    /// default calls it.
+    #[inline]
+    fn exceeds_near(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
+        self.exceeds(p, factor, threshold)
+    }
     /// A [`LocalModel`] of the density valid over the rectangle `[min, max]`, where the
     /// density has one cheaper than evaluating it at the rectangle's points: queries decide
     /// the points of a cell by it and evaluate only those it leaves open. The default, `None`,
@@ -74,6 +82,10 @@ macro_rules! forward_density {
             #[inline]
             fn exceeds(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
                 (**self).exceeds(p, factor, threshold)
+            }
+            #[inline]
+            fn exceeds_near(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
+                (**self).exceeds_near(p, factor, threshold)
             }
             #[inline]
             fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {

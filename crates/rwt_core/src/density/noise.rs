@@ -478,6 +478,12 @@ impl Density for NoiseDensity {
         })
     }
 
+    /// The whole sum: near the threshold the partial sums' checks would only cost.
+    #[inline]
+    fn exceeds_near(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
+        sanitize(self.density(p)) * factor > threshold
+    }
+
     /// Sums the octaves until the partial sum, give or take what the remaining octaves can
     /// add, decides the point on one side of the threshold; the last octave decides exactly
     /// as [`Density::density`] would.

@@ -403,9 +403,12 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
     /// where it decides, by the density otherwise.
     #[inline(always)]
     fn decide(&self, run: &Run, p: DVec2, rank: f64) -> bool {
-        match run.model.and_then(|m| m.decides(p, run.frame.area, rank)) {
-            Some(decided) => decided,
-            None => self.density.exceeds(p, run.frame.area, rank),
+        let area = run.frame.area;
+        match run.model {
+            Some(model) => model
+                .decides(p, area, rank)
+                .unwrap_or_else(|| self.density.exceeds_near(p, area, rank)),
+            None => self.density.exceeds(p, area, rank),
         }
     }
 }
