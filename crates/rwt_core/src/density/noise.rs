@@ -241,8 +241,9 @@ impl NoiseDensity {
 
     /// The fBm as a plane at the rectangle's centre plus a bounded bend, octave by octave:
     /// each octave's value and gradient at the centre, its curvature bound scaled by its
-    /// weight and its frequency squared. `None` where an octave's clamp to [-1, 1] may act
-    /// inside the rectangle (the bound is for the noise before it), or where inputs wrap.
+    /// weight and its frequency squared. Where an octave's clamp to [-1, 1] may act inside
+    /// the rectangle (the bounds are for the noise before it), what the clamp can take off
+    /// widens the slack. `None` where inputs wrap.
     fn fbm_model(&self, min: DVec2, max: DVec2) -> Option<FbmModel> {
         let centre = (min + max) * 0.5;
         let radius = (max - min).length() * 0.5;
@@ -264,9 +265,10 @@ impl NoiseDensity {
             let r = radius * gain.abs();
             let reach = half * gain.abs() * (1.0 + ROUNDING_MARGIN) + ROUNDING_MARGIN;
             let (cells_curvature, clamp_free) = lattice_bounds(&octave.table, q - reach, q + reach);
-            let bend = 0.5 * cells_curvature * r * r;
-            if !(clamp_free || v.abs() + g.length() * r + bend < 1.0 - ROUNDING_MARGIN) {
-                return None;
+            if !clamp_free {
+                // The clamp takes off at most how far the noise can pass 1 in magnitude.
+                let peak = v.abs() + g.length() * r + 0.5 * cells_curvature * r * r;
+                slack += octave.weight * (peak - 1.0 + ROUNDING_MARGIN).max(0.0);
             }
             value += octave.weight * v;
             gradient += g * (octave.weight * gain);

@@ -44,6 +44,7 @@ impl<F: FnMut(Point)> Sink for F {
 
 /// Which of the sampler's cell lists a run's points come from.
 #[derive(Clone, Copy)]
+#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
 pub(super) struct CellList {
     tile: u16,
     cell: u8,
@@ -53,6 +54,7 @@ pub(super) struct CellList {
 
 impl Sampler {
     /// The points of a cell list.
+    #[cfg(feature = "parallel")]
     #[inline(always)]
     pub(super) fn cell_list(&self, list: CellList) -> &[CellPoint] {
         let tile = &self.tiles[list.tile as usize];
@@ -75,7 +77,8 @@ pub(super) struct Frame {
     offset: f64,
     /// Area of the tile whose ranking this is (thresholds are ranks per this area).
     area: f64,
-    /// Where the points come from.
+    /// Where the points come from (what the parallel query keeps of them).
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
     pub list: CellList,
 }
 
