@@ -73,7 +73,7 @@ const PERLIN_GRADIENT_BOUND: f64 = 4.25;
 
 /// Bound of the curvature (the Hessian's largest eigenvalue in magnitude) of the `noise`
 /// crate's 2D Perlin noise before its clamp: proven 19.0 by
-/// `the_perlin_curvature_bound_holds_everywhere` (the grid's largest is 17.8).
+/// `the_perlin_curvature_bounds_hold_everywhere` (the grid's largest is 17.8).
 const PERLIN_CURVATURE_BOUND: f64 = 19.5;
 
 /// The `noise` crate's fBm defaults (frequency 1): each octave's weight is the previous one's
@@ -300,6 +300,20 @@ fn permutation(seed: u32) -> [u8; 256] {
     std::array::from_fn(|i| table.hash(&[i as isize]) as u8)
 }
 
+/// The `noise` crate's lattice corner below `v`: truncation, minus one at or below zero.
+#[inline(always)]
+fn lattice_corner(v: f64) -> isize {
+    if v <= 0.0 { v as isize - 1 } else { v as isize }
+}
+
+/// Which of the four gradients `(+-1, +-1)` the `noise` crate's table picks at lattice
+/// point `(x, y)`: 0 `(1, 1)`, 1 `(-1, 1)`, 2 `(1, -1)`, 3 `(-1, -1)`.
+#[inline(always)]
+fn gradient_pick(table: &[u8; 256], x: isize, y: isize) -> u8 {
+    let first = table[(x & 0xff) as usize] as usize;
+    table[first ^ (y & 0xff) as usize] & 0b11
+}
+
 /// The `noise` crate's `perlin_2d` (0.9), operation for operation: its lattice corner
 /// (truncation, minus one at or below zero), its gradients `(+-1, +-1)` picked by the
 /// table, its quintic curve, its interpolation `b * t + a * (1 - t)` (first along y), its
@@ -307,13 +321,11 @@ fn permutation(seed: u32) -> [u8; 256] {
 #[inline(always)]
 fn perlin(table: &[u8; 256], x: f64, y: f64) -> f64 {
     const SCALE_FACTOR: f64 = 2.0 / std::f64::consts::SQRT_2;
-    let corner = |v: f64| if v <= 0.0 { v as isize - 1 } else { v as isize };
-    let (cx, cy) = (corner(x), corner(y));
+    let (cx, cy) = (lattice_corner(x), lattice_corner(y));
     let (dx, dy) = (x - cx as f64, y - cy as f64);
     let gradient = |ox: isize, oy: isize| {
         let (px, py) = (dx - ox as f64, dy - oy as f64);
-        let first = table[((cx + ox) & 0xff) as usize] as usize;
-        match table[first ^ ((cy + oy) & 0xff) as usize] & 0b11 {
+        match gradient_pick(table, cx + ox, cy + oy) {
             0 => px + py,
             1 => -px + py,
             2 => px - py,
@@ -374,10 +386,7 @@ const LATTICE_SPAN: isize = 3;
 
 /// The corner-gradient combination of the lattice cell at `(cx, cy)`, as `perlin` picks it.
 fn corner_combination(table: &[u8; 256], cx: isize, cy: isize) -> usize {
-    let pick = |ox: isize, oy: isize| {
-        let first = table[((cx + ox) & 0xff) as usize] as usize;
-        (table[first ^ ((cy + oy) & 0xff) as usize] & 0b11) as usize
-    };
+    let pick = |ox: isize, oy: isize| gradient_pick(table, cx + ox, cy + oy) as usize;
     pick(0, 0) | pick(1, 0) << 2 | pick(0, 1) << 4 | pick(1, 1) << 6
 }
 
@@ -405,13 +414,11 @@ fn lattice_bounds(table: &[u8; 256], min: DVec2, max: DVec2) -> (f64, bool) {
 /// interpolation of the corner gradients' planes by the quintic curve, differentiated.
 fn perlin_plane(table: &[u8; 256], x: f64, y: f64) -> (f64, DVec2) {
     const SCALE_FACTOR: f64 = 2.0 / std::f64::consts::SQRT_2;
-    let corner = |v: f64| if v <= 0.0 { v as isize - 1 } else { v as isize };
-    let (cx, cy) = (corner(x), corner(y));
+    let (cx, cy) = (lattice_corner(x), lattice_corner(y));
     let (dx, dy) = (x - cx as f64, y - cy as f64);
     // Each corner's gradient (+-1, +-1) and its plane's value at (dx, dy).
     let plane = |ox: isize, oy: isize| {
-        let first = table[((cx + ox) & 0xff) as usize] as usize;
-        let g = match table[first ^ ((cy + oy) & 0xff) as usize] & 0b11 {
+        let g = match gradient_pick(table, cx + ox, cy + oy) {
             0 => DVec2::new(1.0, 1.0),
             1 => DVec2::new(-1.0, 1.0),
             2 => DVec2::new(1.0, -1.0),
@@ -683,10 +690,9 @@ mod tests {
     fn the_perlin_gradient_bound_holds_everywhere() {
         let steps = 400;
         let h = 1.0 / steps as f64;
-        let signs = [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)];
         let mut largest: f64 = 0.0;
         for combo in 0..256 {
-            let grads = [0, 1, 2, 3].map(|k| signs[(combo >> (2 * k)) & 3]);
+            let grads = gradients(combo);
             for i in 0..=steps {
                 for j in 0..=steps {
                     largest = largest.max(perlin_gradient(grads, i as f64 * h, j as f64 * h));
