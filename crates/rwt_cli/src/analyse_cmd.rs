@@ -84,70 +84,78 @@ pub fn print_table(rows: &[Row]) {
     }
 }
 
-fn read_points(path: &Path) -> Result<Vec<DVec2>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut out = Vec::new();
-    for (n, line) in text.lines().enumerate() {
+/// Most points of one analysis window: a window's periodogram costs its points times 128^2,
+/// and each reference is made as large, so larger files are analysed in windows of this
+/// many points (memory and time stay bounded however large the file).
+const MAX_WINDOW_POINTS: f64 = 20_000.0;
+
+/// Calls `f` with every point of the file (`x y` first on each line; lines with fewer than
+/// two fields are skipped), streaming it; returns how many.
+fn for_each_point(path: &Path, mut f: impl FnMut(DVec2)) -> Result<usize, String> {
+    use std::io::BufRead;
+    let file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut count = 0;
+    for (n, line) in std::io::BufReader::new(file).lines().enumerate() {
+        let line = line.map_err(|e| format!("{}: line {}: {e}", path.display(), n + 1))?;
         let mut it = line.split_whitespace();
         let (Some(x), Some(y)) = (it.next(), it.next()) else {
             continue;
         };
-        let (x, y) = (
-            x.parse::<f64>()
-                .map_err(|_| format!("line {}: bad x {x:?}", n + 1))?,
-            y.parse::<f64>()
-                .map_err(|_| format!("line {}: bad y {y:?}", n + 1))?,
-        );
-        if x.is_finite() && y.is_finite() {
-            out.push(DVec2::new(x, y));
-        }
+        let number = |v: &str, axis: &str| {
+            v.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("{}: line {}: bad {axis} {v:?}", path.display(), n + 1))
+        };
+        f(DVec2::new(number(x, "x")?, number(y, "y")?));
+        count += 1;
     }
-    if out.len() < 16 {
-        return Err(format!(
-            "{}: {} points, need at least 16",
-            path.display(),
-            out.len()
-        ));
-    }
-    Ok(out)
+    Ok(count)
 }
 
 /// `rwt analyse FILE [--plot out.png]`.
 pub fn run(path: &Path, plot: Option<&Path>) -> Result<(), String> {
-    let points = read_points(path)?;
-    let (mut lo, mut hi) = (points[0], points[0]);
-    for &p in &points {
+    // Two passes over the file: its extent, then the points of the windows.
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    let count = for_each_point(path, |p| {
         lo = lo.min(p);
         hi = hi.max(p);
+    })?;
+    if count < 16 {
+        return Err(format!(
+            "{}: {count} points, need at least 16",
+            path.display()
+        ));
     }
     let side_all = (hi - lo).min_element();
     if side_all.is_nan() || side_all <= 0.0 {
         return Err("points span no area".into());
     }
-    // Up to 4x4 square windows, each with at least ~500 points.
-    let per_axis = ((points.len() as f64 / 500.0).sqrt().floor() as usize).clamp(1, 4);
-    let side = side_all / per_axis as f64;
-    let mut windows = Vec::new();
-    for j in 0..per_axis {
-        for i in 0..per_axis {
-            let o = lo + DVec2::new(i as f64, j as f64) * side;
-            let w: Vec<DVec2> = points
-                .iter()
-                .copied()
-                .filter(|p| p.x >= o.x && p.y >= o.y && p.x < o.x + side && p.y < o.y + side)
-                .collect();
-            windows.push((o, w));
+    // Up to 4x4 square windows, each with at least ~500 points and at most
+    // MAX_WINDOW_POINTS.
+    let per_axis = ((count as f64 / 500.0).sqrt().floor() as usize).clamp(1, 4);
+    let cell = side_all / per_axis as f64;
+    let density = count as f64 / ((hi.x - lo.x) * (hi.y - lo.y));
+    let side = cell.min((MAX_WINDOW_POINTS / density).sqrt());
+    let origins: Vec<DVec2> = (0..per_axis * per_axis)
+        .map(|k| lo + DVec2::new((k % per_axis) as f64, (k / per_axis) as f64) * cell)
+        .collect();
+    let mut windows: Vec<(DVec2, Vec<DVec2>)> = origins.iter().map(|&o| (o, Vec::new())).collect();
+    for_each_point(path, |p| {
+        let k = ((p - lo) / cell).floor();
+        let (i, j) = (k.x as usize, k.y as usize);
+        if i < per_axis && j < per_axis {
+            let (o, w) = &mut windows[j * per_axis + i];
+            if p.x < o.x + side && p.y < o.y + side {
+                w.push(p);
+            }
         }
-    }
-    let total = points.len() as f64 / ((hi.x - lo.x) * (hi.y - lo.y));
+    })?;
     say!(
-        "{} points, {:.4} x {:.4}, {:.1} per unit area; {} window(s) of side {:.4}",
-        points.len(),
+        "{count} points, {:.4} x {:.4}, {density:.1} per unit area; {} window(s) of side {side:.4}",
         hi.x - lo.x,
         hi.y - lo.y,
-        total,
         windows.len(),
-        side
     );
     let rows = compare(&windows, side, 128);
     print_table(&rows);
@@ -242,7 +250,5 @@ pub fn draw(
         10.0,
         0.0,
     );
-    c.image
-        .save(out)
-        .map_err(|e| format!("{}: {e}", out.display()))
+    c.save(out)
 }

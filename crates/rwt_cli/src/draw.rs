@@ -1,6 +1,23 @@
 //! Minimal raster drawing for the CLI's pictures (discs, lines, rectangles on RGB images).
 
-use image::{Rgb, RgbImage};
+use image::{ExtendedColorType, ImageEncoder, Rgb, RgbImage};
+use std::path::Path;
+
+/// Writes pixels as a PNG, atomically: on any error an existing file keeps its bytes.
+pub fn save_png(
+    path: &Path,
+    pixels: &[u8],
+    width: u32,
+    height: u32,
+    color: ExtendedColorType,
+) -> Result<(), String> {
+    rwt_core::files::write_atomic_with(path, |w| {
+        image::codecs::png::PngEncoder::new(w)
+            .write_image(pixels, width, height, color)
+            .map_err(std::io::Error::other)
+    })
+    .map_err(|e| e.to_string())
+}
 
 /// An RGB canvas.
 pub struct Canvas {
@@ -9,6 +26,12 @@ pub struct Canvas {
 }
 
 impl Canvas {
+    /// Writes the canvas as a PNG (see [`save_png`]).
+    pub fn save(&self, path: &Path) -> Result<(), String> {
+        let (w, h) = self.image.dimensions();
+        save_png(path, self.image.as_raw(), w, h, ExtendedColorType::Rgb8)
+    }
+
     /// A canvas filled with `background`.
     pub fn new(width: u32, height: u32, background: [u8; 3]) -> Self {
         Self {

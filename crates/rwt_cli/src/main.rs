@@ -45,7 +45,9 @@ enum Command {
         #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true)]
         rect: Vec<f64>,
         /// `const:V` (points per unit area), `image:PATH[:V]`, `dark:PATH[:V]` or
-        /// `noise:V[:FREQ[:OCTAVES[:SEED]]]`; images are stretched over the rectangle.
+        /// `noise:V[:FREQ[:OCTAVES[:SEED]]]`; images are stretched over the rectangle, their
+        /// luma times alpha (transparent is empty). A path may contain `:`; one ending in
+        /// `:NUMBER` goes in double quotes: `image:"a:5":500`.
         #[arg(long)]
         density: String,
         /// Tiling seed.
@@ -98,6 +100,12 @@ enum Command {
         /// Output pixels per image pixel.
         #[arg(long, default_value_t = 2.0)]
         scale: f64,
+        /// Refuse stipples of more dots than this.
+        #[arg(long, default_value_t = rwt_core::stipple::DEFAULT_MAX_DOTS)]
+        max_dots: usize,
+        /// Refuse rendered rasters of more pixels than this.
+        #[arg(long, default_value_t = rwt_core::stipple::DEFAULT_MAX_RASTER_PIXELS)]
+        max_raster_pixels: u64,
     },
     /// Throughput and scaling of queries, as ratios measured in one run.
     Bench {
@@ -199,6 +207,8 @@ fn main() -> ExitCode {
             contrast,
             seed,
             scale,
+            max_dots,
+            max_raster_pixels,
         } => stipple_cmd::run(&stipple_cmd::StippleArgs {
             image: &image,
             out: &out,
@@ -207,6 +217,10 @@ fn main() -> ExitCode {
             tone: rwt_core::stipple::ToneMap { gamma, contrast },
             seed,
             scale,
+            limits: rwt_core::stipple::StippleLimits {
+                max_dots,
+                max_raster_pixels,
+            },
         })
         .map(|()| true),
         Command::Bench { quick } => bench_cmd::run(quick).map(|()| true),

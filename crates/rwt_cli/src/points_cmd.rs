@@ -1,14 +1,17 @@
 //! `rwt points`: the points of a rectangle, one per line, in the serial query's order
-//! (large rectangles are queried on all cores, with a progress bar past a second).
+//! (large rectangles are queried on all cores, with a progress bar past a second). The query
+//! is admitted before `--out` is opened, and the file is replaced atomically: a refused or
+//! failed run leaves an existing file as it was.
 
 use crate::spec;
 use glam::DVec2;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rayon::prelude::*;
 use rwt_core::density::Density;
+use rwt_core::files::AtomicFile;
 use rwt_core::query::{Point, Rect, Sampler};
 use rwt_core::tileset::TileSet;
 use std::io::Write;
+use std::ops::ControlFlow;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -41,7 +44,7 @@ pub fn run(args: PointsArgs) -> Result<(), String> {
             args.tile_size
         ));
     }
-    let density = spec::parse(args.density, (rect.min(), rect.max()))?;
+    let density = spec::parse(args.density, (rect.min(), rect.max())).map_err(|e| e.to_string())?;
     let set = match args.tileset {
         Some(path) => crate::tileset_cmd::load(path)?,
         None => TileSet::embedded(),
@@ -49,20 +52,30 @@ pub fn run(args: PointsArgs) -> Result<(), String> {
     let sampler = Sampler::new(&set, args.seed)
         .with_tile_size(args.tile_size)
         .with_budget(args.budget);
-    let mut sink: Box<dyn Write> = match args.out {
-        Some(p) => Box::new(std::io::BufWriter::new(
-            std::fs::File::create(p).map_err(|e| format!("{}: {e}", p.display()))?,
-        )),
-        None => Box::new(std::io::BufWriter::new(std::io::stdout().lock())),
-    };
+    // Refused queries stop here, before any output exists.
+    sampler.admits(&rect, &density).map_err(|e| e.to_string())?;
     let started = Instant::now();
-    let tiles = rect.area() / (args.tile_size * args.tile_size);
-    let count = if tiles >= PARALLEL_TILES {
-        parallel(&sampler, rect, &density, &mut sink, args.seed)?
-    } else {
-        serial(&sampler, rect, &density, &mut sink, args.seed)?
+    let parallel = rect.area() / (args.tile_size * args.tile_size) >= PARALLEL_TILES;
+    let query = Query {
+        sampler: &sampler,
+        rect,
+        density: &density,
+        seed: args.seed,
     };
-    sink.flush().map_err(|e| format!("writing points: {e}"))?;
+    let count = match args.out {
+        Some(path) => {
+            let mut file = AtomicFile::create(path).map_err(|e| e.to_string())?;
+            let count = query.write(&mut file, parallel)?;
+            file.commit().map_err(|e| e.to_string())?;
+            count
+        }
+        None => {
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            let count = query.write(&mut out, parallel)?;
+            out.flush().map_err(|e| format!("writing points: {e}"))?;
+            count
+        }
+    };
     eprintln!(
         "{count} points in {:.1} ms",
         started.elapsed().as_secs_f64() * 1e3
@@ -72,8 +85,6 @@ pub fn run(args: PointsArgs) -> Result<(), String> {
 
 /// Rectangles of at least this many base tiles are queried on all cores.
 const PARALLEL_TILES: f64 = 256.0;
-/// Runs formatted together before they are written.
-const WRITE_BATCH: usize = 64;
 
 /// One point as a line: `x y class rotation level:x:y:index`.
 fn write_point(sink: &mut dyn Write, p: &Point, seed: u64) -> std::io::Result<()> {
@@ -92,68 +103,79 @@ fn write_point(sink: &mut dyn Write, p: &Point, seed: u64) -> std::io::Result<()
     )
 }
 
-/// Streams the points out as the serial query finds them.
-fn serial(
-    sampler: &Sampler,
+/// An admitted query and the seed its rotations are hashed with.
+struct Query<'a> {
+    sampler: &'a Sampler,
     rect: Rect,
-    density: &(dyn Density + Sync),
-    sink: &mut dyn Write,
+    density: &'a (dyn Density + Sync),
     seed: u64,
-) -> Result<usize, String> {
-    let mut failed = None;
-    let count = sampler
-        .query_with(rect, density, |p| {
-            if failed.is_none()
-                && let Err(e) = write_point(sink, &p, seed)
-            {
-                failed = Some(e);
-            }
-        })
-        .map_err(|e| e.to_string())?;
-    match failed {
-        Some(e) => Err(format!("writing points: {e}")),
-        None => Ok(count),
-    }
 }
 
-/// Queries on all cores (the same points in the same order), then writes; a progress bar
-/// appears when this takes longer than a second.
-fn parallel(
-    sampler: &Sampler,
-    rect: Rect,
-    density: &(dyn Density + Sync),
-    sink: &mut dyn Write,
-    seed: u64,
-) -> Result<usize, String> {
-    let bar = LateBar::new(1000, "querying");
-    let runs = sampler
-        .query_par_runs_with_progress(rect, density, &|f| bar.set((f * 1000.0) as u64))
-        .map_err(|e| e.to_string())?;
-    let count: usize = runs.iter().map(Vec::len).sum();
-    bar.phase(count as u64, "writing");
-    // Lines are formatted on all cores, a batch of runs at a time, and written in order.
-    let mut written = 0;
-    for batch in runs.chunks(WRITE_BATCH) {
-        let text: Vec<Vec<u8>> = batch
-            .par_iter()
-            .map(|run| {
-                let mut text = Vec::with_capacity(run.len() * 64);
-                for p in run {
-                    // Writing to memory cannot fail.
-                    let _ = write_point(&mut text, p, seed);
-                }
-                text
-            })
-            .collect();
-        for t in &text {
-            sink.write_all(t)
-                .map_err(|e| format!("writing points: {e}"))?;
+impl Query<'_> {
+    /// Writes the points to `sink`, serially or on all cores; returns how many.
+    fn write(&self, sink: &mut dyn Write, parallel: bool) -> Result<usize, String> {
+        if parallel {
+            self.parallel(sink)
+        } else {
+            self.serial(sink)
         }
-        written += batch.iter().map(Vec::len).sum::<usize>();
-        bar.set(written as u64);
     }
-    bar.bar.finish_and_clear();
-    Ok(count)
+
+    /// Streams the points out as the serial query finds them.
+    fn serial(&self, sink: &mut dyn Write) -> Result<usize, String> {
+        let mut failed = None;
+        let count = self
+            .sampler
+            .query_with(self.rect, self.density, |p| {
+                if failed.is_none()
+                    && let Err(e) = write_point(sink, &p, self.seed)
+                {
+                    failed = Some(e);
+                }
+            })
+            .map_err(|e| e.to_string())?;
+        match failed {
+            Some(e) => Err(format!("writing points: {e}")),
+            None => Ok(count),
+        }
+    }
+
+    /// Queries and formats on all cores (the same points in the same order, a block of base
+    /// tiles at a time, a few blocks ahead of the one written: memory stays small however
+    /// many points there are); a progress bar appears when this takes longer than a second.
+    fn parallel(&self, sink: &mut dyn Write) -> Result<usize, String> {
+        let bar = LateBar::new(1000, "points");
+        let lines = |run: &[Point]| {
+            let mut text = Vec::with_capacity(run.len() * 64);
+            for p in run {
+                // Writing to memory cannot fail.
+                let _ = write_point(&mut text, p, self.seed);
+            }
+            text
+        };
+        let mut failed = None;
+        let count = self
+            .sampler
+            .query_par_ordered(
+                self.rect,
+                self.density,
+                lines,
+                |text| match sink.write_all(&text) {
+                    Ok(()) => ControlFlow::Continue(()),
+                    Err(e) => {
+                        failed = Some(e);
+                        ControlFlow::Break(())
+                    }
+                },
+                &|f| bar.set((f * 1000.0) as u64),
+            )
+            .map_err(|e| e.to_string())?;
+        bar.bar.finish_and_clear();
+        match failed {
+            Some(e) => Err(format!("writing points: {e}")),
+            None => Ok(count),
+        }
+    }
 }
 
 /// A progress bar drawn only once its work has run for a second.
@@ -184,12 +206,6 @@ impl LateBar {
         }
         self.bar.set_position(position);
     }
-
-    fn phase(&self, len: u64, message: &'static str) {
-        self.bar.set_length(len);
-        self.bar.set_message(message);
-        self.set(0);
-    }
 }
 
 #[cfg(test)]
@@ -202,9 +218,15 @@ mod tests {
         let rect = Rect::new(DVec2::new(-3.0, 1.0), DVec2::new(17.0, 12.5)).unwrap();
         let density = spec::parse("noise:6:0.2", (rect.min(), rect.max())).unwrap();
         assert!(rect.area() / 0.25 >= PARALLEL_TILES);
+        let query = Query {
+            sampler: &sampler,
+            rect,
+            density: &density,
+            seed: 5,
+        };
         let (mut a, mut b) = (Vec::new(), Vec::new());
-        let n = serial(&sampler, rect, &density, &mut a, 5).unwrap();
-        let m = parallel(&sampler, rect, &density, &mut b, 5).unwrap();
+        let n = query.write(&mut a, false).unwrap();
+        let m = query.write(&mut b, true).unwrap();
         assert_eq!(n, m);
         assert!(n > 500, "{n}");
         assert_eq!(String::from_utf8(a).unwrap(), String::from_utf8(b).unwrap());

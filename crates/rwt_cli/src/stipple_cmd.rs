@@ -1,9 +1,12 @@
 //! `rwt stipple`: blue-noise stippling of an image whose blurred dots keep the image's tone
 //! (paper figure 11), with the tone error printed next to a white-noise stipple's.
 
-use rwt_core::stipple::{DotCount, Grey, Stipple, StippleSettings, ToneMap, stipple};
+use rwt_core::density::open_image;
+use rwt_core::stipple::{
+    DotCount, Grey, Stipple, StippleLimits, StippleSettings, ToneMap, stipple,
+};
 use rwt_core::tileset::TileSet;
-use std::fmt::Write as _;
+use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
@@ -23,17 +26,16 @@ pub struct StippleArgs<'a> {
     pub seed: u64,
     /// Output pixels per image pixel.
     pub scale: f64,
+    /// Most dots and raster pixels.
+    pub limits: StippleLimits,
 }
 
 /// Runs `rwt stipple`.
 pub fn run(args: &StippleArgs) -> Result<(), String> {
-    let img = image::open(args.image).map_err(|e| format!("{}: {e}", args.image.display()))?;
-    let luma = img.to_luma32f();
-    let grey = Grey {
-        width: luma.width() as usize,
-        height: luma.height() as usize,
-        values: luma.into_raw(),
-    };
+    // At most rwt_core's MAX_IMAGE_PIXELS, checked from the header before decoding.
+    let img = open_image(args.image).map_err(|e| format!("{}: {e}", args.image.display()))?;
+    let grey = Grey::from_image(&img);
+    drop(img);
     let dots = match (args.points, args.radius) {
         (Some(n), None) => DotCount::Points(n),
         (None, Some(r)) => DotCount::Radius(r),
@@ -45,6 +47,7 @@ pub fn run(args: &StippleArgs) -> Result<(), String> {
         tone: args.tone,
         seed: args.seed,
         scale: args.scale,
+        limits: args.limits,
     };
     let started = Instant::now();
     let s = stipple(&grey, &TileSet::embedded(), &settings).map_err(|e| e.to_string())?;
@@ -55,7 +58,7 @@ pub fn run(args: &StippleArgs) -> Result<(), String> {
         started.elapsed().as_secs_f64() * 1e3
     );
     // Rendered once: the tone figures and the PNG are of the same raster.
-    let ink = s.render(&s.dots, args.scale);
+    let ink = s.render(&s.dots, args.scale).map_err(|e| e.to_string())?;
     report_tone(&s, &grey, &ink, args.seed);
     write(&s, &ink, args.out, args.scale)?;
     say!("wrote {}", args.out.display());
@@ -87,39 +90,49 @@ fn report_tone(s: &Stipple, grey: &Grey, rendered: &Grey, seed: u64) {
     );
 }
 
-/// Writes the stipple as antialiased PNG (`ink`, its rendering) or as SVG circles.
+/// Writes the stipple as antialiased PNG (`ink`, its rendering) or as SVG circles,
+/// atomically: on any error an existing file keeps its bytes.
 fn write(s: &Stipple, ink: &Grey, out: &Path, scale: f64) -> Result<(), String> {
     let ext = out
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    let io = |e: String| format!("{}: {e}", out.display());
     if ext == "svg" {
-        let (w, h) = (s.target.width, s.target.height);
-        let mut svg = format!(
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 {w} {h}\" width=\"{}\" height=\"{}\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
-            w as f64 * scale,
-            h as f64 * scale
-        );
-        for p in &s.dots {
-            let _ = writeln!(
-                svg,
-                "<circle cx=\"{:.3}\" cy=\"{:.3}\" r=\"{:.3}\"/>",
-                p.x, p.y, s.radius
-            );
-        }
-        svg.push_str("</svg>\n");
-        std::fs::write(out, svg).map_err(|e| io(e.to_string()))
+        rwt_core::files::write_atomic_with(out, |w| write_svg(s, scale, w))
+            .map_err(|e| e.to_string())
     } else {
-        let pixels = ink
+        let pixels: Vec<u8> = ink
             .values
             .iter()
             .map(|&v| ((1.0 - v) * 255.0).round() as u8)
             .collect();
-        image::GrayImage::from_raw(ink.width as u32, ink.height as u32, pixels)
-            .ok_or_else(|| io("raster size".into()))?
-            .save(out)
-            .map_err(|e| io(e.to_string()))
+        crate::draw::save_png(
+            out,
+            &pixels,
+            ink.width as u32,
+            ink.height as u32,
+            image::ExtendedColorType::L8,
+        )
     }
+}
+
+/// The dots as SVG circles, streamed.
+fn write_svg(s: &Stipple, scale: f64, w: &mut dyn Write) -> std::io::Result<()> {
+    let (width, height) = (s.target.width, s.target.height);
+    writeln!(
+        w,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 {width} {height}\" width=\"{}\" height=\"{}\">",
+        width as f64 * scale,
+        height as f64 * scale
+    )?;
+    writeln!(w, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>")?;
+    for p in &s.dots {
+        writeln!(
+            w,
+            "<circle cx=\"{:.3}\" cy=\"{:.3}\" r=\"{:.3}\"/>",
+            p.x, p.y, s.radius
+        )?;
+    }
+    writeln!(w, "</svg>")
 }

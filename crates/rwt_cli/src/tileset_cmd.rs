@@ -4,7 +4,9 @@ use crate::draw::Canvas;
 use indicatif::{ProgressBar, ProgressStyle};
 use rwt_core::analysis::check::{base_prefix_rho, edge_violations, subdivision_prefix_rho};
 use rwt_core::construction::{BuildConfig, Progress, Stage, build};
-use rwt_core::tileset::{TileSet, fixed_to_unit};
+use rwt_core::files::{AtomicFile, read_limited};
+use rwt_core::tileset::{MAX_FILE_BYTES, TileSet, TileSetError, fixed_to_unit};
+use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
 use std::time::Instant;
@@ -44,12 +46,20 @@ pub fn build_cmd(out: &Path, config: BuildConfig) -> Result<(), String> {
     };
     let (set, report) = build(&config, &bars).map_err(|e| e.to_string())?;
     let text = set.to_ron();
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
-    std::fs::write(out, &text).map_err(|e| format!("{}: {e}", out.display()))?;
+    // Written atomically; through a link (assets/tilesets/default.ron points into rwt_core,
+    // whose embedded set it is), the file it points to is replaced and the link kept.
+    let mut file = AtomicFile::create(out).map_err(|e| e.to_string())?;
+    let target = file.target().to_path_buf();
+    file.write_all(text.as_bytes())
+        .map_err(|e| format!("{}: {e}", out.display()))?;
+    file.commit().map_err(|e| e.to_string())?;
+    let through = if target != out {
+        format!(" (a link to {})", target.display())
+    } else {
+        String::new()
+    };
     say!(
-        "built {} tiles x {} points (subdivision {}x{}) in {:.1} s -> {} ({:.1} MB)",
+        "built {} tiles x {} points (subdivision {}x{}) in {:.1} s -> {}{through} ({:.1} MB)",
         set.tiles.len(),
         set.points_per_tile,
         set.subdivision,
@@ -78,15 +88,18 @@ pub fn build_cmd(out: &Path, config: BuildConfig) -> Result<(), String> {
     Ok(())
 }
 
-/// Reads and validates a tile set file; the error names the file.
+/// Reads and validates a tile set file (at most [`MAX_FILE_BYTES`]); the error names the
+/// file.
 pub fn load(path: &Path) -> Result<TileSet, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    TileSet::from_ron_bytes(&bytes).map_err(|e| format!("{}: {e}", path.display()))
+    TileSet::read_file(path).map_err(|e| match e {
+        TileSetError::File(e) => e.to_string(),
+        e => format!("{}: {e}", path.display()),
+    })
 }
 
 /// `rwt tileset check`: returns whether the set is valid.
 pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let bytes = read_limited(path, MAX_FILE_BYTES).map_err(|e| e.to_string())?;
     let set = TileSet::from_ron_bytes_unchecked(&bytes).map_err(|e| e.to_string())?;
     let mut ok = true;
     say!("tile set        {}", path.display());
@@ -291,9 +304,7 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
             }
         }
     }
-    c.image
-        .save(out)
-        .map_err(|e| format!("{}: {e}", out.display()))?;
+    c.save(out)?;
     say!("wrote {}", out.display());
     Ok(())
 }

@@ -84,6 +84,7 @@ pub mod bench;
 #[cfg(feature = "build")]
 pub mod construction;
 pub mod density;
+pub mod files;
 mod geometry;
 pub mod query;
 pub mod rng;

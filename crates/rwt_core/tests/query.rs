@@ -275,6 +275,68 @@ fn far_from_the_origin_points_stay_exact_and_spaced() {
 }
 
 #[test]
+fn points_finer_than_positions_resolve_are_refused_before_any_is_produced() {
+    // At x = 9e11 a density of 1e9 per unit area asks for points 3.4e-5 apart, where f64
+    // positions step by 1.2e-4: 99 037 points landed on 6 724 distinct positions.
+    let s = sampler(1).with_budget(1_000_000);
+    let rect = Rect::new(DVec2::new(9e11, 0.0), DVec2::new(9e11 + 0.01, 0.01)).unwrap();
+    let mut emitted = 0;
+    let e = s.query_with(rect, &Constant(1e9), |_| emitted += 1);
+    let Err(QueryError::Precision {
+        spacing,
+        coordinate,
+        resolution,
+    }) = e
+    else {
+        panic!("{e:?}");
+    };
+    assert_eq!(emitted, 0);
+    assert!(
+        spacing < 4e-5 && coordinate >= 9e11 && resolution > 1e-4,
+        "{e:?}"
+    );
+    assert!(e.unwrap_err().to_string().contains("nearer the origin"));
+    // The same density near the origin, and a sparse one out there, are served, with
+    // distinct positions.
+    let near = Rect::new(DVec2::ZERO, DVec2::splat(0.01)).unwrap();
+    let mut out = Vec::new();
+    s.query(near, &Constant(1e9), &mut out).unwrap();
+    assert!(out.len() > 90_000, "{}", out.len());
+    let far = Rect::new(DVec2::new(9e11, 0.0), DVec2::new(9e11 + 64.0, 64.0)).unwrap();
+    out.clear();
+    s.query(far, &Constant(2.0), &mut out).unwrap();
+    let distinct: std::collections::HashSet<_> = out
+        .iter()
+        .map(|p| (p.position.x.to_bits(), p.position.y.to_bits()))
+        .collect();
+    assert!(
+        out.len() > 7_000 && distinct.len() == out.len(),
+        "{}",
+        out.len()
+    );
+    // A dense spot at the origin of a rectangle reaching 1e11 is served: only where the
+    // density is high must positions be fine.
+    let spot = rwt_core::density::DistanceFalloff {
+        inner: Constant(1e6),
+        centre: DVec2::ZERO,
+        near: 0.01,
+        far: 0.02,
+    };
+    let huge = Rect::new(DVec2::splat(-1e11), DVec2::splat(1e11)).unwrap();
+    // The work bound of such rectangles is refined until it fits the budget, and never
+    // below the spot's own (its running sum once cancelled to 0 at 1e9, 5.8e12 at 1e11).
+    let spot_alone = s.work_bound(&square(-0.05, 0.1), &spot);
+    for side in [1e3, 1e9, 1e11] {
+        let r = Rect::new(DVec2::splat(-side), DVec2::splat(side)).unwrap();
+        let bound = s.work_bound(&r, &spot);
+        assert!(bound >= spot_alone && bound <= 1e6, "{side}: {bound}");
+    }
+    out.clear();
+    s.query(huge, &spot, &mut out).unwrap();
+    assert!(out.len() > 300, "{}", out.len());
+}
+
+#[test]
 fn bad_input_gets_typed_errors() {
     let s = sampler(1).with_budget(100_000);
     assert_eq!(
@@ -588,6 +650,20 @@ fn parallel_queries_return_the_serial_points_in_the_serial_order() {
             assert_eq!(serial[..], parallel[sentinel.len()..], "{rect:?}");
             let runs = s.query_par_runs(*rect, density).unwrap();
             assert!(runs.concat() == serial, "{rect:?}");
+            let mut ordered = Vec::new();
+            let k = s
+                .query_par_ordered(
+                    *rect,
+                    density,
+                    <[Point]>::to_vec,
+                    |run| {
+                        ordered.extend(run);
+                        std::ops::ControlFlow::Continue(())
+                    },
+                    &|_| {},
+                )
+                .unwrap();
+            assert_eq!((k, &ordered), (n, &serial), "{rect:?}");
             empty += usize::from(n == 0);
         }
     }
@@ -620,10 +696,72 @@ fn a_density_that_panics_fails_the_parallel_query() {
         }));
         assert!(result.is_err());
     }
+    let ordered = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        s.query_par_ordered(
+            square(0.0, 100.0),
+            &fragile,
+            |r| r.len(),
+            |_| std::ops::ControlFlow::Continue(()),
+            &|_| {},
+        )
+    }));
+    assert!(ordered.is_err());
     // The pool is still usable afterwards.
     let mut out = Vec::new();
     s.query_par(square(0.0, 50.0), &fragile, &mut out).unwrap();
     assert!(!out.is_empty());
+}
+
+#[test]
+fn the_ordered_parallel_query_holds_few_blocks_and_stops_when_asked() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let s = sampler(4);
+    let rect = square(0.0, 400.0);
+    // Blocks mapped but not yet consumed: never more than the window ahead.
+    let (mapped, most) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let mut consumed = 0;
+    let n = s
+        .query_par_ordered(
+            rect,
+            &Constant(1.0),
+            |run| {
+                let ahead = mapped.fetch_add(1, Ordering::SeqCst) + 1;
+                most.fetch_max(ahead, Ordering::SeqCst);
+                run.len()
+            },
+            |len| {
+                mapped.fetch_sub(1, Ordering::SeqCst);
+                consumed += len;
+                std::ops::ControlFlow::Continue(())
+            },
+            &|_| {},
+        )
+        .unwrap();
+    assert_eq!(n, consumed);
+    assert!(n > 150_000, "{n}");
+    let window = 4 * rayon::current_num_threads();
+    // 2500 blocks of 8 x 8 tiles, at most a window of them in memory at once.
+    assert!(most.load(Ordering::SeqCst) <= window, "{most:?} > {window}");
+    // A consumer that stops after three blocks gets three.
+    let mut blocks = 0;
+    let m = s
+        .query_par_ordered(
+            rect,
+            &Constant(1.0),
+            |run| run.len(),
+            |_| {
+                blocks += 1;
+                if blocks == 3 {
+                    std::ops::ControlFlow::Break(())
+                } else {
+                    std::ops::ControlFlow::Continue(())
+                }
+            },
+            &|_| {},
+        )
+        .unwrap();
+    assert_eq!(blocks, 3);
+    assert!(m > 0 && m < n / 100, "{m}");
 }
 
 #[test]

@@ -265,3 +265,65 @@ fn loader_reports_what_is_wrong() {
     let e = TileSet::from_ron_bytes(bad_sequences.to_ron().as_bytes()).unwrap_err();
     assert!(e.to_string().contains("not unique"), "{e}");
 }
+
+#[test]
+fn coincident_points_are_rejected_in_linear_time() {
+    // Every point of every tile in one place, with subdivision rankings that keep the
+    // subset property: structurally valid, but no blue noise at all. `rwt tileset check`
+    // used to pass it ("OK", rho 0.000) after a quadratic nearest-neighbour search.
+    let mut set = TileSet::embedded();
+    let (cells, n) = ((set.subdivision as u32).pow(2), set.points_per_tile);
+    for tile in &mut set.tiles {
+        tile.points = vec![[0, 0]; n as usize];
+        tile.subdivision = (0..cells)
+            .flat_map(|cell| (0..n).map(move |k| cell << 16 | k))
+            .collect();
+    }
+    let e = TileSet::from_ron_bytes(set.to_ron().as_bytes()).unwrap_err();
+    assert!(
+        matches!(e, TileSetError::Crowded { tile: 0, rho, .. } if rho == 0.0),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("coincident or crowded"), "{e}");
+    // The shipped set's closest points keep well clear of the limit.
+    let shipped = TileSet::embedded();
+    let spacing = hex_spacing(shipped.points_per_tile as f64);
+    let worst = shipped
+        .tiles
+        .iter()
+        .map(|t| {
+            let pts: Vec<DVec2> = t
+                .points
+                .iter()
+                .map(|p| DVec2::new(fixed_to_unit(p[0]), fixed_to_unit(p[1])))
+                .collect();
+            rwt_core::analysis::min_distance(&pts).unwrap() / spacing
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(worst > 3.0 * rwt_core::tileset::MIN_TILE_RHO, "{worst}");
+}
+
+#[test]
+fn tile_set_files_are_read_within_a_size_limit() {
+    use rwt_core::files::FileError;
+    let dir = std::env::temp_dir().join(format!("rwt-tileset-limit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("set.ron");
+    let text = TileSet::embedded().to_ron();
+    std::fs::write(&path, &text).unwrap();
+    assert!(TileSet::read_file(&path).is_ok());
+    let limit = text.len() as u64 - 1;
+    assert_eq!(
+        TileSet::read_file_with_limit(&path, limit),
+        Err(TileSetError::File(FileError::TooLarge {
+            path: path.clone(),
+            limit
+        }))
+    );
+    #[cfg(unix)]
+    assert!(matches!(
+        TileSet::read_file_with_limit(std::path::Path::new("/dev/zero"), 1 << 20),
+        Err(TileSetError::File(FileError::TooLarge { .. }))
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

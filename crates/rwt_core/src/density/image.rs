@@ -3,6 +3,14 @@
 
 use super::Density;
 use glam::DVec2;
+use std::io::{BufRead, Seek};
+use std::path::Path;
+
+/// Most pixels an image may have to be decoded by [`decode_image`] and [`open_image`]:
+/// 2^26 (8192 x 8192). Checked from the image's header, before its pixels are decoded; a
+/// density of that many pixels takes about 1 GB. Pass a larger limit to
+/// [`decode_image_with_limit`] or [`open_image_with_limit`] to read larger images.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 
 /// A painted density map: one channel of an image, bilinearly interpolated over a world
 /// rectangle, times `scale` (points per unit area at value 1). Zero outside the rectangle.
@@ -40,6 +48,84 @@ pub enum ImageDensityError {
     /// The bytes are not an image this build can decode.
     #[error("cannot decode image: {0}")]
     Decode(String),
+    /// The image's header announces more pixels than the limit (nothing was decoded).
+    #[error(
+        "image of {width}x{height} pixels is over the limit of {limit} pixels \
+         (decode_image_with_limit reads larger images; a density takes about 16 bytes a pixel)"
+    )]
+    TooManyPixels {
+        /// Width in the header.
+        width: u32,
+        /// Height in the header.
+        height: u32,
+        /// The limit.
+        limit: u64,
+    },
+    /// The image file could not be read.
+    #[error("cannot read image: {0}")]
+    Read(String),
+}
+
+/// Decodes image bytes (any format this build of `image` reads) of at most
+/// [`MAX_IMAGE_PIXELS`] pixels.
+pub fn decode_image(bytes: &[u8]) -> Result<image::DynamicImage, ImageDensityError> {
+    decode_image_with_limit(bytes, MAX_IMAGE_PIXELS)
+}
+
+/// Decodes image bytes of at most `max_pixels` pixels: the header is read first, and a
+/// larger image is refused before any pixel is decoded.
+pub fn decode_image_with_limit(
+    bytes: &[u8],
+    max_pixels: u64,
+) -> Result<image::DynamicImage, ImageDensityError> {
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| ImageDensityError::Decode(e.to_string()))
+    };
+    decode_limited(reader, max_pixels)
+}
+
+/// Opens and decodes an image file of at most [`MAX_IMAGE_PIXELS`] pixels, streaming from
+/// the file (its bytes are never held whole).
+pub fn open_image(path: &Path) -> Result<image::DynamicImage, ImageDensityError> {
+    open_image_with_limit(path, MAX_IMAGE_PIXELS)
+}
+
+/// [`open_image`] with another pixel limit.
+pub fn open_image_with_limit(
+    path: &Path,
+    max_pixels: u64,
+) -> Result<image::DynamicImage, ImageDensityError> {
+    let reader = || {
+        image::ImageReader::open(path)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| ImageDensityError::Read(e.to_string()))
+    };
+    decode_limited(reader, max_pixels)
+}
+
+/// Reads the header through one reader, then decodes through another when the size is
+/// within the limit.
+fn decode_limited<R: BufRead + Seek>(
+    reader: impl Fn() -> Result<image::ImageReader<R>, ImageDensityError>,
+    max_pixels: u64,
+) -> Result<image::DynamicImage, ImageDensityError> {
+    let decode_err = |e: image::ImageError| ImageDensityError::Decode(e.to_string());
+    let (width, height) = reader()?.into_dimensions().map_err(decode_err)?;
+    if width as u64 * height as u64 > max_pixels {
+        return Err(ImageDensityError::TooManyPixels {
+            width,
+            height,
+            limit: max_pixels,
+        });
+    }
+    let mut r = reader()?;
+    let mut limits = image::Limits::default();
+    // Room for the largest pixel format (16-bit RGBA) of an image within the limit.
+    limits.max_alloc = Some((width as u64 * height as u64 * 8).max(512 << 20));
+    r.limits(limits);
+    r.decode().map_err(decode_err)
 }
 
 impl ImageDensity {
@@ -89,8 +175,9 @@ impl ImageDensity {
         })
     }
 
-    /// From an image: `channel` 0..=3 of its RGBA form, or the luma when `None`. With
-    /// `invert`, dark pixels are dense (for stippling).
+    /// From an image: `channel` 0..=3 of its RGBA form, or its luma times its alpha when
+    /// `None` (a transparent pixel has no density, as painters expect). With `invert`, dark
+    /// pixels are dense (for stippling): `(1 - luma)` times alpha.
     pub fn from_image(
         image: &image::DynamicImage,
         channel: Option<usize>,
@@ -103,19 +190,30 @@ impl ImageDensity {
         if w == 0 || h == 0 || w > 32_768 || h > 32_768 {
             return Err(ImageDensityError::Size(w, h));
         }
+        let tone = |v: f32| if invert { 1.0 - v } else { v };
         let values: Vec<f32> = match channel {
-            None => image.to_luma32f().into_raw(),
-            Some(c) => image.to_rgba32f().pixels().map(|p| p.0[c.min(3)]).collect(),
-        };
-        let values: Vec<f32> = if invert {
-            values.iter().map(|v| 1.0 - v).collect()
-        } else {
-            values
+            None if image.color().has_alpha() => image
+                .to_luma_alpha32f()
+                .pixels()
+                .map(|p| tone(p.0[0]) * p.0[1])
+                .collect(),
+            None => image
+                .to_luma32f()
+                .into_raw()
+                .into_iter()
+                .map(tone)
+                .collect(),
+            Some(c) => image
+                .to_rgba32f()
+                .pixels()
+                .map(|p| tone(p.0[c.min(3)]))
+                .collect(),
         };
         Self::from_values(w, h, &values, origin, size, scale)
     }
 
-    /// Decodes image bytes (any format this build of `image` supports) into a density.
+    /// Decodes image bytes (any format this build of `image` supports, at most
+    /// [`MAX_IMAGE_PIXELS`] pixels) into a density (see [`ImageDensity::from_image`]).
     pub fn from_bytes(
         bytes: &[u8],
         invert: bool,
@@ -123,8 +221,7 @@ impl ImageDensity {
         size: DVec2,
         scale: f64,
     ) -> Result<Self, ImageDensityError> {
-        let img =
-            image::load_from_memory(bytes).map_err(|e| ImageDensityError::Decode(e.to_string()))?;
+        let img = decode_image(bytes)?;
         Self::from_image(&img, None, invert, origin, size, scale)
     }
 

@@ -196,3 +196,96 @@ fn bad_values_are_sanitized_or_rejected() {
         ImageDensity::from_bytes(b"not an image", false, DVec2::ZERO, DVec2::ONE, 1.0).is_err()
     );
 }
+
+/// CRC-32 (PNG's) of `bytes`.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 == 1 {
+                0xedb8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
+
+/// A PNG's signature, header chunk and an empty data chunk, announcing `width x height` grey pixels: enough for a
+/// reader of headers.
+fn png_header(width: u32, height: u32) -> Vec<u8> {
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend(width.to_be_bytes());
+    ihdr.extend(height.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]);
+    png.extend(13u32.to_be_bytes());
+    png.extend(&ihdr);
+    png.extend(crc32(&ihdr).to_be_bytes());
+    // An empty data chunk: readers stop reading the header there.
+    png.extend(0u32.to_be_bytes());
+    png.extend(b"IDAT");
+    png.extend(crc32(b"IDAT").to_be_bytes());
+    png
+}
+
+#[test]
+fn images_over_the_pixel_limit_are_refused_from_their_header() {
+    let huge = png_header(20_000, 20_000);
+    let e = ImageDensity::from_bytes(&huge, false, DVec2::ZERO, DVec2::ONE, 1.0).unwrap_err();
+    assert_eq!(
+        e,
+        ImageDensityError::TooManyPixels {
+            width: 20_000,
+            height: 20_000,
+            limit: MAX_IMAGE_PIXELS
+        }
+    );
+    assert!(e.to_string().contains("decode_image_with_limit"), "{e}");
+    // Within a raised limit the header passes and decoding is tried (this one has no
+    // pixel data, so it fails there).
+    assert!(matches!(
+        decode_image_with_limit(&huge, 400_000_000),
+        Err(ImageDensityError::Decode(_))
+    ));
+    let e = open_image(std::path::Path::new("/does/not/exist.png")).unwrap_err();
+    assert!(matches!(e, ImageDensityError::Read(_)), "{e:?}");
+}
+
+#[test]
+fn transparent_pixels_have_no_density() {
+    // Four pixels: opaque white, transparent white, half-transparent white, opaque black.
+    let mut rgba = ::image::RgbaImage::new(4, 1);
+    for (x, px) in [
+        [255, 255, 255, 255],
+        [255, 255, 255, 0],
+        [255, 255, 255, 128],
+        [0, 0, 0, 255],
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        rgba.put_pixel(x as u32, 0, ::image::Rgba(px));
+    }
+    let img = ::image::DynamicImage::ImageRgba8(rgba);
+    let at = |d: &ImageDensity, x: f64| d.value(DVec2::new(x + 0.5, 0.5));
+    let light = ImageDensity::from_image(&img, None, false, DVec2::ZERO, DVec2::new(4.0, 1.0), 1.0)
+        .unwrap();
+    assert!((at(&light, 0.0) - 1.0).abs() < 1e-6);
+    assert_eq!(at(&light, 1.0), 0.0);
+    assert!((at(&light, 2.0) - 128.0 / 255.0).abs() < 1e-6);
+    assert_eq!(at(&light, 3.0), 0.0);
+    // Dark pixels dense (`dark:`), transparent ones still empty.
+    let dark =
+        ImageDensity::from_image(&img, None, true, DVec2::ZERO, DVec2::new(4.0, 1.0), 1.0).unwrap();
+    assert_eq!(at(&dark, 1.0), 0.0);
+    assert!((at(&dark, 3.0) - 1.0).abs() < 1e-6);
+    // An explicit channel is that channel: the alpha channel itself here.
+    let alpha =
+        ImageDensity::from_image(&img, Some(3), false, DVec2::ZERO, DVec2::new(4.0, 1.0), 1.0)
+            .unwrap();
+    assert_eq!(at(&alpha, 1.0), 0.0);
+    assert!((at(&alpha, 0.0) - 1.0).abs() < 1e-6);
+}

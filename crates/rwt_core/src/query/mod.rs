@@ -43,6 +43,12 @@ pub const MAX_LEVEL: u32 = 24;
 /// every level inside `i64`).
 pub const MAX_TILE_COORDINATE: f64 = 1.0e12;
 
+/// Fewest steps between adjacent `f64` values a point spacing must span where a query's
+/// points lie: rounding then moves a point by at most 1/512 of the spacing, which leaves
+/// every spacing statistic as it is. Denser points far from the origin are
+/// [`QueryError::Precision`].
+pub const MIN_SPACING_ULPS: f64 = 256.0;
+
 /// Hash stream of the per-base-tile rank offsets.
 const OFFSET_STREAM: u64 = 0x0ff5_e7a1_u64;
 
@@ -62,6 +68,22 @@ pub enum QueryError {
     TooFar {
         /// Distance in base tiles.
         tiles: f64,
+    },
+    /// The density asks for points closer together than `f64` positions resolve at the
+    /// rectangle's coordinates (see [`MIN_SPACING_ULPS`]): they would collapse onto a few
+    /// distinct positions. Query nearer the origin, or at a lower density.
+    #[error(
+        "points would be {spacing:.3e} apart near coordinate {coordinate:.3e}, where positions \
+         resolve only {resolution:.3e} ({MIN_SPACING_ULPS} steps per spacing are needed): \
+         query nearer the origin or lower the density"
+    )]
+    Precision {
+        /// The spacing of the densest points, in world units.
+        spacing: f64,
+        /// The largest coordinate magnitude where they would be.
+        coordinate: f64,
+        /// The step between adjacent `f64` values there.
+        resolution: f64,
     },
     /// The query asks for more points, or spans more base tiles of positive density, than
     /// the budget allows (see [`Sampler::work_bound`]).
@@ -190,6 +212,13 @@ impl Sampler {
         Ok(count)
     }
 
+    /// The checks every query of `rect` for `density` makes before producing a point
+    /// (coordinates, budget, precision), alone: a tool calls it before it opens an output,
+    /// so that a refused query leaves existing files as they were.
+    pub fn admits<D: Density + ?Sized>(&self, rect: &Rect, density: &D) -> Result<(), QueryError> {
+        self.admit(rect, density).map(|_| ())
+    }
+
     /// Checks a query against the coordinate limit and the budget; returns the base tiles
     /// it spans (`None` for an empty rectangle).
     fn admit<D: Density + ?Sized>(
@@ -205,6 +234,7 @@ impl Sampler {
                 budget: self.budget,
             });
         }
+        self.check_precision(rect, density)?;
         if rect.is_empty() {
             return Ok(None);
         }

@@ -2,15 +2,20 @@
 //! planned in its order (its splits and its pruning by density bounds), then taken on
 //! rayon's thread pool. [`Sampler::query_par_runs`] returns each block's points as a run;
 //! [`Sampler::query_par`] keeps each block's points compactly and builds them into the
-//! output in order while later blocks are still being computed. Either way the points are
-//! exactly the serial query's, in exactly its order.
+//! output in order while later blocks are still being computed; [`Sampler::query_par_ordered`]
+//! hands each block's points, mapped on the pool, to the caller in order with a bounded
+//! number of blocks in flight, so that writing a file takes as little memory as the serial
+//! query. Either way the points are exactly the serial query's, in exactly its order.
 
 use super::prepared::CellPoint;
 use super::traversal::{Frame, LEAF_BLOCK, Sink, Visit};
 use super::{Point, QueryError, Rect, Sampler, TileRange};
 use crate::density::{Density, sanitize};
 use glam::DVec2;
+use std::collections::BTreeMap;
+use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::sync::{Mutex, OnceLock};
 
 impl Sampler {
@@ -73,6 +78,143 @@ impl Sampler {
         let fork = Fork::new(self, rect, density, progress, &range);
         let blocks = fork.plan(range, LEAF_BLOCK as usize);
         Ok(fork.runs(&blocks))
+    }
+}
+
+/// Blocks computed ahead of the one [`Sampler::query_par_ordered`] hands over, per pool thread.
+const BLOCKS_AHEAD_PER_THREAD: usize = 4;
+
+impl Sampler {
+    /// The points of [`Sampler::query`], in its order, computed on rayon's pool a block of
+    /// base tiles at a time: `map` turns a block's points into what the caller keeps
+    /// (formatted lines, a GPU buffer) on the pool, and `consume` receives the results in
+    /// order on the calling thread; returning `Break` stops the query. At most four blocks
+    /// per pool thread are computed ahead of the one being consumed, so memory stays bounded
+    /// however many points the query yields. `progress` is called from the pool with the
+    /// fraction of base tiles done. Returns how many points were consumed.
+    ///
+    /// ```
+    /// use glam::DVec2;
+    /// use std::ops::ControlFlow;
+    /// use rwt_core::{Constant, Rect, Sampler, TileSet};
+    ///
+    /// let sampler = Sampler::new(&TileSet::embedded(), 3);
+    /// let rect = Rect::new(DVec2::ZERO, DVec2::splat(100.0)).unwrap();
+    /// let mut text = String::new();
+    /// let lines = |run: &[rwt_core::Point]| -> String {
+    ///     run.iter().map(|p| format!("{} {}\n", p.position.x, p.position.y)).collect()
+    /// };
+    /// let n = sampler
+    ///     .query_par_ordered(rect, &Constant(2.0), lines, |t| {
+    ///         text.push_str(&t);
+    ///         ControlFlow::Continue(())
+    ///     }, &|_| {})
+    ///     .unwrap();
+    /// assert_eq!(text.lines().count(), n);
+    /// ```
+    pub fn query_par_ordered<D, T, M, C>(
+        &self,
+        rect: Rect,
+        density: &D,
+        map: M,
+        mut consume: C,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<usize, QueryError>
+    where
+        D: Density + Sync + ?Sized,
+        T: Send,
+        M: Fn(&[Point]) -> T + Sync,
+        C: FnMut(T) -> ControlFlow<()>,
+    {
+        let Some(range) = self.admit(&rect, density)? else {
+            progress(1.0);
+            return Ok(0);
+        };
+        let fork = Fork::new(self, rect, density, progress, &range);
+        let blocks = fork.plan(range, LEAF_BLOCK as usize);
+        let ahead = BLOCKS_AHEAD_PER_THREAD * rayon::current_num_threads().max(1);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        let stop = AtomicBool::new(false);
+        let mut count = 0;
+        rayon::in_place_scope_fifo(|scope| {
+            let spawn = |i: usize| {
+                let (sender, fork, map, stop) = (sender.clone(), &fork, &map, &stop);
+                let block = blocks[i];
+                scope.spawn_fifo(move |_| {
+                    let unwinding = SendOnUnwind(&sender, i);
+                    let done = (!stop.load(Ordering::Relaxed)).then(|| {
+                        let points = fork.points(block);
+                        fork.progress.finished(&block);
+                        (points.len(), map(&points))
+                    });
+                    let _ = sender.send((i, done));
+                    std::mem::forget(unwinding);
+                });
+            };
+            (0..blocks.len().min(ahead)).for_each(spawn);
+            let mut waiting = BTreeMap::new();
+            for i in 0..blocks.len() {
+                match next_in_order(&receiver, &mut waiting, i) {
+                    Some((n, t)) => {
+                        count += n;
+                        if consume(t).is_break() {
+                            break;
+                        }
+                    }
+                    // A block's task unwound (its density panicked): the scope re-raises it.
+                    None => break,
+                }
+                if i + ahead < blocks.len() {
+                    spawn(i + ahead);
+                }
+            }
+            stop.store(true, Ordering::Relaxed);
+        });
+        Ok(count)
+    }
+}
+
+/// Tells the consumer of [`Sampler::query_par_ordered`] that block `.1`'s task unwound, so
+/// that it stops waiting for it (forgotten when the task ends normally).
+struct SendOnUnwind<'a, T>(&'a Sender<(usize, Option<T>)>, usize);
+
+impl<T> Drop for SendOnUnwind<'_, T> {
+    fn drop(&mut self) {
+        let _ = self.0.send((self.1, None));
+    }
+}
+
+/// The result of block `i`, from `waiting` or from the channel (keeping the blocks that
+/// arrive early). A pool thread takes pool work while it waits, instead of blocking a
+/// thread the blocks may need.
+fn next_in_order<T>(
+    receiver: &Receiver<(usize, Option<T>)>,
+    waiting: &mut BTreeMap<usize, Option<T>>,
+    i: usize,
+) -> Option<T> {
+    let on_pool = rayon::current_thread_index().is_some();
+    loop {
+        if let Some(done) = waiting.remove(&i) {
+            return done;
+        }
+        let (j, done) = if on_pool {
+            match receiver.try_recv() {
+                Ok(message) => message,
+                Err(TryRecvError::Empty) => {
+                    if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                        std::thread::yield_now();
+                    }
+                    continue;
+                }
+                Err(TryRecvError::Disconnected) => return None,
+            }
+        } else {
+            match receiver.recv() {
+                Ok(message) => message,
+                Err(_) => return None,
+            }
+        };
+        waiting.insert(j, done);
     }
 }
 

@@ -1,7 +1,9 @@
-//! The work bound that lets a query refuse, up front, what it could not finish.
+//! The bounds that let a query refuse, up front, what it could not finish: its work, and
+//! point spacings finer than positions resolve.
 
-use super::{MAX_LEVEL, Rect, Sampler};
+use super::{MAX_LEVEL, MIN_SPACING_ULPS, QueryError, Rect, Sampler};
 use crate::density::{Density, sanitize};
+use crate::geometry::hex_spacing;
 use glam::DVec2;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -68,6 +70,11 @@ impl Sampler {
                     heap.push(Cell(qb, q));
                 }
             }
+            // Taking a cell that held most of the total off a running sum cancels what the
+            // small cells added (a 1e9-wide rectangle summed to 0): sum them afresh.
+            if b > 0.5 * total {
+                total = heap.iter().map(|c| c.0).sum();
+            }
         }
         total.max(0.0)
     }
@@ -90,5 +97,69 @@ impl Sampler {
         let size = r.size();
         let tiles = (size.x / s_deep + 2.0) * (size.y / s_deep + 2.0);
         d * r.area() + 2.0 * tiles
+    }
+}
+
+/// Where a part of a query stands against the precision of `f64` positions.
+struct Resolution {
+    /// Spacing of points at the part's largest density.
+    spacing: f64,
+    /// Largest coordinate magnitude in the part.
+    coordinate: f64,
+    /// The `f64` step there (an upper bound: `coordinate * EPSILON`).
+    step: f64,
+}
+
+impl Resolution {
+    fn of<D: Density + ?Sized>(r: &Rect, density: &D) -> Option<Self> {
+        let d = sanitize(density.max_over(r.min(), r.max()));
+        if d.is_nan() || d <= 0.0 {
+            return None;
+        }
+        let coordinate = r.min().abs().max(r.max().abs()).max_element();
+        Some(Self {
+            spacing: hex_spacing(d),
+            coordinate,
+            step: (coordinate * f64::EPSILON).max(f64::MIN_POSITIVE),
+        })
+    }
+
+    fn resolved(&self) -> bool {
+        self.spacing >= MIN_SPACING_ULPS * self.step
+    }
+}
+
+impl Sampler {
+    /// Refuses a query whose densest points would be closer than [`MIN_SPACING_ULPS`] steps
+    /// of `f64` at their coordinates. One density bound decides almost every query; a
+    /// rectangle that fails as a whole is split where it fails (up to 4096 bounds), so a
+    /// dense spot near the origin of a huge sparse rectangle is served.
+    pub(super) fn check_precision<D: Density + ?Sized>(
+        &self,
+        rect: &Rect,
+        density: &D,
+    ) -> Result<(), QueryError> {
+        let mut failing = Vec::new();
+        match Resolution::of(rect, density) {
+            Some(r) if !r.resolved() => failing.push((*rect, r)),
+            _ => return Ok(()),
+        }
+        let mut evaluations = 1;
+        while let Some((cell, worst)) = failing.pop() {
+            if evaluations >= MAX_EVALUATIONS || cell.is_empty() {
+                return Err(QueryError::Precision {
+                    spacing: worst.spacing,
+                    coordinate: worst.coordinate,
+                    resolution: worst.step,
+                });
+            }
+            for q in quadrants(&cell) {
+                evaluations += 1;
+                if let Some(r) = Resolution::of(&q, density).filter(|r| !r.resolved()) {
+                    failing.push((q, r));
+                }
+            }
+        }
+        Ok(())
     }
 }

@@ -18,6 +18,26 @@ pub struct Grey {
 const SUPERSAMPLE: usize = 4;
 
 impl Grey {
+    /// The grey levels of an image (its luma, 0 black .. 1 white), transparent pixels
+    /// composited over white: a transparent pixel is paper, with no ink.
+    pub fn from_image(image: &image::DynamicImage) -> Self {
+        let (width, height) = (image.width() as usize, image.height() as usize);
+        let values = if image.color().has_alpha() {
+            image
+                .to_luma_alpha32f()
+                .pixels()
+                .map(|p| 1.0 - (1.0 - p.0[0]) * p.0[1])
+                .collect()
+        } else {
+            image.to_luma32f().into_raw()
+        };
+        Self {
+            width,
+            height,
+            values,
+        }
+    }
+
     /// A raster of one value.
     pub fn filled(width: usize, height: usize, value: f32) -> Self {
         Self {
@@ -145,6 +165,19 @@ fn blur_pass(v: &[f32], w: usize, h: usize, kernel: &[f32], along_x: bool) -> Ve
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn transparent_pixels_are_white_paper() {
+        let mut rgba = image::RgbaImage::new(3, 1);
+        rgba.put_pixel(0, 0, image::Rgba([0, 0, 0, 255]));
+        rgba.put_pixel(1, 0, image::Rgba([0, 0, 0, 0]));
+        rgba.put_pixel(2, 0, image::Rgba([0, 0, 0, 51]));
+        let g = Grey::from_image(&image::DynamicImage::ImageRgba8(rgba));
+        assert_eq!((g.width, g.height), (3, 1));
+        assert_eq!(g.values[0], 0.0);
+        assert_eq!(g.values[1], 1.0);
+        assert!((g.values[2] - 0.8).abs() < 1e-6, "{}", g.values[2]);
+    }
 
     #[test]
     fn a_dot_covers_its_area() {

@@ -1,0 +1,551 @@
+//! Files a user keeps: written atomically, alone or several together, and read within a
+//! size limit.
+//!
+//! A write never truncates the file it replaces: [`AtomicFile`] writes a temporary file in
+//! the same folder, flushes and syncs it, and renames it over the target, so on any error (a
+//! full disk, a failing writer, a crash) the target keeps its previous bytes and the
+//! temporary file is removed. A link is followed: the file it points to is replaced and the
+//! link stays a link.
+//!
+//! [`SaveTransaction`] commits several files of one folder all-or-nothing: each is staged
+//! as a temporary file; only when every one is written and synced does a journal naming
+//! them make the save durable, and the renames follow. A failure while staging leaves every
+//! previous file as it was; a crash after the journal is finished by [`recover`] (which
+//! [`SaveTransaction::begin`] calls), so a reader never sees half of a save. One writer per
+//! folder at a time.
+//!
+//! ```
+//! use std::io::Write;
+//! let dir = std::env::temp_dir().join(format!("rwt-files-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir).unwrap();
+//! let path = dir.join("points.txt");
+//! rwt_core::files::write_atomic(&path, b"1 2\n").unwrap();
+//! // A writer that fails part-way leaves the previous file as it was.
+//! let failed = rwt_core::files::write_atomic_with(&path, |w| {
+//!     w.write_all(b"3 4\n")?;
+//!     Err(std::io::Error::other("disk full"))
+//! });
+//! assert!(failed.is_err());
+//! assert_eq!(std::fs::read(&path).unwrap(), b"1 2\n");
+//! # std::fs::remove_dir_all(&dir).unwrap();
+//! ```
+
+use serde::{Deserialize, Serialize};
+use std::fs::File;
+use std::io::{self, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Ends the names of temporary files (`.NAME.PID-N.rwt-tmp`).
+pub const TEMP_SUFFIX: &str = ".rwt-tmp";
+
+/// The journal of a [`SaveTransaction`] whose renames are under way.
+pub const JOURNAL_FILE: &str = ".rwt-commit.ron";
+
+/// What was being done to a file when it failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileAction {
+    /// Creating a folder or a temporary file.
+    Create,
+    /// Writing, flushing or syncing.
+    Write,
+    /// Renaming the temporary file over the target.
+    Rename,
+    /// Opening or reading.
+    Read,
+}
+
+impl std::fmt::Display for FileAction {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            FileAction::Create => "create",
+            FileAction::Write => "write",
+            FileAction::Rename => "replace",
+            FileAction::Read => "read",
+        })
+    }
+}
+
+/// Why a file could not be written or read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum FileError {
+    /// The operating system refused.
+    #[error("{}: cannot {action}: {reason}", path.display())]
+    Io {
+        /// The file (the target, not its temporary file).
+        path: PathBuf,
+        /// What was being done.
+        action: FileAction,
+        /// The kind of error.
+        kind: io::ErrorKind,
+        /// The operating system's words.
+        reason: String,
+    },
+    /// The file holds more bytes than the reader accepts.
+    #[error("{}: more than {limit} bytes, over the limit for this kind of file", path.display())]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// The limit in bytes.
+        limit: u64,
+    },
+    /// A transaction was asked to write one file twice.
+    #[error("{}: written twice in one save", path.display())]
+    Duplicate {
+        /// The file.
+        path: PathBuf,
+    },
+}
+
+impl FileError {
+    /// An I/O error on `path` while doing `action`.
+    pub fn io(path: &Path, action: FileAction, error: &io::Error) -> Self {
+        FileError::Io {
+            path: path.to_path_buf(),
+            action,
+            kind: error.kind(),
+            reason: error.to_string(),
+        }
+    }
+}
+
+/// The file a write to `path` replaces: the target of a link (followed to the end), else
+/// `path` itself.
+fn resolve_target(path: &Path) -> PathBuf {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(path).unwrap_or_else(|_| {
+            // A dangling link: write where it points.
+            std::fs::read_link(path)
+                .map(|t| path.parent().unwrap_or(Path::new("")).join(t))
+                .unwrap_or_else(|_| path.to_path_buf())
+        }),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// A temporary file name beside `target`, unique within this process.
+fn temp_beside(target: &Path) -> PathBuf {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    target.with_file_name(format!(".{name}.{}-{n}{TEMP_SUFFIX}", std::process::id()))
+}
+
+/// Syncs a folder, so that renames in it survive a crash (best effort: not every system
+/// opens folders as files).
+fn sync_dir(dir: &Path) {
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    if let Ok(d) = File::open(dir) {
+        let _ = d.sync_all();
+    }
+}
+
+/// A file being written in place of another: bytes go to a temporary file beside the
+/// target, which [`AtomicFile::commit`] renames over it. Dropped without a commit (an error
+/// on the way), the temporary file is removed and the target is untouched.
+pub struct AtomicFile {
+    target: PathBuf,
+    /// What the error messages name: the path the caller gave.
+    shown: PathBuf,
+    temp: PathBuf,
+    file: Option<BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Starts replacing `path` (creating its folder when missing).
+    pub fn create(path: &Path) -> Result<Self, FileError> {
+        let target = resolve_target(path);
+        if let Some(dir) = target.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| FileError::io(dir, FileAction::Create, &e))?;
+        }
+        let temp = temp_beside(&target);
+        let file = File::options()
+            .write(true)
+            .create_new(true)
+            .open(&temp)
+            .map_err(|e| FileError::io(path, FileAction::Create, &e))?;
+        Ok(Self {
+            target,
+            shown: path.to_path_buf(),
+            temp,
+            file: Some(BufWriter::with_capacity(1 << 16, file)),
+        })
+    }
+
+    /// The file this replaces (a link's target when `path` was a link).
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Flushes and syncs the temporary file and leaves it in place, not renamed.
+    fn finish(&mut self) -> Result<(), FileError> {
+        let shown = &self.shown;
+        let writer = self.file.take().expect("not finished twice");
+        let file = writer
+            .into_inner()
+            .map_err(|e| FileError::io(shown, FileAction::Write, e.error()))?;
+        file.sync_all()
+            .map_err(|e| FileError::io(shown, FileAction::Write, &e))
+    }
+
+    /// Makes the new bytes the target's: flush, sync, rename over the target, sync the
+    /// folder. On error the target is untouched and the temporary file removed.
+    pub fn commit(mut self) -> Result<(), FileError> {
+        self.finish()?;
+        std::fs::rename(&self.temp, &self.target)
+            .map_err(|e| FileError::io(&self.shown, FileAction::Rename, &e))?;
+        // Renamed: nothing left for `drop` to remove.
+        self.temp = PathBuf::new();
+        sync_dir(self.target.parent().unwrap_or(Path::new("")));
+        Ok(())
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        match &mut self.file {
+            Some(f) => f.write(buf),
+            None => Err(io::Error::other("file already committed")),
+        }
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        match &mut self.file {
+            Some(f) => f.flush(),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        // Uncommitted: the writer's buffer is discarded with it, then the file removed.
+        if let Some(writer) = self.file.take() {
+            let (file, _) = writer.into_parts();
+            drop(file);
+        }
+        if !self.temp.as_os_str().is_empty() {
+            let _ = std::fs::remove_file(&self.temp);
+        }
+    }
+}
+
+/// Replaces `path` by `bytes` atomically (see [`AtomicFile`]).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    write_atomic_with(path, |w| w.write_all(bytes))
+}
+
+/// Replaces `path` by what `write` writes, atomically: when `write` fails, the file keeps
+/// its previous bytes (see [`AtomicFile`]).
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> Result<(), FileError> {
+    let mut file = AtomicFile::create(path)?;
+    write(&mut file).map_err(|e| FileError::io(path, FileAction::Write, &e))?;
+    file.commit()
+}
+
+/// Reads a whole file of at most `limit` bytes: a larger one (or an endless device such as
+/// `/dev/zero`) is [`FileError::TooLarge`] after reading at most `limit + 1` bytes.
+pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FileError> {
+    let read_err = |e: io::Error| FileError::io(path, FileAction::Read, &e);
+    let file = File::open(path).map_err(read_err)?;
+    let too_large = || FileError::TooLarge {
+        path: path.to_path_buf(),
+        limit,
+    };
+    let len = file.metadata().map(|m| m.len()).unwrap_or(0);
+    if len > limit {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(read_err)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large());
+    }
+    Ok(bytes)
+}
+
+/// One staged file of a transaction: its temporary name and its name, in the folder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct Staged {
+    temp: String,
+    name: String,
+}
+
+/// Several files of one folder written all-or-nothing (see the [module](self) docs).
+///
+/// ```
+/// use rwt_core::files::SaveTransaction;
+/// let dir = std::env::temp_dir().join(format!("rwt-save-doc-{}", std::process::id()));
+/// let mut save = SaveTransaction::begin(&dir).unwrap();
+/// save.write("map.png", b"...").unwrap();
+/// save.write("index.ron", b"(maps: [\"map.png\"])").unwrap();
+/// save.commit().unwrap();
+/// assert_eq!(std::fs::read(dir.join("map.png")).unwrap(), b"...");
+/// # std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub struct SaveTransaction {
+    dir: PathBuf,
+    staged: Vec<Staged>,
+}
+
+impl SaveTransaction {
+    /// Starts a save into `dir` (created when missing), first finishing a save a crash
+    /// interrupted there (see [`recover`]).
+    pub fn begin(dir: &Path) -> Result<Self, FileError> {
+        std::fs::create_dir_all(dir).map_err(|e| FileError::io(dir, FileAction::Create, &e))?;
+        recover(dir)?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            staged: Vec::new(),
+        })
+    }
+
+    /// The folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Stages `bytes` as the file `name` of the folder.
+    pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<(), FileError> {
+        self.write_with(name, |w| w.write_all(bytes))
+    }
+
+    /// Stages what `write` writes as the file `name` of the folder; nothing of the folder's
+    /// files changes before [`SaveTransaction::commit`].
+    pub fn write_with(
+        &mut self,
+        name: &str,
+        write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+    ) -> Result<(), FileError> {
+        let path = self.dir.join(name);
+        if self.staged.iter().any(|s| s.name == name) {
+            return Err(FileError::Duplicate { path });
+        }
+        let mut file = AtomicFile::create(&path)?;
+        write(&mut file).map_err(|e| FileError::io(&path, FileAction::Write, &e))?;
+        file.finish()?;
+        let temp = std::mem::take(&mut file.temp);
+        self.staged.push(Staged {
+            temp: file_name(&temp),
+            name: name.to_string(),
+        });
+        Ok(())
+    }
+
+    /// Makes every staged file the folder's: the journal is written (from then on the save
+    /// is durable), the files are renamed into place, and the journal removed.
+    pub fn commit(mut self) -> Result<(), FileError> {
+        let staged = std::mem::take(&mut self.staged);
+        let journal = ron::to_string(&staged).expect("plain data serializes");
+        write_atomic(&self.dir.join(JOURNAL_FILE), journal.as_bytes())?;
+        finish_journal(&self.dir, &staged)
+    }
+}
+
+impl Drop for SaveTransaction {
+    fn drop(&mut self) {
+        // Not committed: the staged files go, the folder's files stay as they were.
+        for s in &self.staged {
+            let _ = std::fs::remove_file(self.dir.join(&s.temp));
+        }
+    }
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Renames the journal's files into place and removes the journal.
+fn finish_journal(dir: &Path, staged: &[Staged]) -> Result<(), FileError> {
+    for s in staged {
+        let (temp, target) = (dir.join(&s.temp), resolve_target(&dir.join(&s.name)));
+        // A temporary file already gone was renamed before an interruption.
+        if temp.exists() {
+            std::fs::rename(&temp, &target)
+                .map_err(|e| FileError::io(&dir.join(&s.name), FileAction::Rename, &e))?;
+        }
+    }
+    sync_dir(dir);
+    let journal = dir.join(JOURNAL_FILE);
+    std::fs::remove_file(&journal).map_err(|e| FileError::io(&journal, FileAction::Write, &e))?;
+    sync_dir(dir);
+    Ok(())
+}
+
+/// Finishes a [`SaveTransaction`] that a crash interrupted in `dir` after its journal was
+/// written, and removes temporary files a crash left before that. Returns whether a save was
+/// finished. Readers of a saved folder call it before reading.
+pub fn recover(dir: &Path) -> Result<bool, FileError> {
+    let journal_path = dir.join(JOURNAL_FILE);
+    let finished = match std::fs::read_to_string(&journal_path) {
+        Ok(text) => match ron::from_str::<Vec<Staged>>(&text) {
+            Ok(staged)
+                if staged
+                    .iter()
+                    .all(|s| is_plain_name(&s.temp) && is_plain_name(&s.name)) =>
+            {
+                finish_journal(dir, &staged)?;
+                true
+            }
+            // A journal is written atomically, so a broken one is not ours: leave it.
+            _ => false,
+        },
+        Err(e) if e.kind() == io::ErrorKind::NotFound => false,
+        Err(e) => return Err(FileError::io(&journal_path, FileAction::Read, &e)),
+    };
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            if name.to_string_lossy().ends_with(TEMP_SUFFIX) {
+                let _ = std::fs::remove_file(entry.path());
+            }
+        }
+    }
+    Ok(finished)
+}
+
+/// A file name without folders (journal entries never leave their folder).
+fn is_plain_name(name: &str) -> bool {
+    !name.is_empty() && Path::new(name).file_name().is_some_and(|n| n == name) && name != ".."
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("rwt-files-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_failing_writer_leaves_the_previous_file_and_no_temporary() {
+        let dir = scratch("fail");
+        let path = dir.join("out.txt");
+        write_atomic(&path, b"previous contents\n").unwrap();
+        let err = write_atomic_with(&path, |w| {
+            w.write_all(&[b'x'; 200_000])?;
+            Err(io::Error::new(io::ErrorKind::StorageFull, "no space left"))
+        })
+        .unwrap_err();
+        assert!(
+            matches!(&err, FileError::Io { kind: io::ErrorKind::StorageFull, action: FileAction::Write, path: p, .. } if p == &path),
+            "{err:?}"
+        );
+        assert_eq!(std::fs::read(&path).unwrap(), b"previous contents\n");
+        assert_eq!(names(&dir), ["out.txt"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_is_followed_and_stays_a_link() {
+        let dir = scratch("link");
+        let real = dir.join("real.ron");
+        std::fs::write(&real, "old").unwrap();
+        let link = dir.join("link.ron");
+        std::os::unix::fs::symlink("real.ron", &link).unwrap();
+        write_atomic(&link, b"new").unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn reads_are_limited_before_memory_is_spent() {
+        let dir = scratch("limit");
+        let path = dir.join("big");
+        std::fs::write(&path, vec![7u8; 1000]).unwrap();
+        assert_eq!(read_limited(&path, 1000).unwrap().len(), 1000);
+        assert_eq!(
+            read_limited(&path, 999),
+            Err(FileError::TooLarge {
+                path: path.clone(),
+                limit: 999
+            })
+        );
+        #[cfg(unix)]
+        assert!(matches!(
+            read_limited(Path::new("/dev/zero"), 1 << 20),
+            Err(FileError::TooLarge { limit: 1048576, .. })
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_transaction_that_fails_part_way_changes_nothing() {
+        let dir = scratch("txn");
+        let mut save = SaveTransaction::begin(&dir).unwrap();
+        save.write("a.png", b"a1").unwrap();
+        save.write("index.ron", b"i1").unwrap();
+        save.commit().unwrap();
+        let mut save = SaveTransaction::begin(&dir).unwrap();
+        save.write("a.png", b"a2").unwrap();
+        let err = save.write_with("index.ron", |w| {
+            w.write_all(b"i2 part")?;
+            Err(io::Error::new(io::ErrorKind::StorageFull, "full"))
+        });
+        assert!(err.is_err());
+        assert!(save.write("a.png", b"again").is_err(), "twice in one save");
+        drop(save);
+        assert_eq!(std::fs::read(dir.join("a.png")).unwrap(), b"a1");
+        assert_eq!(std::fs::read(dir.join("index.ron")).unwrap(), b"i1");
+        assert_eq!(names(&dir), ["a.png", "index.ron"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_save_interrupted_after_its_journal_is_finished_by_recover() {
+        let dir = scratch("journal");
+        let mut save = SaveTransaction::begin(&dir).unwrap();
+        save.write("a.png", b"a1").unwrap();
+        save.write("index.ron", b"i1").unwrap();
+        save.commit().unwrap();
+        // A crash after the journal and the first rename: stage, journal, rename one by
+        // hand, then forget the transaction.
+        let mut save = SaveTransaction::begin(&dir).unwrap();
+        save.write("a.png", b"a2").unwrap();
+        save.write("index.ron", b"i2").unwrap();
+        let staged = std::mem::take(&mut save.staged);
+        std::fs::write(dir.join(JOURNAL_FILE), ron::to_string(&staged).unwrap()).unwrap();
+        std::fs::rename(dir.join(&staged[0].temp), dir.join("a.png")).unwrap();
+        // A temporary file of a save that crashed before its journal.
+        std::fs::write(dir.join(format!(".x.png.1-1{TEMP_SUFFIX}")), b"junk").unwrap();
+        assert_eq!(recover(&dir), Ok(true));
+        assert_eq!(std::fs::read(dir.join("a.png")).unwrap(), b"a2");
+        assert_eq!(std::fs::read(dir.join("index.ron")).unwrap(), b"i2");
+        assert_eq!(names(&dir), ["a.png", "index.ron"]);
+        assert_eq!(recover(&dir), Ok(false));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
