@@ -32,10 +32,6 @@ pub struct StippleArgs<'a> {
 
 /// Runs `rwt stipple`.
 pub fn run(args: &StippleArgs) -> Result<(), String> {
-    // At most rwt_core's MAX_IMAGE_PIXELS, checked from the header before decoding.
-    let img = open_image(args.image).map_err(|e| format!("{}: {e}", args.image.display()))?;
-    let grey = Grey::from_image(&img);
-    drop(img);
     let dots = match (args.points, args.radius) {
         (Some(n), None) => DotCount::Points(n),
         (None, Some(r)) => DotCount::Radius(r),
@@ -49,6 +45,16 @@ pub fn run(args: &StippleArgs) -> Result<(), String> {
         scale: args.scale,
         limits: args.limits,
     };
+    let named = |e: &dyn std::fmt::Display| format!("{}: {e}", args.image.display());
+    // Settings, raster and dot count are admitted from the header, before decoding; the
+    // image itself is at most rwt_core's MAX_IMAGE_PIXELS.
+    let (w, h) = image::image_dimensions(args.image).map_err(|e| named(&e))?;
+    settings
+        .admit(w as usize, h as usize)
+        .map_err(|e| e.to_string())?;
+    let img = open_image(args.image).map_err(|e| named(&e))?;
+    let grey = Grey::from_image(&img);
+    drop(img);
     let started = Instant::now();
     let s = stipple(&grey, &TileSet::embedded(), &settings).map_err(|e| e.to_string())?;
     say!(

@@ -198,11 +198,8 @@ pub fn stipple(
 ) -> Result<Stipple, StippleError> {
     check(image, settings)?;
     let tone = settings.tone;
-    let target = Grey {
-        values: image.values.iter().map(|&v| tone.darkness(v)).collect(),
-        ..image.clone()
-    };
-    let ink: f64 = target.values.iter().map(|&v| v as f64).sum();
+    // The ink is known before anything image-sized is allocated.
+    let ink: f64 = image.values.iter().map(|&v| tone.darkness(v) as f64).sum();
     if ink <= 0.0 {
         return Err(StippleError::White);
     }
@@ -221,6 +218,8 @@ pub fn stipple(
         (_, Some(n)) => radius_for(ink, n),
         _ => unreachable!("a count or a radius"),
     };
+    // (Not `..image.clone()`: that copies the values it replaces.)
+    let target = image.map(|v| tone.darkness(v));
     // What the dots reproduce: the darkness as seen at the scale of the dots.
     let seen = target.blurred(PREFILTER_RADII * radius);
     // Calibrate at the first guess of the radius; with a dot count, the nominal ink then
@@ -237,24 +236,33 @@ fn check(image: &Grey, settings: &StippleSettings) -> Result<(), StippleError> {
     if image.width == 0 || image.height == 0 || image.values.len() != image.width * image.height {
         return Err(ImageDensityError::Size(image.width as u32, image.height as u32).into());
     }
-    let positive = |v: f64| v.is_finite() && v > 0.0;
-    let mut numbers = vec![
-        ("scale", settings.scale),
-        ("gamma", settings.tone.gamma),
-        ("contrast", settings.tone.contrast),
-    ];
-    if let DotCount::Radius(r) = settings.dots {
-        numbers.push(("radius", r));
-    }
-    if let Some(&(setting, value)) = numbers.iter().find(|(_, v)| !positive(*v)) {
-        return Err(StippleError::Setting { setting, value });
-    }
-    let limits = &settings.limits;
-    limits.raster(image.width, image.height, settings.scale)?;
-    match settings.dots {
-        DotCount::Points(n) => limits.dots(n as f64),
-        DotCount::Auto => limits.dots((image.width * image.height).div_ceil(4) as f64),
-        DotCount::Radius(_) => Ok(()),
+    settings.admit(image.width, image.height)
+}
+
+impl StippleSettings {
+    /// The checks that need only the image's size: numbers in range, and the raster and
+    /// the dot count (of [`DotCount::Auto`] and [`DotCount::Points`]) within the limits.
+    /// [`stipple`] makes them first; a tool makes them from an image file's header, before
+    /// it decodes the image.
+    pub fn admit(&self, width: usize, height: usize) -> Result<(), StippleError> {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        let mut numbers = vec![
+            ("scale", self.scale),
+            ("gamma", self.tone.gamma),
+            ("contrast", self.tone.contrast),
+        ];
+        if let DotCount::Radius(r) = self.dots {
+            numbers.push(("radius", r));
+        }
+        if let Some(&(setting, value)) = numbers.iter().find(|(_, v)| !positive(*v)) {
+            return Err(StippleError::Setting { setting, value });
+        }
+        self.limits.raster(width, height, self.scale)?;
+        match self.dots {
+            DotCount::Points(n) => self.limits.dots(n as f64),
+            DotCount::Auto => self.limits.dots((width * height).div_ceil(4) as f64),
+            DotCount::Radius(_) => Ok(()),
+        }
     }
 }
 
@@ -278,14 +286,7 @@ impl Plan {
         let sampler = Sampler::new(set, settings.seed).with_tile_size(tile);
         let curve =
             CoverageCurve::measure(&sampler, radius, settings.scale, MAX_NOMINAL, CURVE_SAMPLES)?;
-        let nominal = Grey {
-            values: target
-                .values
-                .iter()
-                .map(|&t| curve.nominal(t as f64) as f32)
-                .collect(),
-            ..target.clone()
-        };
+        let nominal = target.map(|t| curve.nominal(t as f64) as f32);
         Ok(Self {
             sampler,
             curve,

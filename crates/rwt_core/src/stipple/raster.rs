@@ -47,6 +47,15 @@ impl Grey {
         }
     }
 
+    /// A raster of the same size with `f` of each value.
+    pub fn map(&self, f: impl Fn(f32) -> f32) -> Self {
+        Self {
+            width: self.width,
+            height: self.height,
+            values: self.values.iter().map(|&v| f(v)).collect(),
+        }
+    }
+
     /// The value at pixel `(x, y)`.
     #[inline]
     pub fn at(&self, x: usize, y: usize) -> f32 {
