@@ -166,3 +166,71 @@ fn a_layer_waits_for_its_map_and_streams_once_it_is_there() {
     assert!(status.live_instances > 1_000, "{status:?}");
     assert_eq!(app.world().resource::<RwtStats>().layers_waiting, 0);
 }
+
+#[test]
+fn a_failed_reload_keeps_the_layer_and_says_so() {
+    let dir = std::env::temp_dir().join(format!("bevy_rwt_reload_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = r#"(tile_size: 8.0, seed: 3, chunk_size: 16.0, load_distance: 48.0, unload_distance: 64.0,
+        classes: [(density: Constant(0.25), mesh: Cone(radius: 0.5, height: 2.0), material: Color(0.1, 0.5, 0.1))])"#;
+    let path = dir.join("meadow.layer.ron");
+    std::fs::write(&path, good).unwrap();
+    // Oversized files are refused after 1 MiB, not read whole.
+    let mut huge = good.to_string();
+    huge.push_str(&" ".repeat(2 << 20));
+    std::fs::write(dir.join("huge.layer.ron"), huge).unwrap();
+    let mut app = app_reading(&dir);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let server = app.world().resource::<AssetServer>().clone();
+    let meadow = app
+        .world_mut()
+        .spawn(ScatterLayerSource(server.load("meadow.layer.ron")))
+        .id();
+    let huge = app
+        .world_mut()
+        .spawn(ScatterLayerSource(server.load("huge.layer.ron")))
+        .id();
+    let loaded = run_until(&mut app, 2_000, |app| {
+        app.world().get::<ScatterLayer>(meadow).is_some()
+            && app.world().resource::<RwtStats>().layers_failed == 1
+    });
+    assert!(loaded, "{:?}", app.world().get::<ScatterLayerStatus>(huge));
+    let status = app.world().get::<ScatterLayerStatus>(huge).unwrap();
+    assert!(
+        matches!(&status.assets, AssetStatus::Failed(why) if why[0].contains("larger than 1048576 bytes")),
+        "{status:?}"
+    );
+    tick_app(&mut app, 2_000);
+    let before = instances(&mut app);
+    assert!(before.len() > 100);
+    // A broken edit, reloaded (what a file watcher does on save): the layer keeps streaming
+    // its previous version, and its status names the file and why.
+    std::fs::write(&path, "(classes: [").unwrap();
+    server.reload("meadow.layer.ron");
+    let reported = run_until(&mut app, 2_000, |app| {
+        app.world()
+            .get::<ScatterLayerStatus>(meadow)
+            .is_some_and(|s| s.layer_file_error.is_some())
+    });
+    let status = app
+        .world()
+        .get::<ScatterLayerStatus>(meadow)
+        .unwrap()
+        .clone();
+    assert!(reported, "{status:?}");
+    let why = status.layer_file_error.unwrap();
+    assert!(why.contains("meadow.layer.ron"), "{why}");
+    assert_eq!(status.assets, AssetStatus::Ready);
+    tick_app(&mut app, 200);
+    assert_eq!(instances(&mut app), before);
+    // Fixed and reloaded: the report clears.
+    std::fs::write(&path, good).unwrap();
+    server.reload("meadow.layer.ron");
+    let cleared = run_until(&mut app, 2_000, |app| {
+        app.world()
+            .get::<ScatterLayerStatus>(meadow)
+            .is_some_and(|s| s.layer_file_error.is_none())
+    });
+    assert!(cleared);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -227,9 +227,13 @@ pub enum BrushCommand {
     /// that reads the maps from beside it, and an index, [`PaintedMaps`], to the folder. The
     /// folder is a painted world another game loads: put it in the assets and load the layer
     /// files (see [`crate::layers::file`]; what they name must be in its
-    /// [`crate::layers::file::NamedAssets`]).
+    /// [`crate::layers::file::NamedAssets`]). All or nothing: every file is staged first
+    /// and renamed into place together, so a failure (a full disk, an unreadable map)
+    /// leaves the previous save complete.
     Save(PathBuf),
-    /// Reads maps written by `Save` into the targets with the same layer and class names.
+    /// Reads maps written by `Save` into the targets with the same names. Every file is
+    /// read and checked first: a missing, corrupt or mismatched one is an error naming it,
+    /// and then the maps and the undo history stay as they were.
     Load(PathBuf),
 }
 
@@ -251,9 +255,52 @@ pub enum BrushError {
     /// Nothing to undo.
     #[error("nothing to undo")]
     NothingToUndo,
-    /// Reading or writing files failed.
-    #[error("{0}")]
-    Io(String),
+    /// A file could not be read or written (a save leaves the previous one as it was).
+    #[error(transparent)]
+    File(#[from] rwt_core::files::FileError),
+    /// The index or a layer file of a save is not valid.
+    #[error("{}: {reason}", file.display())]
+    Parse {
+        /// The file.
+        file: std::path::PathBuf,
+        /// What the parser said.
+        reason: String,
+    },
+    /// A saved map is not an image of at most the target's size.
+    #[error("{}: {error}", file.display())]
+    Decode {
+        /// The file.
+        file: std::path::PathBuf,
+        /// Why.
+        error: rwt_core::density::ImageDensityError,
+    },
+    /// A saved map's size is not its target's.
+    #[error("{}: {}x{} map, the target's is {}x{}", file.display(), found.0, found.1, expected.0, expected.1)]
+    MapSize {
+        /// The file.
+        file: std::path::PathBuf,
+        /// Its size.
+        found: (u32, u32),
+        /// The target map's size.
+        expected: (u32, u32),
+    },
+    /// A map could not be encoded as PNG.
+    #[error("target {target}: cannot encode its map: {reason}")]
+    Encode {
+        /// The target.
+        target: String,
+        /// The encoder's words.
+        reason: String,
+    },
+    /// Two targets have one name: their maps could not be told apart when loaded.
+    #[error("two brush targets are named {0:?}: names identify maps in a save")]
+    DuplicateTarget(String),
+    /// The index names a file outside its folder.
+    #[error("the index names {file:?}, outside its folder")]
+    OutsideFolder {
+        /// The name.
+        file: String,
+    },
     /// The maps were saved, but these layers (name: reason) have no layer file: they use
     /// something a layer file cannot name (see [`crate::layers::file::NamedAssets`]).
     #[error("maps saved; no layer file for {0}")]

@@ -1,5 +1,10 @@
 //! Painted maps on disk: one 16-bit grey PNG per target, a layer file per target layer that
 //! reads them, and a RON index of where each lies.
+//!
+//! A save is one transaction ([`rwt_core::files::SaveTransaction`]): every file is staged
+//! and synced, then all are renamed into place, so a full disk, an unreadable map or a crash
+//! leaves the previous save complete. A load reads and checks every file first and changes
+//! the world only when all of it is good.
 
 use super::paint::set_texel_luminance;
 use super::plugin::target_map;
@@ -7,12 +12,17 @@ use super::{BrushError, BrushTarget, DensityBrush};
 use crate::layers::file::{LayerDescription, NamedAssets};
 use crate::layers::{ScatterLayer, texel_luminance};
 use bevy::prelude::*;
+use rwt_core::files::{SaveTransaction, read_limited, recover};
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
+use std::io::Write;
 use std::path::Path;
 
 /// The index file [`super::BrushCommand::Save`] writes beside the maps.
 pub const INDEX_FILE: &str = "painted.ron";
+
+/// Largest index or layer file a load reads.
+const MAX_TEXT_BYTES: u64 = 1 << 20;
 
 /// One saved map.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
@@ -43,106 +53,153 @@ pub struct PaintedMaps {
 }
 
 impl PaintedMaps {
-    /// Reads `dir/painted.ron`.
+    /// Reads `dir/painted.ron` (finishing first a save that a crash interrupted there).
     pub fn read(dir: &Path) -> Result<Self, BrushError> {
+        recover(dir)?;
         let path = dir.join(INDEX_FILE);
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| BrushError::Io(format!("{}: {e}", path.display())))?;
-        ron::from_str(&text).map_err(|e| BrushError::Io(format!("{}: {e}", path.display())))
+        let text = read_text(&path)?;
+        let index: Self = ron::from_str(&text).map_err(|e| BrushError::Parse {
+            file: path.clone(),
+            reason: e.to_string(),
+        })?;
+        let names = index.maps.iter().map(|m| &m.file).chain(&index.layers);
+        if let Some(bad) = names.into_iter().find(|f| !is_plain_file_name(f)) {
+            return Err(BrushError::OutsideFolder { file: bad.clone() });
+        }
+        Ok(index)
     }
 
-    /// Writes `dir/painted.ron`.
-    pub fn write(&self, dir: &Path) -> Result<(), BrushError> {
-        let path = dir.join(INDEX_FILE);
-        let text = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())
-            .map_err(|e| BrushError::Io(e.to_string()))?;
-        std::fs::write(&path, text).map_err(|e| BrushError::Io(format!("{}: {e}", path.display())))
+    /// The index as RON.
+    fn to_ron(&self) -> String {
+        ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())
+            .expect("plain data serializes")
     }
 }
 
-/// A file name: `name` with anything but letters, digits, `-` and `_` replaced, then
-/// `extension`.
-fn file_name(name: &str, extension: &str) -> String {
-    let clean: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    format!(
-        "{}.{extension}",
-        if clean.is_empty() { "map" } else { &clean }
-    )
+/// A text file of at most [`MAX_TEXT_BYTES`].
+fn read_text(path: &Path) -> Result<String, BrushError> {
+    let bytes = read_limited(path, MAX_TEXT_BYTES)?;
+    String::from_utf8(bytes).map_err(|_| BrushError::Parse {
+        file: path.to_path_buf(),
+        reason: "not UTF-8 text".into(),
+    })
+}
+
+/// A name in the index's folder: no folders, no `..`.
+fn is_plain_file_name(name: &str) -> bool {
+    Path::new(name).file_name().is_some_and(|n| n == name) && name != ".."
+}
+
+/// File names given out in one save: `name` with anything but letters, digits, `-` and
+/// `_` replaced, made unique (also on file systems that ignore case) with `-2`, `-3`...
+#[derive(Default)]
+struct FileNames(HashSet<String>);
+
+impl FileNames {
+    fn claim(&mut self, name: &str, extension: &str) -> String {
+        let clean: String = name
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        let stem = if clean.is_empty() { "map" } else { &clean };
+        let mut file = format!("{stem}.{extension}");
+        let mut n = 1;
+        while !self.0.insert(file.to_lowercase()) {
+            n += 1;
+            file = format!("{stem}-{n}.{extension}");
+        }
+        file
+    }
 }
 
 /// Writes a map's values as a 16-bit grey PNG.
-fn write_map(image: &Image, path: &Path) -> Result<(), BrushError> {
-    let (w, h) = (image.width(), image.height());
-    let mut pixels = Vec::with_capacity((w * h) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let v = texel_luminance(image, x, y).ok_or_else(|| {
-                BrushError::Io(format!("{}: map texels unreadable", path.display()))
-            })?;
+fn write_map(image: &Image, target: &str, w: &mut dyn Write) -> Result<(), BrushError> {
+    let (width, height) = (image.width(), image.height());
+    let mut pixels = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let v = texel_luminance(image, x, y)
+                .ok_or_else(|| BrushError::MapUnavailable(target.to_string()))?;
             pixels.push((v.clamp(0.0, 1.0) * 65535.0).round() as u16);
         }
     }
-    let png = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(w, h, pixels)
-        .ok_or_else(|| BrushError::Io("map size".into()))?;
-    png.save(path)
-        .map_err(|e| BrushError::Io(format!("{}: {e}", path.display())))
+    let png = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels)
+        .ok_or_else(|| BrushError::MapUnavailable(target.to_string()))?;
+    png.write_with_encoder(image::codecs::png::PngEncoder::new(w))
+        .map_err(|e| BrushError::Encode {
+            target: target.to_string(),
+            reason: e.to_string(),
+        })
 }
 
-/// Reads a PNG written by [`write_map`] (or any image, as its luminance) into `image`, which
-/// must have the same size; nothing is changed when it does not.
-fn read_map(image: &mut Image, path: &Path) -> Result<(), BrushError> {
-    let io = |e: String| BrushError::Io(format!("{}: {e}", path.display()));
-    let png = image::open(path)
-        .map_err(|e| io(e.to_string()))?
+/// Reads a PNG written by [`write_map`] (or any image, as its luminance) of exactly
+/// `width x height` pixels (checked from its header, before decoding).
+fn read_map(path: &Path, width: u32, height: u32) -> Result<Vec<f32>, BrushError> {
+    let pixels = width as u64 * height as u64;
+    let bytes = read_limited(path, pixels * 16 + (1 << 20))?;
+    let png = rwt_core::density::decode_image_with_limit(&bytes, pixels)
+        .map_err(|error| BrushError::Decode {
+            file: path.to_path_buf(),
+            error,
+        })?
         .to_luma16();
-    if png.dimensions() != (image.width(), image.height()) {
-        return Err(io(format!(
-            "{}x{} map, the target's is {}x{}",
-            png.width(),
-            png.height(),
-            image.width(),
-            image.height()
-        )));
+    if png.dimensions() != (width, height) {
+        return Err(BrushError::MapSize {
+            file: path.to_path_buf(),
+            found: png.dimensions(),
+            expected: (width, height),
+        });
     }
-    for (x, y, p) in png.enumerate_pixels() {
-        if !set_texel_luminance(image, x, y, p[0] as f32 / 65535.0) {
-            return Err(io("target map not writable".into()));
-        }
-    }
-    Ok(())
+    Ok(png.pixels().map(|p| p[0] as f32 / 65535.0).collect())
+}
+
+/// What a save reads: the layers, their names, the names of assets, the maps.
+pub(super) struct SaveSources<'a, 'w, 's, 'q> {
+    pub layers: &'a Query<'w, 's, &'q ScatterLayer>,
+    pub layer_name: &'a dyn Fn(Entity) -> Option<String>,
+    pub names: &'a NamedAssets,
+    pub images: &'a Assets<Image>,
 }
 
 /// Writes every target's map, the layer file of every target's layer (reading the maps
-/// from beside it) and the index to `dir`. A layer that cannot be described (see
-/// [`LayerDescription::describe`]) gets no file; the rest is still written, and the error
-/// names it.
+/// from beside it) and the index to `dir`, all or nothing. A layer that cannot be described
+/// (see [`LayerDescription::describe`]) gets no file; the rest is still saved, and the
+/// error names it.
 pub(super) fn save(
     brush: &DensityBrush,
-    layers: &Query<&ScatterLayer>,
-    layer_name: impl Fn(Entity) -> Option<String>,
-    names: &NamedAssets,
-    images: &Assets<Image>,
+    from: &SaveSources,
     dir: &Path,
 ) -> Result<String, BrushError> {
-    std::fs::create_dir_all(dir).map_err(|e| BrushError::Io(format!("{}: {e}", dir.display())))?;
+    let mut seen = HashSet::new();
+    if let Some(t) = brush.targets.iter().find(|t| !seen.insert(&t.name)) {
+        return Err(BrushError::DuplicateTarget(t.name.clone()));
+    }
+    let mut save = SaveTransaction::begin(dir)?;
+    let mut names = FileNames::default();
+    names.claim("painted", "ron");
     let mut index = PaintedMaps::default();
     let mut saved = HashMap::new();
     for (i, BrushTarget { name, .. }) in brush.targets.iter().enumerate() {
-        let map = target_map(brush, i, layers)?;
-        let image = images
+        let map = target_map(brush, i, from.layers)?;
+        let image = from
+            .images
             .get(&map.image)
             .ok_or_else(|| BrushError::MapUnavailable(name.clone()))?;
-        let file = file_name(name, "png");
-        write_map(image, &dir.join(&file))?;
+        let file = names.claim(name, "png");
+        let mut failed = None;
+        save.write_with(&file, |w| {
+            write_map(image, name, w).map_err(|e| {
+                failed = Some(e);
+                std::io::Error::other("map not written")
+            })
+        })
+        .map_err(|e| failed.take().unwrap_or(e.into()))?;
         saved.insert(map.image.id(), format!("./{file}"));
         index.maps.push(PaintedMapEntry {
             name: name.clone(),
@@ -152,34 +209,9 @@ pub(super) fn save(
             scale: map.scale,
         });
     }
-    let mut unwritten = Vec::new();
-    let mut entities: Vec<Entity> = Vec::new();
-    for t in &brush.targets {
-        if !entities.contains(&t.layer) {
-            entities.push(t.layer);
-        }
-    }
-    for entity in entities {
-        let name = layer_name(entity).unwrap_or_else(|| format!("layer {entity}"));
-        let mut file = file_name(&name, "layer.ron");
-        if index.layers.contains(&file) {
-            file = file_name(&format!("{name} {entity}"), "layer.ron");
-        }
-        let layer = layers
-            .get(entity)
-            .map_err(|_| BrushError::NoLayer(name.clone()))?;
-        let image_path = |h: &Handle<Image>| saved.get(&h.id()).cloned();
-        match LayerDescription::describe(layer, names, image_path).and_then(|d| d.to_ron()) {
-            Ok(text) => {
-                let path = dir.join(&file);
-                std::fs::write(&path, text)
-                    .map_err(|e| BrushError::Io(format!("{}: {e}", path.display())))?;
-                index.layers.push(file);
-            }
-            Err(e) => unwritten.push(format!("{name}: {e}")),
-        }
-    }
-    index.write(dir)?;
+    let unwritten = stage_layer_files(brush, from, &saved, &mut names, &mut save, &mut index)?;
+    save.write(INDEX_FILE, index.to_ron().as_bytes())?;
+    save.commit()?;
     if !unwritten.is_empty() {
         return Err(BrushError::LayerNotSaved(unwritten.join("; ")));
     }
@@ -191,7 +223,44 @@ pub(super) fn save(
     ))
 }
 
-/// Reads the maps of `dir`'s index into the targets of the same name.
+/// Stages a layer file per target layer; returns the layers that cannot be described
+/// (`name: reason`).
+fn stage_layer_files(
+    brush: &DensityBrush,
+    from: &SaveSources,
+    saved: &HashMap<AssetId<Image>, String>,
+    names: &mut FileNames,
+    save: &mut SaveTransaction,
+    index: &mut PaintedMaps,
+) -> Result<Vec<String>, BrushError> {
+    let mut unwritten = Vec::new();
+    let mut entities: Vec<Entity> = Vec::new();
+    for t in &brush.targets {
+        if !entities.contains(&t.layer) {
+            entities.push(t.layer);
+        }
+    }
+    for entity in entities {
+        let name = (from.layer_name)(entity).unwrap_or_else(|| format!("layer {entity}"));
+        let layer = from
+            .layers
+            .get(entity)
+            .map_err(|_| BrushError::NoLayer(name.clone()))?;
+        let image_path = |h: &Handle<Image>| saved.get(&h.id()).cloned();
+        match LayerDescription::describe(layer, from.names, image_path).and_then(|d| d.to_ron()) {
+            Ok(text) => {
+                let file = names.claim(&name, "layer.ron");
+                save.write(&file, text.as_bytes())?;
+                index.layers.push(file);
+            }
+            Err(e) => unwritten.push(format!("{name}: {e}")),
+        }
+    }
+    Ok(unwritten)
+}
+
+/// Reads the maps of `dir`'s index into the targets of the same name, once every map and
+/// layer file of the save has been read and checked; on any error nothing changes.
 pub(super) fn load(
     brush: &DensityBrush,
     layers: &Query<&ScatterLayer>,
@@ -199,17 +268,73 @@ pub(super) fn load(
     dir: &Path,
 ) -> Result<String, BrushError> {
     let index = PaintedMaps::read(dir)?;
-    let mut loaded = 0;
+    let mut read = Vec::new();
     for entry in &index.maps {
         let Some(i) = brush.targets.iter().position(|t| t.name == entry.name) else {
             continue;
         };
         let map = target_map(brush, i, layers)?;
-        let mut image = images
-            .get_mut(&map.image)
+        let image = images
+            .get(&map.image)
+            .filter(|image| texel_luminance(image, 0, 0).is_some())
             .ok_or_else(|| BrushError::MapUnavailable(entry.name.clone()))?;
-        read_map(&mut image, &dir.join(&entry.file))?;
-        loaded += 1;
+        let values = read_map(&dir.join(&entry.file), image.width(), image.height())?;
+        read.push((map.image, entry.name.clone(), values));
     }
-    Ok(format!("loaded {loaded} maps from {}", dir.display()))
+    for file in &index.layers {
+        let path = dir.join(file);
+        LayerDescription::from_ron(&read_text(&path)?).map_err(|e| BrushError::Parse {
+            file: path,
+            reason: e.to_string(),
+        })?;
+    }
+    for (handle, name, values) in &read {
+        let mut image = images
+            .get_mut(handle)
+            .ok_or_else(|| BrushError::MapUnavailable(name.clone()))?;
+        let width = image.width();
+        for (texel, &v) in values.iter().enumerate() {
+            let (x, y) = (texel as u32 % width, texel as u32 / width);
+            if !set_texel_luminance(&mut image, x, y, v) {
+                return Err(BrushError::MapUnavailable(name.clone()));
+            }
+        }
+    }
+    Ok(format!("loaded {} maps from {}", read.len(), dir.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colliding_names_get_their_own_files() {
+        let mut names = FileNames::default();
+        names.claim("painted", "ron");
+        let files: Vec<String> = ["red flowers", "red_flowers", "Red_Flowers", "", "painted"]
+            .iter()
+            .map(|n| names.claim(n, "png"))
+            .collect();
+        assert_eq!(
+            files,
+            [
+                "red_flowers.png",
+                "red_flowers-2.png",
+                "Red_Flowers-3.png",
+                "map.png",
+                "painted.png"
+            ]
+        );
+        assert_eq!(names.claim("painted", "ron"), "painted-2.ron");
+    }
+
+    #[test]
+    fn index_entries_stay_in_their_folder() {
+        for ok in ["a.png", "red_flowers-2.png", ".hidden.png"] {
+            assert!(is_plain_file_name(ok), "{ok}");
+        }
+        for bad in ["../a.png", "/etc/passwd", "maps/a.png", "..", ""] {
+            assert!(!is_plain_file_name(bad), "{bad}");
+        }
+    }
 }

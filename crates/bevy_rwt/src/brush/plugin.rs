@@ -1,7 +1,7 @@
 //! The brush plugin: cursor, input, dabs, strokes and their undo, files, the gizmo circle.
 
 use super::paint::{MapPlacement, StrokeRecord, dab, restore};
-use super::persist::{load, save};
+use super::persist::{SaveSources, load, save};
 use super::{BrushCommand, BrushError, BrushSystems, DensityBrush, PaintDab, ground_hit};
 use crate::layers::file::NamedAssets;
 use crate::layers::{HeightFn, LayerDensity, ScatterLayer};
@@ -302,11 +302,22 @@ fn apply_commands(
             BrushCommand::Undo => undo(&mut history, &mut images, &mut painted),
             BrushCommand::Save(dir) => {
                 let layer_name = |e: Entity| files.layer_names.get(e).ok().map(|n| n.to_string());
-                save(&brush, &layers, layer_name, &files.names, &images, dir)
+                let from = SaveSources {
+                    layers: &layers,
+                    layer_name: &layer_name,
+                    names: &files.names,
+                    images: &images,
+                };
+                save(&brush, &from, dir)
             }
             BrushCommand::Load(dir) => {
-                history.done.clear();
-                load(&brush, &layers, &mut images, dir)
+                let loaded = load(&brush, &layers, &mut images, dir);
+                // Strokes before a load cannot be undone over it; a failed load changed
+                // nothing, so they still can.
+                if loaded.is_ok() {
+                    history.done.clear();
+                }
+                loaded
             }
         };
         brush.last = Some(outcome);

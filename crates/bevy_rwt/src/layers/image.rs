@@ -2,13 +2,23 @@
 
 use bevy::prelude::*;
 use glam::DVec2;
-use rwt_core::density::ImageDensity;
+use rwt_core::density::{ImageDensity, MAX_IMAGE_PIXELS};
 
-/// The luminance of a Bevy image (row 0 at the top, as Bevy stores it) over the ground
+/// Whether a map has more pixels than a density or heightmap is made from.
+pub(crate) fn too_large(image: &Image) -> bool {
+    image.width() as u64 * image.height() as u64 > MAX_IMAGE_PIXELS
+}
+
+/// The luminance times alpha of a Bevy image (row 0 at the top, as Bevy stores it; a
+/// transparent texel is empty) over the ground
 /// rectangle `min..min + size` (x, z), times `scale`. `None` for images whose pixels cannot be
-/// read on the CPU (compressed formats, GPU-only images).
+/// read on the CPU (compressed formats, GPU-only images) and for images of more than
+/// [`MAX_IMAGE_PIXELS`] pixels (a density takes about 16 bytes a pixel).
 pub fn from_bevy_image(image: &Image, min: Vec2, size: Vec2, scale: f64) -> Option<ImageDensity> {
     let (w, h) = (image.width(), image.height());
+    if too_large(image) {
+        return None;
+    }
     let values = luminance_fast(image).or_else(|| {
         let mut values = Vec::with_capacity((w * h) as usize);
         for y in 0..h {
@@ -30,15 +40,16 @@ pub fn from_bevy_image(image: &Image, min: Vec2, size: Vec2, scale: f64) -> Opti
     .ok()
 }
 
-/// The value a layer reads from texel `(x, y)`: its linear luminance (Bevy reads one-channel
-/// formats as a grey, so their value is the channel's); `None` for unreadable texels.
+/// The value a layer reads from texel `(x, y)`: its linear luminance times its alpha, so a
+/// transparent texel is an empty one (Bevy reads one-channel formats as an opaque grey, so
+/// their value is the channel's); `None` for unreadable texels.
 pub(crate) fn texel_luminance(image: &Image, x: u32, y: u32) -> Option<f32> {
     let c = image.get_color_at(x, y).ok()?.to_linear();
-    Some(0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue)
+    Some((0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue) * c.alpha)
 }
 
-/// Linear luminance straight from the bytes of the common 8-bit formats (painted maps are
-/// re-read on every stroke, so this path matters); `None` for other formats.
+/// Linear luminance times alpha straight from the bytes of the common 8-bit formats (painted
+/// maps are re-read on every stroke, so this path matters); `None` for other formats.
 fn luminance_fast(image: &Image) -> Option<Vec<f32>> {
     use bevy::render::render_resource::TextureFormat as F;
     let data = image.data.as_ref()?;
@@ -68,9 +79,10 @@ fn luminance_fast(image: &Image) -> Option<Vec<f32>> {
                 if channels == 1 {
                     table[p[0] as usize]
                 } else {
-                    0.2126 * table[p[0] as usize]
+                    (0.2126 * table[p[0] as usize]
                         + 0.7152 * table[p[1] as usize]
-                        + 0.0722 * table[p[2] as usize]
+                        + 0.0722 * table[p[2] as usize])
+                        * linear[p[3] as usize]
                 }
             })
             .collect(),
@@ -92,11 +104,13 @@ mod tests {
                     depth_or_array_layers: 1,
                 },
                 TextureDimension::D2,
-                &[10, 120, 240, 255],
+                &[10, 120, 240, 200],
                 format,
                 Default::default(),
             );
             img.set_color_at(3, 5, Color::srgb(0.9, 0.1, 0.4)).unwrap();
+            img.set_color_at(4, 5, Color::srgba(1.0, 1.0, 1.0, 0.0))
+                .unwrap();
             let fast = luminance_fast(&img).unwrap();
             for y in 0..8 {
                 for x in 0..8 {
@@ -107,6 +121,9 @@ mod tests {
                     );
                 }
             }
+            // A transparent white texel is empty.
+            assert_eq!(fast[5 * 8 + 4], 0.0);
+            assert_eq!(texel_luminance(&img, 4, 5), Some(0.0));
         }
     }
 }

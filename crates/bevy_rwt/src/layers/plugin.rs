@@ -92,23 +92,46 @@ pub(crate) fn merge_missing(missing: impl IntoIterator<Item = AssetStatus>) -> A
 /// Reports layer files that are still loading or failed to load on entities that have no
 /// layer yet.
 fn watch_layer_files(
-    mut sources: Query<
-        (Entity, &ScatterLayerSource, &mut ScatterLayerStatus),
-        Without<ScatterLayer>,
-    >,
+    mut sources: Query<(
+        Entity,
+        &ScatterLayerSource,
+        &mut ScatterLayerStatus,
+        Has<ScatterLayer>,
+    )>,
     assets: Res<Assets<ScatterLayerAsset>>,
     server: Option<Res<AssetServer>>,
 ) {
-    for (entity, source, mut status) in &mut sources {
+    for (entity, source, mut status, streaming) in &mut sources {
         let handle = &source.0;
         let path = handle.path().map(|p| p.to_string());
-        let missing = missing_asset(
-            handle.id().untyped(),
-            path,
-            assets.contains(handle),
-            server.as_deref(),
-        );
-        report_assets(entity, &mut status, missing.unwrap_or_default());
+        if !streaming {
+            let missing = missing_asset(
+                handle.id().untyped(),
+                path,
+                assets.contains(handle),
+                server.as_deref(),
+            );
+            report_assets(entity, &mut status, missing.unwrap_or_default());
+            continue;
+        }
+        // A file that loaded once and then failed to reload: the layer keeps its previous
+        // version, and says so.
+        let failed = match server
+            .as_deref()
+            .and_then(|s| s.get_load_state(handle.id()))
+        {
+            Some(LoadState::Failed(err)) => Some(format!(
+                "{}: {err}",
+                path.unwrap_or_else(|| format!("{:?}", handle.id()))
+            )),
+            _ => None,
+        };
+        if status.layer_file_error != failed {
+            if let Some(why) = &failed {
+                error!("rwt: layer {entity} keeps its previous version: cannot reload {why}");
+            }
+            status.layer_file_error = failed;
+        }
     }
 }
 

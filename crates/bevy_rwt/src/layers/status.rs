@@ -38,6 +38,10 @@ pub struct ScatterLayerStatus {
     /// Loaded chunks not generated because their query would exceed
     /// [`crate::RwtSettings::chunk_point_budget`] (lower the density, or raise the budget).
     pub refused_chunks: usize,
+    /// The last reload of the layer's file ([`super::file::ScatterLayerSource`]) that failed
+    /// (`path: reason`): the layer keeps streaming the version loaded before, until a reload
+    /// succeeds (then `None`).
+    pub layer_file_error: Option<String>,
     /// Instanced classes that cannot be drawn (class index, reason): their chunks stream and
     /// are counted, but are not drawn until the cause is fixed.
     pub class_errors: Vec<(u16, InstancedClassError)>,

@@ -2,7 +2,7 @@
 //! Each is made once and kept; repainting a map forgets only the snapshots that read it.
 
 use crate::layers::{AssetStatus, HeightFn, LayerDensity, ScatterLayer, SharedDensity};
-use crate::layers::{merge_missing, missing_asset};
+use crate::layers::{merge_missing, missing_asset, too_large};
 use bevy::prelude::*;
 use rwt_core::density::Exclude;
 use std::sync::Arc;
@@ -45,18 +45,24 @@ fn unreadable(
     server: Option<&AssetServer>,
 ) -> AssetStatus {
     let path = image.path().map(|p| p.to_string());
-    match missing_asset(
+    if let Some(missing) = missing_asset(
         image.id().untyped(),
         path.clone(),
         images.contains(image),
         server,
     ) {
-        Some(missing) => missing,
-        None => AssetStatus::Failed(vec![format!(
-            "{}: pixels not readable on the CPU (compressed or GPU-only format)",
-            path.unwrap_or_else(|| format!("{:?}", image.id()))
-        )]),
+        return missing;
     }
+    let name = path.unwrap_or_else(|| format!("{:?}", image.id()));
+    AssetStatus::Failed(vec![match images.get(image).filter(|i| too_large(i)) {
+        Some(i) => format!(
+            "{name}: {}x{} pixels, over the limit of {} for a map (rwt_core::density::MAX_IMAGE_PIXELS)",
+            i.width(),
+            i.height(),
+            rwt_core::density::MAX_IMAGE_PIXELS
+        ),
+        None => format!("{name}: pixels not readable on the CPU (compressed or GPU-only format)"),
+    }])
 }
 
 impl Resolved {

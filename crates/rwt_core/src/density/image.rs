@@ -37,7 +37,7 @@ pub struct ImageDensity {
 }
 
 /// Why an image density could not be made.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum ImageDensityError {
     /// The image has no pixels or is larger than 2^15 on a side.
     #[error("image size {0}x{1} is not in 1..=32768")]

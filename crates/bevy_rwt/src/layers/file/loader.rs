@@ -1,9 +1,10 @@
 //! The asset loader of layer files.
 
 use super::{
-    LayerDescription, LayerFileError, MaterialDescription, NamedAssets, ScatterLayerAsset,
+    LayerDescription, LayerFileError, MAX_LAYER_FILE_BYTES, MaterialDescription, NamedAssets,
+    ScatterLayerAsset,
 };
-use bevy::asset::{AssetLoader, AssetPath, LoadContext, io::Reader};
+use bevy::asset::{AssetLoader, AssetPath, AsyncReadExt, LoadContext, io::Reader};
 use bevy::prelude::*;
 use std::cell::RefCell;
 
@@ -26,7 +27,14 @@ impl AssetLoader for ScatterLayerLoader {
         ctx: &mut LoadContext<'_>,
     ) -> Result<ScatterLayerAsset, LayerFileError> {
         let mut bytes = Vec::new();
-        reader.read_to_end(&mut bytes).await?;
+        AsyncReadExt::take(reader, MAX_LAYER_FILE_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .await?;
+        if bytes.len() as u64 > MAX_LAYER_FILE_BYTES {
+            return Err(LayerFileError::TooLarge {
+                limit: MAX_LAYER_FILE_BYTES,
+            });
+        }
         let text = std::str::from_utf8(&bytes).map_err(|e| LayerFileError::Parse(e.to_string()))?;
         let description = LayerDescription::from_ron(text)?;
         // Primitive meshes and plain colours become labelled sub-assets of the layer file.

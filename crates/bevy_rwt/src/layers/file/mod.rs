@@ -394,7 +394,17 @@ pub enum LayerFileError {
     /// The file names a mesh, material or height function [`NamedAssets`] does not have.
     #[error("layer file names {0}, which is not registered in NamedAssets")]
     UnknownName(String),
+    /// The file is larger than [`MAX_LAYER_FILE_BYTES`]: not a layer description.
+    #[error("layer file is larger than {limit} bytes")]
+    TooLarge {
+        /// The limit in bytes.
+        limit: u64,
+    },
 }
+
+/// Largest layer file the loader reads (layer files are descriptions of a few kilobytes;
+/// anything larger is refused after reading this many bytes).
+pub const MAX_LAYER_FILE_BYTES: u64 = 1 << 20;
 
 impl LayerDescription {
     /// The layer file text: what [`LayerDescription::from_ron`] reads back (optional fields
