@@ -16,6 +16,8 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy_rwt::prelude::*;
 use glam::DVec2;
+use rwt_core::density::open_image;
+use rwt_core::files::{SaveTransaction, recover};
 use rwt_core::query::Rect;
 use rwt_core::rng::{hash_words, unit_f64};
 use rwt_examples::prelude::*;
@@ -197,22 +199,29 @@ impl Canvas {
             })
     }
 
+    /// Writes the maps and the setup together, all or nothing (a failure keeps the
+    /// previous save).
     fn save(&self, dir: &Path) -> Result<(), String> {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let mut save = SaveTransaction::begin(dir).map_err(|e| e.to_string())?;
         let n = self.setup.map_size as u32;
         for (c, map) in self.setup.classes.iter().zip(&self.maps) {
             let bytes: Vec<u8> = map.iter().map(|v| (v * 255.0).round() as u8).collect();
             let img = image::GrayImage::from_raw(n, n, bytes).ok_or("map size mismatch")?;
-            let path = dir.join(format!("{}.png", c.name));
-            img.save(&path)
-                .map_err(|e| format!("{}: {e}", path.display()))?;
+            save.write_with(&format!("{}.png", c.name), |w| {
+                img.write_with_encoder(image::codecs::png::PngEncoder::new(w))
+                    .map_err(std::io::Error::other)
+            })
+            .map_err(|e| e.to_string())?;
         }
         let ron = ron::ser::to_string_pretty(&self.setup, ron::ser::PrettyConfig::default())
             .map_err(|e| e.to_string())?;
-        std::fs::write(dir.join("layer.ron"), ron).map_err(|e| e.to_string())
+        save.write("layer.ron", ron.as_bytes())
+            .and_then(|()| save.commit())
+            .map_err(|e| e.to_string())
     }
 
     fn load(&mut self, dir: &Path) -> Result<(), String> {
+        recover(dir).map_err(|e| e.to_string())?;
         let text = std::fs::read_to_string(dir.join("layer.ron"))
             .map_err(|e| format!("{}: {e}", dir.join("layer.ron").display()))?;
         let setup: PaintSetup = ron::from_str(&text).map_err(|e| format!("layer.ron: {e}"))?;
@@ -222,7 +231,7 @@ impl Canvas {
         let mut maps = Vec::new();
         for c in &setup.classes {
             let path = dir.join(format!("{}.png", c.name));
-            let img = image::open(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let img = open_image(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let img = img
                 .resize_exact(
                     setup.map_size as u32,

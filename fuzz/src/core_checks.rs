@@ -1,5 +1,7 @@
-//! Fuzz checks of `rwt_core`: the tile set loader, image densities and queries. Each takes
-//! raw bytes, must never panic, and asserts what must hold for whatever input it accepts.
+//! Fuzz checks of `rwt_core`: the tile set loader, image densities, queries and stippling.
+//! Each takes raw bytes, must never panic, and asserts what must hold for whatever input it
+//! accepts. Budgets and sizes are small, so that each input runs in well under a
+//! millisecond and a run reaches millions of inputs.
 
 use glam::DVec2;
 use rwt_core::density::{
@@ -7,6 +9,7 @@ use rwt_core::density::{
     Sum, from_fn, sanitize,
 };
 use rwt_core::query::{Point, Rect, Sampler};
+use rwt_core::stipple::{DotCount, Grey, StippleLimits, StippleSettings, Stippler, ToneMap};
 use rwt_core::tileset::TileSet;
 use std::collections::HashSet;
 use std::sync::OnceLock;
@@ -176,12 +179,13 @@ fn density(b: &mut Bytes, depth: u32) -> Box<dyn Density + Send + Sync> {
 }
 
 /// A query with any rectangle, density, tile size, seed and budget (the budget is kept
-/// under a million so that every run is quick). Returns whether the query was served.
+/// at 20 000 points or tile visits, so that every input runs in a fraction of a
+/// millisecond). Returns whether the query was served.
 pub fn query(data: &[u8]) -> bool {
     let mut b = Bytes(data);
     let seed = b.u64();
     let tile = b.number();
-    let budget = (b.u64() % 1_000_000) as usize;
+    let budget = (b.u64() % 20_001) as usize;
     let (x0, y0, x1, y1) = (b.number(), b.number(), b.number(), b.number());
     let Ok(rect) = Rect::new(DVec2::new(x0, y0), DVec2::new(x1, y1)) else {
         return false;
@@ -197,4 +201,67 @@ pub fn query(data: &[u8]) -> bool {
         assert!((p.class as usize) < classes.len());
     });
     served
+}
+
+/// The shipped set prepared for stippling, once.
+fn stippler() -> &'static Stippler {
+    static STIPPLER: OnceLock<Stippler> = OnceLock::new();
+    STIPPLER.get_or_init(|| Stippler::new(&TileSet::embedded()))
+}
+
+/// A small grey image (up to 12 x 12) of any values (NaN and infinities too) stippled with
+/// any settings under small limits: refused with an error, or dots inside the image that
+/// render within the limits.
+pub fn stipple(data: &[u8]) -> bool {
+    let mut b = Bytes(data);
+    let (w, h) = ((b.u8() % 13) as usize, (b.u8() % 13) as usize);
+    let dots = match b.u8() % 3 {
+        0 => DotCount::Auto,
+        1 => DotCount::Points((b.u64() % 5_000) as usize),
+        _ => DotCount::Radius(b.number()),
+    };
+    let settings = StippleSettings {
+        dots,
+        tone: ToneMap {
+            gamma: b.number(),
+            contrast: b.number(),
+        },
+        seed: b.u8() as u64,
+        scale: b.number(),
+        limits: StippleLimits {
+            max_dots: 20_000,
+            max_raster_pixels: 1 << 10,
+        },
+    };
+    let values = (0..w * h).map(|_| b.number() as f32).collect();
+    let image = Grey {
+        width: w,
+        height: h,
+        values,
+    };
+    let Ok(s) = stippler().stipple(&image, &settings) else {
+        return false;
+    };
+    assert!(
+        s.radius.is_finite() && s.radius > 0.0,
+        "radius {}",
+        s.radius
+    );
+    assert!(!s.dots.is_empty());
+    // Dots are admitted by their expected number; a query's count varies a little.
+    assert!(
+        s.dots.len() <= 2 * settings.limits.max_dots,
+        "{} dots",
+        s.dots.len()
+    );
+    for d in &s.dots {
+        assert!(
+            d.x >= 0.0 && d.y >= 0.0 && d.x <= w as f64 && d.y <= h as f64,
+            "{d} outside {w}x{h}"
+        );
+    }
+    let raster = s.render(&s.dots, settings.scale).expect("admitted raster");
+    assert!(raster.values.len() as u64 <= settings.limits.max_raster_pixels);
+    assert!(raster.values.iter().all(|v| (0.0..=1.0).contains(v)));
+    true
 }

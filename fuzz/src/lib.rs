@@ -1,5 +1,4 @@
-//! The checks behind the fuzz targets. The same files are compiled into the project's tests
-//! (`#[path]` modules), which replay every input kept under `fuzz/regressions/`.
+//! The checks behind the core fuzz targets. The same file is compiled into rwt_core's tests
+//! (a `#[path]` module), which replay every input kept under `fuzz/regressions/`.
 
 pub mod core_checks;
-pub mod layer_checks;

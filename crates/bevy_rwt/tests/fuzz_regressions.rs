@@ -1,8 +1,8 @@
 //! Replays the layer-file inputs kept under `fuzz/regressions/layer_file/` through the check
-//! the `layer_file` fuzz target runs (`fuzz/src/layer_checks.rs`).
+//! the `layer_file` fuzz target runs (`fuzz/bevy/src/layer_checks.rs`).
 
 #[allow(dead_code, missing_docs)]
-#[path = "../../../fuzz/src/layer_checks.rs"]
+#[path = "../../../fuzz/bevy/src/layer_checks.rs"]
 mod layer_checks;
 
 #[test]

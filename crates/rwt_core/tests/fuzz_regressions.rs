@@ -36,3 +36,8 @@ fn image_density_inputs() {
 fn query_inputs() {
     assert!(replay("query", core_checks::query) > 0);
 }
+
+#[test]
+fn stipple_inputs() {
+    assert!(replay("stipple", core_checks::stipple) > 0);
+}

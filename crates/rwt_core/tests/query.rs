@@ -351,6 +351,15 @@ fn bad_input_gets_typed_errors() {
         s.query(square(1e15, 1.0), &Constant(1.0), &mut Vec::new()),
         Err(QueryError::TooFar { .. })
     ));
+    // Tiles whose area overflows (or underflows) at some level: every bound would be
+    // infinite (found by fuzzing: a query visiting 16^24 tiles).
+    for size in [1.9e185, 1e160, 1e-150] {
+        let huge = sampler(1).with_tile_size(size);
+        assert_eq!(
+            huge.query(square(0.0, 1.0), &Constant(1.0), &mut Vec::new()),
+            Err(QueryError::TileSize { size })
+        );
+    }
     // Over budget: refused before a single point is produced.
     let mut emitted = 0;
     let e = s.query_with(square(0.0, 10.0), &Constant(1.0e4), |_| emitted += 1);

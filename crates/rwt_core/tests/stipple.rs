@@ -128,6 +128,14 @@ fn white_stays_white_and_counts_and_radii_are_honoured() {
     // Same seed, same dots; another seed, others.
     let again = stipple(&image, &set, &with(DotCount::Points(1500))).unwrap();
     assert_eq!(again.dots, s.dots);
+    // A Stippler prepares the set once and stipples alike, image after image.
+    let stippler = rwt_core::stipple::Stippler::new(&set);
+    for _ in 0..2 {
+        let reused = stippler
+            .stipple(&image, &with(DotCount::Points(1500)))
+            .unwrap();
+        assert_eq!(reused.dots, s.dots);
+    }
     let other = StippleSettings {
         seed: 9,
         ..with(DotCount::Points(1500))

@@ -386,7 +386,9 @@ const LATTICE_SPAN: isize = 3;
 
 /// The corner-gradient combination of the lattice cell at `(cx, cy)`, as `perlin` picks it.
 fn corner_combination(table: &[u8; 256], cx: isize, cy: isize) -> usize {
-    let pick = |ox: isize, oy: isize| gradient_pick(table, cx + ox, cy + oy) as usize;
+    let pick = |ox: isize, oy: isize| {
+        gradient_pick(table, cx.wrapping_add(ox), cy.wrapping_add(oy)) as usize
+    };
     pick(0, 0) | pick(1, 0) << 2 | pick(0, 1) << 4 | pick(1, 1) << 6
 }
 
@@ -396,7 +398,10 @@ fn corner_combination(table: &[u8; 256], cx: isize, cy: isize) -> usize {
 fn lattice_bounds(table: &[u8; 256], min: DVec2, max: DVec2) -> (f64, bool) {
     let (x0, y0) = (min.x.floor() as isize, min.y.floor() as isize);
     let (x1, y1) = (max.x.floor() as isize, max.y.floor() as isize);
-    if x1 - x0 >= LATTICE_SPAN || y1 - y0 >= LATTICE_SPAN {
+    // Apart by the distance, not the difference: infinite corners saturate to isize::MIN
+    // and MAX, whose difference overflows.
+    let span = LATTICE_SPAN as usize;
+    if x1.abs_diff(x0) >= span || y1.abs_diff(y0) >= span {
         return (PERLIN_CURVATURE_BOUND, false);
     }
     let (mut tenths, mut free) = (0, true);

@@ -61,6 +61,13 @@ pub enum QueryError {
     /// `max < min` on some axis.
     #[error("query rectangle is inverted (max < min)")]
     InvertedRect,
+    /// A tile size whose area is not a normal `f64` at some level (from the base tile
+    /// to [`MAX_LEVEL`]): above about 1e154 or below about 1e-139 world units.
+    #[error("tile size {size:e} is out of range: tile areas must be normal numbers at every level")]
+    TileSize {
+        /// The sampler's tile size.
+        size: f64,
+    },
     /// Coordinates beyond [`MAX_TILE_COORDINATE`] base tiles.
     #[error(
         "query rectangle reaches {tiles:e} tiles from the origin (limit {MAX_TILE_COORDINATE:e})"
@@ -180,6 +187,11 @@ impl Sampler {
     }
 
     fn check(&self, rect: &Rect) -> Result<(), QueryError> {
+        let s = self.tile_size;
+        let finest = s / (self.n as f64).powi(MAX_LEVEL as i32);
+        if !((s * s).is_finite() && (finest * finest).is_normal()) {
+            return Err(QueryError::TileSize { size: s });
+        }
         let far = rect.min().abs().max(rect.max().abs()).max_element() / self.tile_size;
         if far > MAX_TILE_COORDINATE {
             return Err(QueryError::TooFar { tiles: far });

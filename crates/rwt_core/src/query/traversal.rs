@@ -137,6 +137,15 @@ impl TileAt {
     }
 }
 
+/// A density bound times an area: ranks per tile. Zero density is zero ranks even where the
+/// area overflows to infinity (`0 * inf` is NaN, and `NaN.min(limit)` is `limit`: every empty
+/// cell of a huge tile would inherit the tile's bound and be visited, 16^24 of them).
+#[inline]
+fn per_area(density: f64, area: f64) -> f64 {
+    let d = sanitize(density);
+    if d > 0.0 { d * area } else { 0.0 }
+}
+
 /// Upper and lower density bounds of each cell of a tile, times the tile's area: how many
 /// of the tile's ranks the cell may show, and how many it shows for sure; and the density's
 /// local model over the cell, where it has one.
@@ -214,7 +223,7 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
 
     /// The lower density bound over `rect` times `area`, at most `limit`; 0 when not finite.
     fn low(&self, rect: &Rect, limit: f64, area: f64) -> f64 {
-        let low = sanitize(self.density.min_over(rect.min(), rect.max())) * area;
+        let low = per_area(self.density.min_over(rect.min(), rect.max()), area);
         if low.is_finite() { low.min(limit) } else { 0.0 }
     }
 
@@ -228,7 +237,7 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
         };
         let area = at.side * at.side;
         let known = known.unwrap_or_else(|| {
-            let limit = sanitize(self.density.max_over(clip.min(), clip.max())) * area;
+            let limit = per_area(self.density.max_over(clip.min(), clip.max()), area);
             Known {
                 limit,
                 low: self.low(&clip, limit, area),
@@ -284,10 +293,17 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
                 Some(m) => {
                     bounds.model[cell] = cell_model;
                     let (lo, hi) = m.bounds_over(r.min(), r.max());
-                    (hi * area, lo * area)
+                    let mut max = per_area(hi, area);
+                    // A model may be looser than the density's maximum, which the work
+                    // bound admitted the query by: a cell is only subdivided when both
+                    // ask for it (one bound against the n^2 its children would take).
+                    if max > self.sampler.sub_len as f64 {
+                        max = max.min(per_area(self.density.max_over(r.min(), r.max()), area));
+                    }
+                    (max, per_area(lo, area))
                 }
                 None => {
-                    let max = sanitize(self.density.max_over(r.min(), r.max())) * area;
+                    let max = per_area(self.density.max_over(r.min(), r.max()), area);
                     (max, self.low(&r, max.min(limit), area))
                 }
             };

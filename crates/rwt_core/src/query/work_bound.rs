@@ -93,7 +93,8 @@ impl Sampler {
         let finest = s / n.powi(MAX_LEVEL as i32);
         // Tiles are visited down to the first level whose tiles ask for at most the full
         // subdivision sequence: side s_deep with d * s_deep^2 <= n^2 N.
-        let s_deep = ((self.sub_len as f64 / d).sqrt() / n).clamp(finest, s);
+        // (Square roots apart: `sub_len / d` overflows for a denormal density.)
+        let s_deep = ((self.sub_len as f64).sqrt() / d.sqrt() / n).clamp(finest, s);
         let size = r.size();
         let tiles = (size.x / s_deep + 2.0) * (size.y / s_deep + 2.0);
         d * r.area() + 2.0 * tiles

@@ -26,7 +26,7 @@ mod tone;
 
 pub use limits::{DEFAULT_MAX_DOTS, DEFAULT_MAX_RASTER_PIXELS, StippleLimits};
 pub use raster::Grey;
-pub use tone::{CoverageCurve, ToneError};
+pub use tone::{CoverageCurve, Patch, ToneError};
 
 use crate::density::{ImageDensity, ImageDensityError};
 use crate::query::{QueryError, Rect, Sampler};
@@ -55,9 +55,12 @@ impl Default for ToneMap {
 }
 
 impl ToneMap {
-    /// The darkness of grey level `v`.
+    /// The darkness of grey level `v` (a NaN grey is white).
     pub fn darkness(&self, v: f32) -> f32 {
         let d = (self.contrast * (1.0 - v as f64)).clamp(0.0, 1.0);
+        if d.is_nan() {
+            return 0.0;
+        }
         d.powf(self.gamma) as f32
     }
 }
@@ -188,48 +191,73 @@ pub struct Stipple {
     limits: StippleLimits,
 }
 
-/// Stipples `image` (grey levels, row 0 at the top) with the tile set's blue noise. The
-/// dots and the raster are admitted against [`StippleSettings::limits`] before anything is
-/// allocated for them.
+/// Stipples `image` (grey levels, row 0 at the top) with the tile set's blue noise (see
+/// [`Stippler::stipple`]; a [`Stippler`] prepares the tile set once for many images).
 pub fn stipple(
     image: &Grey,
     set: &TileSet,
     settings: &StippleSettings,
 ) -> Result<Stipple, StippleError> {
-    check(image, settings)?;
-    let tone = settings.tone;
-    // The ink is known before anything image-sized is allocated.
-    let ink: f64 = image.values.iter().map(|&v| tone.darkness(v) as f64).sum();
-    if ink <= 0.0 {
-        return Err(StippleError::White);
-    }
-    let wanted = match settings.dots {
-        DotCount::Auto => Some((image.width * image.height).div_ceil(4).max(MIN_AUTO_DOTS)),
-        DotCount::Points(n) => Some(n.max(1)),
-        DotCount::Radius(_) => None,
-    };
-    let radius_for = |nominal_ink: f64, n: usize| (nominal_ink / (PI * n as f64)).sqrt();
-    let mut radius = match (settings.dots, wanted) {
-        (DotCount::Radius(r), _) => {
-            // Dots lay down at most their nominal ink: at least this many are needed.
-            settings.limits.dots(ink / (PI * r * r))?;
-            r
+    Stippler::new(set).stipple(image, settings)
+}
+
+/// A tile set prepared for stippling: its sampler is built once, so that stippling many
+/// images (the frames of a video, a batch of prints) costs only the stipples.
+#[derive(Clone, Debug)]
+pub struct Stippler {
+    sampler: Sampler,
+}
+
+impl Stippler {
+    /// Prepares `set`.
+    pub fn new(set: &TileSet) -> Self {
+        Self {
+            sampler: Sampler::new(set, 0),
         }
-        (_, Some(n)) => radius_for(ink, n),
-        _ => unreachable!("a count or a radius"),
-    };
-    // (Not `..image.clone()`: that copies the values it replaces.)
-    let target = image.map(|v| tone.darkness(v));
-    // What the dots reproduce: the darkness as seen at the scale of the dots.
-    let seen = target.blurred(PREFILTER_RADII * radius);
-    // Calibrate at the first guess of the radius; with a dot count, the nominal ink then
-    // gives the radius, calibrated once more.
-    let mut plan = Plan::new(set, settings, &seen, radius)?;
-    if let Some(n) = wanted {
-        radius = radius_for(plan.nominal_ink(), n);
-        plan = Plan::new(set, settings, &seen, radius)?;
     }
-    plan.place(image, radius, target, settings.limits)
+
+    /// Stipples `image` (grey levels, row 0 at the top). The dots and the raster are
+    /// admitted against [`StippleSettings::limits`] before anything is allocated for them.
+    pub fn stipple(
+        &self,
+        image: &Grey,
+        settings: &StippleSettings,
+    ) -> Result<Stipple, StippleError> {
+        check(image, settings)?;
+        let tone = settings.tone;
+        // The ink is known before anything image-sized is allocated.
+        let ink: f64 = image.values.iter().map(|&v| tone.darkness(v) as f64).sum();
+        if ink <= 0.0 {
+            return Err(StippleError::White);
+        }
+        let wanted = match settings.dots {
+            DotCount::Auto => Some((image.width * image.height).div_ceil(4).max(MIN_AUTO_DOTS)),
+            DotCount::Points(n) => Some(n.max(1)),
+            DotCount::Radius(_) => None,
+        };
+        let radius_for = |nominal_ink: f64, n: usize| (nominal_ink / (PI * n as f64)).sqrt();
+        let mut radius = match (settings.dots, wanted) {
+            (DotCount::Radius(r), _) => {
+                // Dots lay down at most their nominal ink: at least this many are needed.
+                settings.limits.dots(ink / (PI * r * r))?;
+                r
+            }
+            (_, Some(n)) => radius_for(ink, n),
+            _ => unreachable!("a count or a radius"),
+        };
+        // (Not `..image.clone()`: that copies the values it replaces.)
+        let target = image.map(|v| tone.darkness(v));
+        // What the dots reproduce: the darkness as seen at the scale of the dots.
+        let seen = target.blurred(PREFILTER_RADII * radius);
+        // Calibrate at the first guess of the radius; with a dot count, the nominal ink
+        // then gives the radius, calibrated once more.
+        let mut plan = Plan::new(&self.sampler, settings, &seen, radius)?;
+        if let Some(n) = wanted {
+            radius = radius_for(plan.nominal_ink(), n);
+            plan = Plan::new(&self.sampler, settings, &seen, radius)?;
+        }
+        plan.place(image, radius, target, settings.limits)
+    }
 }
 
 fn check(image: &Grey, settings: &StippleSettings) -> Result<(), StippleError> {
@@ -275,17 +303,21 @@ struct Plan {
 
 impl Plan {
     fn new(
-        set: &TileSet,
+        base: &Sampler,
         settings: &StippleSettings,
         target: &Grey,
         radius: f64,
     ) -> Result<Self, StippleError> {
         // Base tiles are full at a light tone: darker tones come from subdivision levels.
         let full_tile = TILE_NOMINAL / (PI * radius * radius);
-        let tile = (set.points_per_tile as f64 / full_tile).sqrt();
-        let sampler = Sampler::new(set, settings.seed).with_tile_size(tile);
-        let curve =
-            CoverageCurve::measure(&sampler, radius, settings.scale, MAX_NOMINAL, CURVE_SAMPLES)?;
+        let tile = (base.points_per_tile() as f64 / full_tile).sqrt();
+        let sampler = base.clone().with_seed(settings.seed).with_tile_size(tile);
+        let patch = Patch {
+            radius,
+            scale: settings.scale,
+            extent: target.width.max(target.height) as f64,
+        };
+        let curve = CoverageCurve::measure(&sampler, patch, MAX_NOMINAL, CURVE_SAMPLES)?;
         let nominal = target.map(|t| curve.nominal(t as f64) as f32);
         Ok(Self {
             sampler,

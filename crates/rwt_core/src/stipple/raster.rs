@@ -136,7 +136,8 @@ impl Grey {
         if sigma.is_nan() || sigma <= 0.0 {
             return self.clone();
         }
-        let reach = (3.0 * sigma).ceil() as usize;
+        // Beyond the raster's own size a wider kernel reaches no other pixel.
+        let reach = ((3.0 * sigma).ceil() as usize).min(self.width.max(self.height));
         let kernel: Vec<f32> = (0..=reach)
             .map(|i| (-0.5 * (i as f64 / sigma).powi(2)).exp() as f32)
             .collect();
@@ -186,6 +187,19 @@ mod tests {
         assert_eq!(g.values[0], 0.0);
         assert_eq!(g.values[1], 1.0);
         assert!((g.values[2] - 0.8).abs() < 1e-6, "{}", g.values[2]);
+    }
+
+    #[test]
+    fn a_huge_blur_is_the_mean_not_an_allocation() {
+        let mut g = Grey::filled(4, 3, 0.0);
+        g.values[0] = 1.2;
+        for sigma in [1e6, 1e300, f64::INFINITY] {
+            let b = g.blurred(sigma);
+            assert!(
+                b.values.iter().all(|&v| (v - 0.1).abs() < 1e-6),
+                "{sigma}: {b:?}"
+            );
+        }
     }
 
     #[test]

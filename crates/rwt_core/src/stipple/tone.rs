@@ -9,13 +9,14 @@ use std::f64::consts::PI;
 
 /// Ink coverage of the sampler's blue-noise dots of one radius as a function of their
 /// *nominal* coverage `a = density * pi * radius^2` (the coverage if dots never overlapped),
-/// measured by rendering uniform patches. Dots overlap more as they crowd, so coverage falls
-/// below `a`; the stippler inverts this to reach each darkness.
+/// measured by rendering a uniform patch (the densest level's dots, drawn in the order they
+/// appear, read after each level). Dots overlap more as they crowd, so coverage falls below
+/// `a`; the stippler inverts this to reach each darkness.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CoverageCurve {
     /// Nominal coverage between samples.
     step: f64,
-    /// Measured coverage at `k * step`, made non-decreasing.
+    /// Measured coverage at `k * step` (non-decreasing: each level adds dots to the last).
     coverage: Vec<f64>,
 }
 
@@ -24,35 +25,53 @@ const PATCH_RADII: f64 = 160.0;
 /// Largest patch raster side in pixels.
 const PATCH_PIXELS: f64 = 1024.0;
 
+/// The dots a [`CoverageCurve`] is measured for, and how large its patches may be.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Patch {
+    /// Dot radius, world units.
+    pub radius: f64,
+    /// Raster pixels per world unit (as the stipple is rendered).
+    pub scale: f64,
+    /// Largest patch side, world units: the image's longer side (a patch larger than the
+    /// image measures nothing the image can show; small images calibrate in microseconds).
+    pub extent: f64,
+}
+
 impl CoverageCurve {
     /// Measures the curve for nominal coverages `0..=max_nominal` in `samples` steps, with
-    /// dots of `radius` rendered at `scale` raster pixels per unit (as the stipple is).
+    /// dots of `patch.radius` rendered at `patch.scale` raster pixels per unit (as the
+    /// stipple is), on square patches of 160 radii, at most 1024 raster pixels and at most
+    /// `patch.extent` a side.
     pub fn measure(
         sampler: &Sampler,
-        radius: f64,
-        scale: f64,
+        patch: Patch,
         max_nominal: f64,
         samples: usize,
     ) -> Result<Self, QueryError> {
-        let side = (PATCH_RADII * radius).min(PATCH_PIXELS / scale);
+        let Patch { radius, scale, .. } = patch;
+        let side = (PATCH_RADII * radius)
+            .min(PATCH_PIXELS / scale)
+            .min(patch.extent);
         let margin = 2.0 * radius;
         let pixels = (side * scale).round().max(1.0) as usize;
-        let step = max_nominal / samples.max(1) as f64;
-        let mut coverage = vec![0.0];
+        let samples = samples.max(1);
+        let step = max_nominal / samples as f64;
+        let density = |k: usize| k as f64 * step / (PI * radius * radius);
+        // The point set only grows with the density: the densest level's points, taken in
+        // the order they appear, are every level's. Each dot is drawn once, and the ink is
+        // read after each level's dots.
+        let rect = Rect::new(DVec2::splat(-margin), DVec2::splat(side + margin))?;
         let mut points = Vec::new();
-        for k in 1..=samples.max(1) {
-            let density = Constant(k as f64 * step / (PI * radius * radius));
-            // Each patch elsewhere in the plane, so that they are independent samples.
-            let origin = DVec2::new(k as f64 * (side + 4.0 * margin), 0.0);
-            let rect = Rect::new(origin - margin, origin + side + margin)?;
-            points.clear();
-            sampler.query(rect, &density, &mut points)?;
-            let mut raster = Grey::filled(pixels, pixels, 0.0);
-            for p in &points {
-                raster.dot((p.position - origin) * scale, radius * scale);
+        sampler.query(rect, &Constant(density(samples)), &mut points)?;
+        points.sort_by(|a, b| a.threshold.total_cmp(&b.threshold));
+        let mut raster = Grey::filled(pixels, pixels, 0.0);
+        let mut coverage = vec![0.0];
+        let mut drawn = points.iter().peekable();
+        for k in 1..=samples {
+            while let Some(p) = drawn.next_if(|p| p.threshold < density(k)) {
+                raster.dot(p.position * scale, radius * scale);
             }
-            let last = *coverage.last().unwrap_or(&0.0);
-            coverage.push(raster.mean().max(last));
+            coverage.push(raster.mean());
         }
         Ok(Self { step, coverage })
     }

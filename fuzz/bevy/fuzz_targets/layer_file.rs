@@ -1,4 +1,4 @@
 #![no_main]
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
-    rwt_fuzz::layer_checks::layer_file(data);
+    rwt_fuzz_bevy::layer_checks::layer_file(data);
 });
