@@ -7,7 +7,9 @@ mod plugin;
 mod status;
 
 pub use image::from_bevy_image;
-pub(crate) use image::{texel_luminance, too_large};
+#[cfg(feature = "brush")]
+pub(crate) use image::texel_luminance;
+pub(crate) use image::too_large;
 pub use plugin::RwtLayersPlugin;
 pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
 pub use status::{AssetStatus, ScatterLayerStatus};

@@ -19,7 +19,9 @@ mod spawn;
 pub use plugin::RwtStreamingPlugin;
 
 use crate::instancing::{InstancedClasses, PackedClass};
-use crate::layers::{HeightFn, ScatterLayer, ScatterLayerStatus};
+#[cfg(feature = "brush")]
+use crate::layers::HeightFn;
+use crate::layers::{ScatterLayer, ScatterLayerStatus};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::tasks::Task;
@@ -122,7 +124,8 @@ pub(crate) struct LayerState {
 
 impl LayerState {
     /// The layer's ground height as its chunks are generated with (`None` until resolved,
-    /// e.g. while a heightmap loads).
+    /// e.g. while a heightmap loads): where the brush paints.
+    #[cfg(feature = "brush")]
     pub(crate) fn height(&self) -> Option<&HeightFn> {
         self.sources.height()
     }
