@@ -16,13 +16,16 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// Runs `rwt` with shell limits (`ulimit ...`) applied first.
+/// Runs `rwt` with shell limits (`ulimit ...`) applied first. Two threads and two malloc
+/// arenas whatever the machine: an address-space limit counts what those reserve.
 fn rwt_limited(limits: &str, dir: &Path, args: &[&str]) -> Output {
     Command::new("sh")
         .arg("-c")
         .arg(format!("{limits}; trap '' XFSZ; exec \"$0\" \"$@\""))
         .arg(env!("CARGO_BIN_EXE_rwt"))
         .args(args)
+        .env("RAYON_NUM_THREADS", "2")
+        .env("MALLOC_ARENA_MAX", "2")
         .current_dir(dir)
         .output()
         .unwrap()

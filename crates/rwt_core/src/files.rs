@@ -149,11 +149,14 @@ fn sync_dir(dir: &Path) {
 
 /// A file being written in place of another: bytes go to a temporary file beside the
 /// target, which [`AtomicFile::commit`] renames over it. Dropped without a commit (an error
-/// on the way), the temporary file is removed and the target is untouched.
+/// on the way), the temporary file is removed and the target is untouched. A target that is
+/// not a regular file (`/dev/null`, a pipe, a terminal) is written in place: it has no
+/// previous bytes to keep, and renaming over it would replace the device.
 pub struct AtomicFile {
     target: PathBuf,
     /// What the error messages name: the path the caller gave.
     shown: PathBuf,
+    /// The temporary file; empty when writing in place or once renamed.
     temp: PathBuf,
     file: Option<BufWriter<File>>,
 }
@@ -162,6 +165,18 @@ impl AtomicFile {
     /// Starts replacing `path` (creating its folder when missing).
     pub fn create(path: &Path) -> Result<Self, FileError> {
         let target = resolve_target(path);
+        if std::fs::metadata(&target).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+            let file = File::options()
+                .write(true)
+                .open(&target)
+                .map_err(|e| FileError::io(path, FileAction::Create, &e))?;
+            return Ok(Self {
+                target,
+                shown: path.to_path_buf(),
+                temp: PathBuf::new(),
+                file: Some(BufWriter::with_capacity(1 << 16, file)),
+            });
+        }
         if let Some(dir) = target.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| FileError::io(dir, FileAction::Create, &e))?;
         }
@@ -191,6 +206,10 @@ impl AtomicFile {
         let file = writer
             .into_inner()
             .map_err(|e| FileError::io(shown, FileAction::Write, e.error()))?;
+        if self.temp.as_os_str().is_empty() {
+            // Written in place: a device or a pipe may not sync, and has nothing to keep.
+            return Ok(());
+        }
         file.sync_all()
             .map_err(|e| FileError::io(shown, FileAction::Write, &e))
     }
@@ -199,6 +218,9 @@ impl AtomicFile {
     /// folder. On error the target is untouched and the temporary file removed.
     pub fn commit(mut self) -> Result<(), FileError> {
         self.finish()?;
+        if self.temp.as_os_str().is_empty() {
+            return Ok(());
+        }
         std::fs::rename(&self.temp, &self.target)
             .map_err(|e| FileError::io(&self.shown, FileAction::Rename, &e))?;
         // Renamed: nothing left for `drop` to remove.
@@ -481,6 +503,22 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    #[cfg(unix)]
+    #[test]
+    fn devices_are_written_in_place_not_replaced() {
+        write_atomic(Path::new("/dev/null"), b"gone").unwrap();
+        let m = std::fs::metadata("/dev/null").unwrap();
+        assert!(!m.is_file(), "/dev/null must stay a device");
+        let leftovers = std::fs::read_dir("/dev")
+            .unwrap()
+            .filter(|e| {
+                let name = e.as_ref().unwrap().file_name();
+                name.to_string_lossy().ends_with(TEMP_SUFFIX)
+            })
+            .count();
+        assert_eq!(leftovers, 0);
+    }
+
     #[test]
     fn reads_are_limited_before_memory_is_spent() {
         let dir = scratch("limit");
@@ -502,13 +540,19 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
-    #[test]
-    fn a_transaction_that_fails_part_way_changes_nothing() {
-        let dir = scratch("txn");
+    /// A folder holding a first save of `a.png` ("a1") and `index.ron` ("i1").
+    fn saved_once(name: &str) -> PathBuf {
+        let dir = scratch(name);
         let mut save = SaveTransaction::begin(&dir).unwrap();
         save.write("a.png", b"a1").unwrap();
         save.write("index.ron", b"i1").unwrap();
         save.commit().unwrap();
+        dir
+    }
+
+    #[test]
+    fn a_transaction_that_fails_part_way_changes_nothing() {
+        let dir = saved_once("txn");
         let mut save = SaveTransaction::begin(&dir).unwrap();
         save.write("a.png", b"a2").unwrap();
         let err = save.write_with("index.ron", |w| {
@@ -526,11 +570,7 @@ mod tests {
 
     #[test]
     fn a_save_interrupted_after_its_journal_is_finished_by_recover() {
-        let dir = scratch("journal");
-        let mut save = SaveTransaction::begin(&dir).unwrap();
-        save.write("a.png", b"a1").unwrap();
-        save.write("index.ron", b"i1").unwrap();
-        save.commit().unwrap();
+        let dir = saved_once("journal");
         // A crash after the journal and the first rename: stage, journal, rename one by
         // hand, then forget the transaction.
         let mut save = SaveTransaction::begin(&dir).unwrap();
