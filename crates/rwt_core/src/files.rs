@@ -9,7 +9,8 @@
 //!
 //! [`SaveTransaction`] commits several files of one folder all-or-nothing: each is staged
 //! as a temporary file; only when every one is written and synced does a journal naming
-//! them make the save durable, and the renames follow. A failure while staging leaves every
+//! them make the save durable, and the renames follow (a link in the folder is replaced by
+//! the file, not followed). A failure while staging leaves every
 //! previous file as it was; a crash after the journal is finished by [`recover`] (which
 //! [`SaveTransaction::begin`] calls), so a reader never sees half of a save. One writer per
 //! folder at a time.
@@ -177,6 +178,12 @@ impl AtomicFile {
                 file: Some(BufWriter::with_capacity(1 << 16, file)),
             });
         }
+        Self::beside(target, path)
+    }
+
+    /// Starts replacing `target` itself (a link is replaced, not followed), through a
+    /// temporary file beside it; errors name `shown`.
+    fn beside(target: PathBuf, shown: &Path) -> Result<Self, FileError> {
         if let Some(dir) = target.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| FileError::io(dir, FileAction::Create, &e))?;
         }
@@ -185,10 +192,10 @@ impl AtomicFile {
             .write(true)
             .create_new(true)
             .open(&temp)
-            .map_err(|e| FileError::io(path, FileAction::Create, &e))?;
+            .map_err(|e| FileError::io(shown, FileAction::Create, &e))?;
         Ok(Self {
             target,
-            shown: path.to_path_buf(),
+            shown: shown.to_path_buf(),
             temp,
             file: Some(BufWriter::with_capacity(1 << 16, file)),
         })
@@ -355,7 +362,9 @@ impl SaveTransaction {
         if self.staged.iter().any(|s| s.name == name) {
             return Err(FileError::Duplicate { path });
         }
-        let mut file = AtomicFile::create(&path)?;
+        // Staged beside its name in the folder (a link there is replaced, not followed: the
+        // journal names files of this folder only).
+        let mut file = AtomicFile::beside(path.clone(), &path)?;
         write(&mut file).map_err(|e| FileError::io(&path, FileAction::Write, &e))?;
         file.finish()?;
         let temp = std::mem::take(&mut file.temp);
@@ -394,7 +403,7 @@ fn file_name(path: &Path) -> String {
 /// Renames the journal's files into place and removes the journal.
 fn finish_journal(dir: &Path, staged: &[Staged]) -> Result<(), FileError> {
     for s in staged {
-        let (temp, target) = (dir.join(&s.temp), resolve_target(&dir.join(&s.name)));
+        let (temp, target) = (dir.join(&s.temp), dir.join(&s.name));
         // A temporary file already gone was renamed before an interruption.
         if temp.exists() {
             std::fs::rename(&temp, &target)
@@ -440,9 +449,10 @@ pub fn recover(dir: &Path) -> Result<bool, FileError> {
     Ok(finished)
 }
 
-/// A file name without folders (journal entries never leave their folder).
-fn is_plain_name(name: &str) -> bool {
-    !name.is_empty() && Path::new(name).file_name().is_some_and(|n| n == name) && name != ".."
+/// Whether `name` names a file of a folder itself: no folders, not `..` (journal and index
+/// entries never leave their folder).
+pub fn is_plain_name(name: &str) -> bool {
+    Path::new(name).file_name().is_some_and(|n| n == name) && name != ".."
 }
 
 #[cfg(test)]
@@ -566,6 +576,32 @@ mod tests {
         assert_eq!(std::fs::read(dir.join("index.ron")).unwrap(), b"i1");
         assert_eq!(names(&dir), ["a.png", "index.ron"]);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_save_replaces_a_link_in_its_folder() {
+        let dir = saved_once("save-link");
+        let elsewhere = scratch("save-link-target");
+        std::fs::write(elsewhere.join("kept.png"), b"theirs").unwrap();
+        std::fs::remove_file(dir.join("a.png")).unwrap();
+        std::os::unix::fs::symlink(elsewhere.join("kept.png"), dir.join("a.png")).unwrap();
+        let mut save = SaveTransaction::begin(&dir).unwrap();
+        save.write("a.png", b"a2").unwrap();
+        save.commit().unwrap();
+        assert!(
+            std::fs::symlink_metadata(dir.join("a.png"))
+                .unwrap()
+                .is_file()
+        );
+        assert_eq!(std::fs::read(dir.join("a.png")).unwrap(), b"a2");
+        assert_eq!(
+            std::fs::read(elsewhere.join("kept.png")).unwrap(),
+            b"theirs"
+        );
+        assert_eq!(names(&elsewhere), ["kept.png"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(&elsewhere).unwrap();
     }
 
     #[test]

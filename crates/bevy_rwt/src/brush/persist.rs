@@ -12,7 +12,7 @@ use super::{BrushError, BrushTarget, DensityBrush};
 use crate::layers::file::{LayerDescription, NamedAssets};
 use crate::layers::{ScatterLayer, texel_luminance};
 use bevy::prelude::*;
-use rwt_core::files::{SaveTransaction, read_limited, recover};
+use rwt_core::files::{SaveTransaction, is_plain_name, read_limited, recover};
 use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, HashSet};
 use std::io::Write;
@@ -63,7 +63,7 @@ impl PaintedMaps {
             reason: e.to_string(),
         })?;
         let names = index.maps.iter().map(|m| &m.file).chain(&index.layers);
-        if let Some(bad) = names.into_iter().find(|f| !is_plain_file_name(f)) {
+        if let Some(bad) = names.into_iter().find(|f| !is_plain_name(f)) {
             return Err(BrushError::OutsideFolder { file: bad.clone() });
         }
         Ok(index)
@@ -83,11 +83,6 @@ fn read_text(path: &Path) -> Result<String, BrushError> {
         file: path.to_path_buf(),
         reason: "not UTF-8 text".into(),
     })
-}
-
-/// A name in the index's folder: no folders, no `..`.
-fn is_plain_file_name(name: &str) -> bool {
-    Path::new(name).file_name().is_some_and(|n| n == name) && name != ".."
 }
 
 /// File names given out in one save: `name` with anything but letters, digits, `-` and
@@ -331,10 +326,10 @@ mod tests {
     #[test]
     fn index_entries_stay_in_their_folder() {
         for ok in ["a.png", "red_flowers-2.png", ".hidden.png"] {
-            assert!(is_plain_file_name(ok), "{ok}");
+            assert!(is_plain_name(ok), "{ok}");
         }
-        for bad in ["../a.png", "/etc/passwd", "maps/a.png", "..", ""] {
-            assert!(!is_plain_file_name(bad), "{bad}");
+        for bad in ["../a.png", "/etc/passwd", "maps/a.png", "..", ".", ""] {
+            assert!(!is_plain_name(bad), "{bad}");
         }
     }
 }
