@@ -48,7 +48,11 @@ pub fn run(args: &StippleArgs) -> Result<(), String> {
     let named = |e: &dyn std::fmt::Display| format!("{}: {e}", args.image.display());
     // Settings, raster and dot count are admitted from the header, before decoding; the
     // image itself is at most rwt_core's MAX_IMAGE_PIXELS.
-    let (w, h) = image::image_dimensions(args.image).map_err(|e| named(&e))?;
+    let (w, h) = image::ImageReader::open(args.image)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| named(&e))?
+        .into_dimensions()
+        .map_err(|e| named(&e))?;
     settings
         .admit(w as usize, h as usize)
         .map_err(|e| e.to_string())?;
