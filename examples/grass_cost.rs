@@ -19,7 +19,7 @@
 use bevy::prelude::*;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::{Render, RenderApp, RenderSystems};
-use bevy_rwt::instancing::blade_mesh;
+use bevy_rwt::look::blade_mesh;
 use bevy_rwt::prelude::*;
 use rwt_examples::prelude::*;
 use std::sync::{Arc, Mutex};

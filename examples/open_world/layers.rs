@@ -2,8 +2,8 @@
 
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushTarget, DensityBrush};
-use bevy_rwt::instancing::blade_mesh;
 use bevy_rwt::layers::file::NamedAssets;
+use bevy_rwt::look::blade_mesh;
 use bevy_rwt::prelude::*;
 use noise::{NoiseFn, Perlin};
 use rwt_core::density::{NoiseDensity, NoiseParams};

@@ -103,9 +103,11 @@
 #[cfg(feature = "brush")]
 pub mod brush;
 pub mod diagnostics;
+mod entities;
 pub mod gizmos;
 pub mod instancing;
 pub mod layers;
+pub mod look;
 mod settings;
 pub mod streaming;
 pub mod viewers;
@@ -113,10 +115,13 @@ pub mod viewers;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 pub use diagnostics::RwtStats;
-pub use instancing::{InstancedChunk, InstancedMaterial, RwtFadeIn, RwtInstancingPlugin, RwtWind};
+pub use instancing::{InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind};
 pub use layers::{
-    AssetStatus, ClassLook, GroundPlane, HeightSource, InstanceInserter, LayerDensity, MeshLod,
-    ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus,
+    AssetStatus, HeightSource, LayerDensity, ScatterClass, ScatterInstance, ScatterLayer,
+    ScatterLayerStatus,
+};
+pub use look::{
+    ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, MeshLod, Pose,
 };
 pub use rwt_core;
 use rwt_core::tileset::TileSet;

@@ -1,6 +1,7 @@
 //! Dabs of paint on a map's texels, and what a stroke needs to be undone.
 
-use crate::layers::{LayerDensity, ground_rect, texel_luminance};
+use super::{BrushError, DensityBrush};
+use crate::layers::{LayerDensity, ScatterLayer, ground_rect, texel_luminance};
 use bevy::asset::RenderAssetUsages;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -36,6 +37,46 @@ pub fn blank_map(
         scale,
     };
     (handle, density)
+}
+
+/// A target's map and where it lies.
+pub(super) struct TargetMap {
+    pub(super) image: Handle<Image>,
+    pub(super) at: MapPlacement,
+    pub(super) scale: f64,
+}
+
+pub(super) fn target_map(
+    brush: &DensityBrush,
+    index: usize,
+    layers: &Query<&ScatterLayer>,
+) -> Result<TargetMap, BrushError> {
+    let target = brush
+        .targets
+        .get(index)
+        .ok_or(BrushError::NoTarget(index))?;
+    let density = layers
+        .get(target.layer)
+        .ok()
+        .and_then(|l| l.classes.get(target.class))
+        .map(|c| &c.density)
+        .ok_or_else(|| BrushError::NoLayer(target.name.clone()))?;
+    match density {
+        LayerDensity::Image {
+            image,
+            min,
+            size,
+            scale,
+        } => Ok(TargetMap {
+            image: image.clone(),
+            at: MapPlacement {
+                min: *min,
+                size: *size,
+            },
+            scale: *scale,
+        }),
+        _ => Err(BrushError::NotPaintable(target.name.clone())),
+    }
 }
 
 /// Where a map lies on the ground.

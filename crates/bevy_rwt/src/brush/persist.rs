@@ -6,8 +6,7 @@
 //! leaves the previous save complete. A load reads and checks every file first and changes
 //! the world only when all of it is good.
 
-use super::paint::set_texel_luminance;
-use super::plugin::target_map;
+use super::paint::{set_texel_luminance, target_map};
 use super::{BrushError, BrushTarget, DensityBrush};
 use crate::layers::file::{LayerDescription, NamedAssets};
 use crate::layers::{ScatterLayer, texel_luminance};

@@ -1,10 +1,10 @@
 //! The brush plugin: cursor, input, dabs, strokes and their undo, files, the gizmo circle.
 
-use super::paint::{MapPlacement, StrokeRecord, dab, restore};
+use super::paint::{StrokeRecord, dab, restore, target_map};
 use super::persist::{SaveSources, load, save};
 use super::{BrushCommand, BrushError, BrushSystems, DensityBrush, PaintDab, ground_hit};
 use crate::layers::file::NamedAssets;
-use crate::layers::{HeightFn, LayerDensity, ScatterLayer};
+use crate::layers::{HeightFn, ScatterLayer};
 use crate::streaming::DensityMapPainted;
 use crate::streaming::LayerState;
 use crate::viewers::RwtViewer;
@@ -60,46 +60,6 @@ impl BrushHistory {
                 self.done.pop_front();
             }
         }
-    }
-}
-
-/// A target's map and where it lies.
-pub(super) struct TargetMap {
-    pub(super) image: Handle<Image>,
-    pub(super) at: MapPlacement,
-    pub(super) scale: f64,
-}
-
-pub(super) fn target_map(
-    brush: &DensityBrush,
-    index: usize,
-    layers: &Query<&ScatterLayer>,
-) -> Result<TargetMap, BrushError> {
-    let target = brush
-        .targets
-        .get(index)
-        .ok_or(BrushError::NoTarget(index))?;
-    let density = layers
-        .get(target.layer)
-        .ok()
-        .and_then(|l| l.classes.get(target.class))
-        .map(|c| &c.density)
-        .ok_or_else(|| BrushError::NoLayer(target.name.clone()))?;
-    match density {
-        LayerDensity::Image {
-            image,
-            min,
-            size,
-            scale,
-        } => Ok(TargetMap {
-            image: image.clone(),
-            at: MapPlacement {
-                min: *min,
-                size: *size,
-            },
-            scale: *scale,
-        }),
-        _ => Err(BrushError::NotPaintable(target.name.clone())),
     }
 }
 

@@ -4,7 +4,8 @@ mod plugin;
 
 pub use plugin::RwtGizmosPlugin;
 
-use crate::layers::{GroundPlane, ScatterLayer, ScatterLayerStatus};
+use crate::layers::{ScatterLayer, ScatterLayerStatus};
+use crate::look::GroundPlane;
 use bevy::prelude::*;
 
 /// What [`RwtGizmosPlugin`] draws.

@@ -2,7 +2,8 @@
 //! task (off the main thread).
 
 use super::{GpuInstance, InstanceBuffer};
-use crate::layers::{ClassLook, GroundPlane, HeightFn, ScatterLayer};
+use crate::layers::{HeightFn, ScatterLayer};
+use crate::look::{ClassLook, GroundPlane, Pose};
 use bevy::prelude::*;
 use glam::DVec2;
 use rwt_core::density::{Density, sanitize};
@@ -118,12 +119,13 @@ impl InstancedClasses {
     /// One instance: the same place, turn and scale as the entity path would give it.
     fn instance(&self, p: &Point, corner: DVec2, height: &HeightFn, appear: f64) -> GpuInstance {
         let (scale, variation) = self.classes[p.class as usize].unwrap_or((1.0, 0.0));
+        let pose = Pose::of(&p.id, self.seed, scale, variation);
         let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
         let offset = p.position - corner;
         GpuInstance {
             offset: [offset.x as f32, height(ground), offset.y as f32],
-            scale: scale * p.id.scale(self.seed, variation as f64) as f32,
-            yaw: unit_u16(p.id.rotation(self.seed) / std::f64::consts::TAU),
+            scale: pose.scale,
+            yaw: unit_u16(pose.yaw / std::f64::consts::TAU),
             appear: unit_u16(appear),
             tint: unit_u16(p.id.unit(self.seed, TINT_SALT)),
             reserved: 0,

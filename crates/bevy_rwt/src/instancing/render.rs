@@ -3,8 +3,8 @@
 //! world's buffer is the same one) and a small uniform with the chunk's corner, shading,
 //! fall-off and wind.
 
-use super::mesh::check_topology;
 use super::{GpuInstance, InstanceBuffer, InstancedChunk, RwtFadeIn, RwtWind};
+use crate::look::check_topology;
 use bevy::core_pipeline::core_3d::{Transparent3d, TransparentSortingInfo3d};
 use bevy::ecs::query::QueryItem;
 use bevy::ecs::system::{SystemParamItem, lifetimeless::*};

@@ -14,8 +14,7 @@ pub use plugin::RwtLayersPlugin;
 pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
 pub use status::{AssetStatus, ScatterLayerStatus};
 
-use crate::instancing::{InstancedLook, InstancedMaterial};
-use bevy::camera::visibility::VisibilityRange;
+use crate::look::{ClassLook, GroundPlane, InstancedLook, InstancedMaterial, MeshLod};
 use bevy::prelude::*;
 use rwt_core::density::{Constant, Density, NoiseDensity};
 use rwt_core::streaming::{Falloff, StreamingConfig};
@@ -96,43 +95,6 @@ impl LayerDensity {
     }
 }
 
-/// Inserts a class's own components into every instance it spawns (after `Transform` and
-/// [`ScatterInstance`]).
-pub type InstanceInserter = Arc<dyn Fn(&mut EntityCommands) + Send + Sync>;
-
-/// How the instances of a class look.
-#[derive(Clone)]
-pub enum ClassLook {
-    /// A mesh and a material shared by every instance, so Bevy batches them.
-    Mesh {
-        /// The mesh.
-        mesh: Handle<Mesh>,
-        /// The material.
-        material: Handle<StandardMaterial>,
-    },
-    /// Whatever the function inserts: a scene (`SceneRoot(handle.clone())`, with Bevy's
-    /// `bevy_scene` feature in the game), another material type, colliders, markers.
-    Custom(InstanceInserter),
-    /// No entity per instance: each chunk's instances are packed into one GPU buffer and
-    /// drawn with one instanced draw (grass, flowers, pebbles; see [`crate::instancing`]).
-    /// Only on the [`GroundPlane::Xz`] plane.
-    Instanced(InstancedLook),
-}
-
-impl std::fmt::Debug for ClassLook {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ClassLook::Mesh { mesh, material } => f
-                .debug_struct("Mesh")
-                .field("mesh", mesh)
-                .field("material", material)
-                .finish(),
-            ClassLook::Custom(_) => f.write_str("Custom(..)"),
-            ClassLook::Instanced(look) => look.fmt(f),
-        }
-    }
-}
-
 /// One kind of instance in a layer: its own density (the layer's classes share one blue-noise
 /// point set, paper section 6.3) and how it looks.
 #[derive(Clone, Debug)]
@@ -147,44 +109,6 @@ pub struct ScatterClass {
     pub scale_variation: f32,
     /// A cheaper look from some distance on (for [`ClassLook::Mesh`] classes).
     pub lod: Option<MeshLod>,
-}
-
-/// The far level of detail of a mesh class: from `distance` to the camera on, instances show
-/// this mesh and material instead of the class's, crossfading (Bevy's dithered
-/// [`VisibilityRange`]) over `crossfade` around `distance`. Each instance then has one child
-/// entity holding the far look.
-#[derive(Clone, Debug)]
-pub struct MeshLod {
-    /// The far mesh, standing on the same origin as the near one.
-    pub mesh: Handle<Mesh>,
-    /// The far material.
-    pub material: Handle<StandardMaterial>,
-    /// Distance of the switch.
-    pub distance: f32,
-    /// Width of the crossfade band centred on `distance`.
-    pub crossfade: f32,
-}
-
-impl MeshLod {
-    /// The visibility ranges of the near and the far look.
-    pub fn ranges(&self) -> (VisibilityRange, VisibilityRange) {
-        let half = (0.5 * self.crossfade).clamp(0.0, 0.99 * self.distance.max(0.0));
-        let switch = (self.distance - half).max(0.0)..self.distance + half;
-        let near = VisibilityRange {
-            start_margin: 0.0..0.0,
-            end_margin: switch.clone(),
-            use_aabb: false,
-        };
-        let far = VisibilityRange {
-            start_margin: switch,
-            end_margin: Self::NEVER..Self::NEVER,
-            use_aabb: false,
-        };
-        (near, far)
-    }
-
-    /// A distance no camera reaches (the far look never fades out).
-    const NEVER: f32 = 1.0e9;
 }
 
 impl ScatterClass {
@@ -453,47 +377,6 @@ impl ScatterLayer {
             .iter()
             .map(|c| &c.density)
             .chain(self.exclusion.iter())
-    }
-}
-
-/// The plane a layer lies on. Ground positions `(u, v)` of the point set and the height
-/// `h` of the [`HeightSource`] become these world positions.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
-pub enum GroundPlane {
-    /// A 3-D world with y up: `(u, h, v)`, instances turned about y.
-    #[default]
-    Xz,
-    /// A 2-D world (sprites): `(u, v, h + depth)`, instances turned about z. `depth` is a
-    /// hash of the point in `[0, 0.001)`, so that overlapping sprites keep a stable order.
-    Xy,
-}
-
-impl GroundPlane {
-    /// An instance's transform: at ground position `ground` and height `height`, turned by
-    /// `yaw` about the plane's normal, scaled by `scale`.
-    pub fn transform(
-        self,
-        ground: Vec2,
-        height: f32,
-        yaw: f32,
-        scale: f32,
-        depth: f32,
-    ) -> Transform {
-        let (translation, rotation) = match self {
-            GroundPlane::Xz => (
-                Vec3::new(ground.x, height, ground.y),
-                Quat::from_rotation_y(yaw),
-            ),
-            GroundPlane::Xy => (
-                Vec3::new(ground.x, ground.y, height + depth * 1e-3),
-                Quat::from_rotation_z(yaw),
-            ),
-        };
-        Transform::from_translation(translation)
-            .with_rotation(rotation)
-            .with_scale(Vec3::splat(scale))
     }
 }
 

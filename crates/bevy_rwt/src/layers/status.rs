@@ -1,6 +1,6 @@
 //! What the plugin reports about each layer: its assets, chunks and instances.
 
-use crate::instancing::InstancedClassError;
+use crate::look::InstancedClassError;
 use bevy::platform::collections::HashSet;
 use bevy::prelude::*;
 use rwt_core::streaming::ChunkCoord;

@@ -5,8 +5,9 @@
 //! - `resolve`: a layer's densities and height source as thread-safe snapshots, re-made
 //!   only for the maps that change;
 //! - `plan`: chunks to load and unload, generation tasks for the nearest stale chunks;
-//! - `collect`: finished tasks to spawn and despawn queues (by point identity);
-//! - `spawn`: budgeted spawning and despawning;
+//! - `collect`: finished tasks handed to the look that shows them: points of entity
+//!   classes to [`crate::entities`], instance buffers to [`crate::instancing`];
+//! - `spawn`: each look's queue spent within the per-frame budgets;
 //! - `repaint`: painted maps mark the chunks they cover stale.
 
 mod collect;
@@ -18,17 +19,17 @@ mod spawn;
 
 pub use plugin::RwtStreamingPlugin;
 
-use crate::instancing::{InstancedClasses, PackedClass};
+use crate::entities::EntityQueue;
+use crate::instancing::{InstancedClasses, InstancedQueue, PackedClass};
 #[cfg(feature = "brush")]
 use crate::layers::HeightFn;
 use crate::layers::{ScatterLayer, ScatterLayerStatus};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::tasks::Task;
-use rwt_core::query::{Point, PointId, QueryError, Rect, Sampler};
+use rwt_core::query::{Point, QueryError, Rect, Sampler};
 use rwt_core::streaming::{ChunkCoord, ChunkSet};
 use rwt_core::tileset::TileSet;
-use std::collections::VecDeque;
 use std::sync::Arc;
 
 /// A chunk's instances were generated (or regenerated) and queued for spawning.
@@ -79,18 +80,6 @@ type ChunkTask = Task<Result<ChunkContent, QueryError>>;
 
 #[derive(Default)]
 struct ChunkState {
-    /// Spawned instances by identity, with their class.
-    instances: HashMap<PointId, (Entity, u16)>,
-    /// Points generated but not yet spawned (waiting for the spawn budget).
-    queued: Vec<Point>,
-    /// Whether the chunk is in the spawn order.
-    in_order: bool,
-    /// The chunk entity of each instanced class, with its instance count.
-    instanced: HashMap<u16, (Entity, usize)>,
-    /// Instance buffers generated but not yet handed to their entities (upload budget).
-    upload: Vec<PackedClass>,
-    /// Whether the chunk is in the upload order.
-    in_upload_order: bool,
     /// Level-of-detail band the content was generated for.
     lod: i64,
     task: Option<(ChunkTask, i64)>,
@@ -106,18 +95,14 @@ struct ChunkState {
 pub(crate) struct LayerState {
     sampler: Option<Arc<Sampler>>,
     /// The layer's instanced classes (made with the sampler).
-    instanced: Option<InstancedClasses>,
+    instanced_classes: Option<InstancedClasses>,
     sources: resolve::Resolved,
     chunks: ChunkSet,
     states: HashMap<ChunkCoord, ChunkState>,
-    /// Chunks with queued points, in the order they finished (unloaded ones are skipped).
-    spawn_order: VecDeque<ChunkCoord>,
-    despawn: VecDeque<Entity>,
-    /// Chunk entities of instanced classes whose chunks were unloaded: despawned this frame
-    /// whatever the budget (one entity each).
-    retired: Vec<Entity>,
-    /// Chunks with instance buffers to hand over, in the order they finished.
-    upload_order: VecDeque<ChunkCoord>,
+    /// What the entity look shows and is about to show.
+    entities: EntityQueue,
+    /// What the instanced look draws and is about to draw.
+    instanced: InstancedQueue,
     /// Whether a refused query was logged (once per layer).
     refusal_logged: bool,
 }
@@ -128,22 +113,6 @@ impl LayerState {
     #[cfg(feature = "brush")]
     pub(crate) fn height(&self) -> Option<&HeightFn> {
         self.sources.height()
-    }
-
-    /// Live instances of the layer: those its chunks hold, plus those waiting in the
-    /// despawn queue (still in the world until their turn comes).
-    fn live(&self) -> usize {
-        self.states
-            .values()
-            .map(|c| c.instances.len())
-            .sum::<usize>()
-            + self.despawn.len()
-    }
-
-    /// Live instances of the layer's instanced classes (in their chunks' buffers).
-    fn live_instanced(&self) -> usize {
-        let per_chunk = |c: &ChunkState| c.instanced.values().map(|(_, n)| n).sum::<usize>();
-        self.states.values().map(per_chunk).sum()
     }
 
     /// Chunks with a generation task in flight or waiting for one.
@@ -159,26 +128,18 @@ impl LayerState {
         self.states.values().filter(|c| c.task.is_some()).count()
     }
 
-    /// Instances waiting for the spawn budget or, in instance buffers, the upload budget.
-    fn queued(&self) -> usize {
-        let upload =
-            |c: &ChunkState| -> usize { c.upload.iter().map(|p| p.buffer.instances.len()).sum() };
-        self.states
-            .values()
-            .map(|c| c.queued.len() + upload(c))
-            .sum()
-    }
-
     /// Despawns every instance the layer has placed or was about to remove.
     fn despawn_all(&self, commands: &mut Commands) {
-        let placed = self.states.values().flat_map(|c| {
-            let instances = c.instances.values().map(|(e, _)| *e);
-            instances.chain(c.instanced.values().map(|(e, _)| *e))
-        });
-        let waiting = self.despawn.iter().chain(&self.retired).copied();
-        for e in placed.chain(waiting) {
-            commands.entity(e).try_despawn();
-        }
+        self.entities.despawn_all(commands);
+        self.instanced.despawn_all(commands);
+    }
+
+    /// Forgets a chunk that left every viewer's unload distance: each look takes its
+    /// instances away.
+    fn unload(&mut self, chunk: ChunkCoord) {
+        self.states.remove(&chunk);
+        self.entities.unload(chunk);
+        self.instanced.unload(chunk);
     }
 
     /// Marks every chunk overlapping `region` for regeneration.
@@ -228,10 +189,10 @@ fn on_layer_inserted(
 fn update_status(mut layers: Query<(&LayerState, &mut ScatterLayerStatus)>) {
     for (state, mut status) in &mut layers {
         let status = status.bypass_change_detection();
-        status.live_instances = state.live();
-        status.live_instanced = state.live_instanced();
+        status.live_instances = state.entities.live();
+        status.live_instanced = state.instanced.live();
         status.pending_tasks = state.pending();
-        status.queued_spawns = state.queued();
+        status.queued_spawns = state.entities.queued() + state.instanced.queued();
         status.refused_chunks = state.states.values().filter(|c| c.refused).count();
     }
 }

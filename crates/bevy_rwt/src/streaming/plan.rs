@@ -59,7 +59,7 @@ pub(super) fn plan_chunks(
             .clone();
         let keep_ids = inputs.settings.keep_instance_ids;
         let instanced = state
-            .instanced
+            .instanced_classes
             .get_or_insert_with(|| InstancedClasses::new(entity, layer, keep_ids))
             .clone();
         let viewers = inputs.viewers.on(layer.plane);
@@ -93,11 +93,7 @@ fn update_chunks(
     let changes = state.chunks.update(&layer.streaming, viewers);
     let changed = !(changes.load.is_empty() && changes.unload.is_empty());
     for chunk in changes.unload {
-        if let Some(c) = state.states.remove(&chunk) {
-            state.despawn.extend(c.instances.values().map(|(e, _)| *e));
-            state.retired.extend(c.instanced.values().map(|(e, _)| *e));
-        }
-        // Its queued points go with it; its place in the spawn order is skipped later.
+        state.unload(chunk);
         unloaded.write(ChunkUnloaded {
             layer: entity,
             chunk,

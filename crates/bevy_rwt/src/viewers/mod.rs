@@ -5,7 +5,7 @@ mod plugin;
 
 pub use plugin::RwtViewersPlugin;
 
-use crate::layers::GroundPlane;
+use crate::look::GroundPlane;
 use crate::settings::RwtSettings;
 use bevy::prelude::*;
 use glam::DVec2;

@@ -5,7 +5,8 @@ use super::{
     LayerDescription, LayerFileError, LodDescription, MaterialDescription, MeshDescription,
     NamedAssets,
 };
-use crate::layers::{ClassLook, HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+use crate::layers::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+use crate::look::ClassLook;
 use bevy::prelude::*;
 
 /// How [`LayerDescription::describe`] names assets.

@@ -68,8 +68,8 @@ mod tests;
 pub use loader::ScatterLayerLoader;
 pub use names::NamedAssets;
 
-use super::{GroundPlane, HeightSource, LayerDensity, MeshLod, ScatterClass, ScatterLayer};
-use crate::instancing::{InstancedMaterial, blade_mesh};
+use super::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+use crate::look::{GroundPlane, InstancedMaterial, MeshLod, blade_mesh};
 use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::Falloff;

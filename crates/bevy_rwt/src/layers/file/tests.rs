@@ -1,7 +1,7 @@
 //! Layer files: parsing, checking, writing and describing layers.
 
 use super::*;
-use crate::layers::ClassLook;
+use crate::look::ClassLook;
 
 /// The layer of `d` with default handles and no names.
 fn plain(d: &LayerDescription) -> ScatterLayer {
@@ -123,9 +123,7 @@ fn instanced_classes_in_a_layer_file() {
     let read = plain.material.base_color.to_linear();
     assert!((base.green - read.green).abs() < 1e-6, "{base:?} {read:?}");
     let blade = d.classes[0].mesh.primitive().unwrap();
-    let (_, hi) = crate::instancing::check_instanced_mesh(&blade)
-        .unwrap()
-        .unwrap();
+    let (_, hi) = crate::look::check_instanced_mesh(&blade).unwrap().unwrap();
     assert!((hi.y - 0.6).abs() < 1e-6);
 }
 

@@ -44,7 +44,7 @@ pub fn blade_mesh(width: f32, height: f32, bend: f32) -> Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::instancing::check_instanced_mesh;
+    use crate::look::check_instanced_mesh;
 
     #[test]
     fn a_blade_stands_on_its_root_and_can_be_drawn() {

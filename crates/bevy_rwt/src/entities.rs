@@ -1,0 +1,184 @@
+//! The entity look: one entity per instance (a shared mesh and material, or a game's own
+//! components), spawned and despawned within per-frame budgets, chunk by chunk in the order
+//! the chunks finished generating. Streaming hands this look each chunk's points; which
+//! entities appear, stay or go is decided here, by point identity: existing instances never
+//! move.
+
+use crate::layers::{HeightFn, ScatterInstance, ScatterLayer};
+use crate::look::{ClassLook, Pose};
+use bevy::platform::collections::{HashMap, HashSet};
+use bevy::prelude::*;
+use rwt_core::query::{Point, PointId};
+use rwt_core::streaming::{ChunkCoord, diff_instances};
+use std::collections::VecDeque;
+
+/// A chunk's entity instances.
+#[derive(Default)]
+struct EntityChunk {
+    /// Spawned instances by identity, with their class.
+    spawned: HashMap<PointId, (Entity, u16)>,
+    /// Points generated but not yet spawned (waiting for the spawn budget).
+    queued: Vec<Point>,
+    /// Whether the chunk is in the spawn order.
+    in_order: bool,
+}
+
+/// A layer's entity instances: what each chunk shows and is about to show, the order in
+/// which chunks spawn, and the instances waiting to be despawned.
+#[derive(Default)]
+pub(crate) struct EntityQueue {
+    chunks: HashMap<ChunkCoord, EntityChunk>,
+    /// Chunks with queued points, in the order they finished (unloaded ones are skipped).
+    spawn_order: VecDeque<ChunkCoord>,
+    despawn: VecDeque<Entity>,
+}
+
+/// What spawning a layer's instances needs.
+pub(crate) struct Spawner<'a> {
+    /// The layer entity.
+    pub entity: Entity,
+    pub layer: &'a ScatterLayer,
+    /// The ground height the layer's chunks are generated with.
+    pub height: &'a HeightFn,
+}
+
+impl EntityQueue {
+    /// Shows `points` in `chunk`: vanished or re-classed instances go to the despawn queue,
+    /// new points wait for the spawn budget; the others stay as they are.
+    pub fn show(&mut self, chunk: ChunkCoord, points: Vec<Point>) {
+        let c = self.chunks.entry(chunk).or_default();
+        // Compare with what the chunk shows or is about to show.
+        let spawned = c.spawned.iter().map(|(id, (_, class))| (*id, *class));
+        let queued = c.queued.iter().map(|p| (p.id, p.class));
+        let diff = diff_instances(spawned.chain(queued), &points);
+        if !diff.removed.is_empty() {
+            let removed: HashSet<PointId> = diff.removed.iter().copied().collect();
+            c.queued.retain(|p| !removed.contains(&p.id));
+            for id in &diff.removed {
+                if let Some((e, _)) = c.spawned.remove(id) {
+                    self.despawn.push_back(e);
+                }
+            }
+        }
+        c.queued.extend(diff.added);
+        if !c.queued.is_empty() && !c.in_order {
+            c.in_order = true;
+            self.spawn_order.push_back(chunk);
+        }
+    }
+
+    /// Forgets a chunk that unloaded: its instances go to the despawn queue, its queued
+    /// points with it (its place in the spawn order is skipped later).
+    pub fn unload(&mut self, chunk: ChunkCoord) {
+        if let Some(c) = self.chunks.remove(&chunk) {
+            self.despawn.extend(c.spawned.values().map(|(e, _)| *e));
+        }
+    }
+
+    /// Instances alive: those the chunks hold, plus those waiting in the despawn queue
+    /// (still in the world until their turn comes).
+    pub fn live(&self) -> usize {
+        self.chunks.values().map(|c| c.spawned.len()).sum::<usize>() + self.despawn.len()
+    }
+
+    /// Points waiting for the spawn budget.
+    pub fn queued(&self) -> usize {
+        self.chunks.values().map(|c| c.queued.len()).sum()
+    }
+
+    /// Despawns every instance placed or about to be removed.
+    pub fn despawn_all(&self, commands: &mut Commands) {
+        let placed = self.chunks.values().flat_map(|c| c.spawned.values());
+        for e in placed.map(|(e, _)| *e).chain(self.despawn.iter().copied()) {
+            commands.entity(e).try_despawn();
+        }
+    }
+
+    /// Despawns queued instances, oldest first, while the budget lasts.
+    pub fn despawn_queued(&mut self, commands: &mut Commands, budget: &mut usize) {
+        while *budget > 0 {
+            let Some(e) = self.despawn.pop_front() else {
+                break;
+            };
+            commands.entity(e).try_despawn();
+            *budget -= 1;
+        }
+    }
+
+    /// Spawns queued points chunk by chunk, in the order their chunks finished, while the
+    /// budget lasts.
+    pub fn spawn_queued(&mut self, commands: &mut Commands, spawner: &Spawner, budget: &mut usize) {
+        while *budget > 0 {
+            let Some(&chunk) = self.spawn_order.front() else {
+                break;
+            };
+            let Some(c) = self.chunks.get_mut(&chunk) else {
+                // Unloaded while waiting.
+                self.spawn_order.pop_front();
+                continue;
+            };
+            while *budget > 0 {
+                let Some(p) = c.queued.pop() else { break };
+                let e = spawn_instance(commands, spawner, &p);
+                c.spawned.insert(p.id, (e, p.class));
+                *budget -= 1;
+            }
+            if c.queued.is_empty() {
+                c.in_order = false;
+                self.spawn_order.pop_front();
+            }
+        }
+    }
+}
+
+/// Spawns one instance: the class's look placed by [`GroundPlane::place`](crate::GroundPlane::place).
+fn spawn_instance(commands: &mut Commands, spawner: &Spawner, p: &Point) -> Entity {
+    let layer = spawner.layer;
+    let class = &layer.classes[(p.class as usize).min(layer.classes.len().saturating_sub(1))];
+    let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+    let pose = Pose::of(&p.id, layer.seed, class.scale, class.scale_variation);
+    let transform = layer
+        .plane
+        .place(p, (spawner.height)(ground), pose, layer.seed);
+    let instance = ScatterInstance {
+        layer: spawner.entity,
+        id: p.id,
+        class: p.class,
+    };
+    // One bundle for the common case: an insert after the spawn would move every instance
+    // to a second archetype.
+    match (&class.look, &class.lod) {
+        (ClassLook::Mesh { mesh, material }, None) => commands
+            .spawn((
+                instance,
+                Mesh3d(mesh.clone()),
+                MeshMaterial3d(material.clone()),
+                transform,
+            ))
+            .id(),
+        (ClassLook::Mesh { mesh, material }, Some(lod)) => {
+            let (near, far) = lod.ranges();
+            commands
+                .spawn((
+                    instance,
+                    Mesh3d(mesh.clone()),
+                    MeshMaterial3d(material.clone()),
+                    transform,
+                    near,
+                    children![(
+                        Mesh3d(lod.mesh.clone()),
+                        MeshMaterial3d(lod.material.clone()),
+                        far,
+                    )],
+                ))
+                .id()
+        }
+        (ClassLook::Custom(insert), _) => {
+            let mut custom = commands.spawn((instance, transform));
+            insert(&mut custom);
+            custom.id()
+        }
+        // Packed in the generation task instead; never queued for spawning.
+        (ClassLook::Instanced(_), _) => commands.spawn((instance, transform)).id(),
+    }
+}

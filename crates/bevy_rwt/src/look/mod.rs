@@ -1,0 +1,171 @@
+//! How instances look, below every module that places or draws them: a class's look
+//! ([`ClassLook`]: a shared mesh, a game's own components, or instanced), the instanced
+//! look's mesh and shading, the checks an instanced mesh must pass, and the rule that turns
+//! a point into a transform ([`Pose`], [`GroundPlane::place`]), which the entity and the
+//! instanced path share so that both put one point in the same place.
+
+mod blade;
+mod check;
+mod instanced;
+
+pub use blade::blade_mesh;
+pub(crate) use check::check_topology;
+pub use check::{InstancedClassError, check_instanced_mesh};
+pub use instanced::{InstancedLook, InstancedMaterial};
+
+use bevy::camera::visibility::VisibilityRange;
+use bevy::prelude::*;
+use rwt_core::query::{Point, PointId};
+use std::sync::Arc;
+
+/// Inserts a class's own components into every instance it spawns (after `Transform` and
+/// [`crate::ScatterInstance`]).
+pub type InstanceInserter = Arc<dyn Fn(&mut EntityCommands) + Send + Sync>;
+
+/// How the instances of a class look.
+#[derive(Clone)]
+pub enum ClassLook {
+    /// A mesh and a material shared by every instance, so Bevy batches them.
+    Mesh {
+        /// The mesh.
+        mesh: Handle<Mesh>,
+        /// The material.
+        material: Handle<StandardMaterial>,
+    },
+    /// Whatever the function inserts: a scene (`SceneRoot(handle.clone())`, with Bevy's
+    /// `bevy_scene` feature in the game), another material type, colliders, markers.
+    Custom(InstanceInserter),
+    /// No entity per instance: each chunk's instances are packed into one GPU buffer and
+    /// drawn with one instanced draw (grass, flowers, pebbles; see [`crate::instancing`]).
+    /// Only on the [`GroundPlane::Xz`] plane.
+    Instanced(InstancedLook),
+}
+
+impl std::fmt::Debug for ClassLook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ClassLook::Mesh { mesh, material } => f
+                .debug_struct("Mesh")
+                .field("mesh", mesh)
+                .field("material", material)
+                .finish(),
+            ClassLook::Custom(_) => f.write_str("Custom(..)"),
+            ClassLook::Instanced(look) => look.fmt(f),
+        }
+    }
+}
+
+/// The far level of detail of a mesh class: from `distance` to the camera on, instances show
+/// this mesh and material instead of the class's, crossfading (Bevy's dithered
+/// [`VisibilityRange`]) over `crossfade` around `distance`. Each instance then has one child
+/// entity holding the far look.
+#[derive(Clone, Debug)]
+pub struct MeshLod {
+    /// The far mesh, standing on the same origin as the near one.
+    pub mesh: Handle<Mesh>,
+    /// The far material.
+    pub material: Handle<StandardMaterial>,
+    /// Distance of the switch.
+    pub distance: f32,
+    /// Width of the crossfade band centred on `distance`.
+    pub crossfade: f32,
+}
+
+impl MeshLod {
+    /// The visibility ranges of the near and the far look.
+    pub fn ranges(&self) -> (VisibilityRange, VisibilityRange) {
+        let half = (0.5 * self.crossfade).clamp(0.0, 0.99 * self.distance.max(0.0));
+        let switch = (self.distance - half).max(0.0)..self.distance + half;
+        let near = VisibilityRange {
+            start_margin: 0.0..0.0,
+            end_margin: switch.clone(),
+            use_aabb: false,
+        };
+        let far = VisibilityRange {
+            start_margin: switch,
+            end_margin: Self::NEVER..Self::NEVER,
+            use_aabb: false,
+        };
+        (near, far)
+    }
+
+    /// A distance no camera reaches (the far look never fades out).
+    const NEVER: f32 = 1.0e9;
+}
+
+/// How a point's instance is turned and sized: hashed from its identity, so every look of
+/// one point (an entity, an instanced copy) agrees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose {
+    /// Turn about the plane's normal, radians in `[0, 2 pi)`.
+    pub yaw: f64,
+    /// Uniform scale: the class's scale times the point's hashed variation.
+    pub scale: f32,
+}
+
+impl Pose {
+    /// The pose of point `id` in a layer of `seed`, for a class of `scale` and
+    /// `variation` (scale in `scale * (1 +- variation)`).
+    pub fn of(id: &PointId, seed: u64, scale: f32, variation: f32) -> Self {
+        Self {
+            yaw: id.rotation(seed),
+            scale: scale * id.scale(seed, variation as f64) as f32,
+        }
+    }
+}
+
+/// Salt of the depth hash that keeps overlapping sprites of a [`GroundPlane::Xy`] layer in
+/// a stable order.
+const DEPTH_SALT: u64 = 0xde97;
+
+/// The plane a layer lies on. Ground positions `(u, v)` of the point set and the height
+/// `h` of the [`HeightSource`] become these world positions.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+pub enum GroundPlane {
+    /// A 3-D world with y up: `(u, h, v)`, instances turned about y.
+    #[default]
+    Xz,
+    /// A 2-D world (sprites): `(u, v, h + depth)`, instances turned about z. `depth` is a
+    /// hash of the point in `[0, 0.001)`, so that overlapping sprites keep a stable order.
+    Xy,
+}
+
+impl GroundPlane {
+    /// An instance's transform: at ground position `ground` and height `height`, turned by
+    /// `yaw` about the plane's normal, scaled by `scale`.
+    pub fn transform(
+        self,
+        ground: Vec2,
+        height: f32,
+        yaw: f32,
+        scale: f32,
+        depth: f32,
+    ) -> Transform {
+        let (translation, rotation) = match self {
+            GroundPlane::Xz => (
+                Vec3::new(ground.x, height, ground.y),
+                Quat::from_rotation_y(yaw),
+            ),
+            GroundPlane::Xy => (
+                Vec3::new(ground.x, ground.y, height + depth * 1e-3),
+                Quat::from_rotation_z(yaw),
+            ),
+        };
+        Transform::from_translation(translation)
+            .with_rotation(rotation)
+            .with_scale(Vec3::splat(scale))
+    }
+
+    /// Where an instance of `p` stands: its ground position at `height`, in `pose`, with
+    /// the sprite depth of the x-y plane hashed from its identity in a layer of `seed`.
+    pub fn place(self, p: &Point, height: f32, pose: Pose, seed: u64) -> Transform {
+        let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+        let depth = match self {
+            GroundPlane::Xy => p.id.unit(seed, DEPTH_SALT) as f32,
+            GroundPlane::Xz => 0.0,
+        };
+        self.transform(ground, height, pose.yaw as f32, pose.scale, depth)
+    }
+}
