@@ -84,6 +84,7 @@ pub mod bench;
 #[cfg(feature = "build")]
 pub mod construction;
 pub mod density;
+pub mod edits;
 pub mod files;
 mod geometry;
 pub mod query;

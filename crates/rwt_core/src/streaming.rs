@@ -30,6 +30,35 @@ impl ChunkCoord {
         .unwrap_or(Rect::EMPTY)
     }
 
+    /// The chunk whose rectangle contains `p` (the one whose query yields a point at `p`),
+    /// for a finite, positive `size` and a finite `p`.
+    pub fn containing(p: DVec2, size: f64) -> Self {
+        let guess = Self {
+            x: (p.x / size).floor() as i64,
+            y: (p.y / size).floor() as i64,
+        };
+        // Division rounds: near a border the guess may be one off; the rectangle decides.
+        const AROUND: [(i64, i64); 9] = [
+            (0, 0),
+            (-1, 0),
+            (1, 0),
+            (0, -1),
+            (0, 1),
+            (-1, -1),
+            (1, -1),
+            (-1, 1),
+            (1, 1),
+        ];
+        AROUND
+            .iter()
+            .map(|(dx, dy)| Self {
+                x: guess.x.saturating_add(*dx),
+                y: guess.y.saturating_add(*dy),
+            })
+            .find(|c| c.rect(size).contains(p))
+            .unwrap_or(guess)
+    }
+
     /// Distance from `p` to the nearest point of the chunk (0 inside).
     pub fn distance(&self, size: f64, p: DVec2) -> f64 {
         let r = self.rect(size);
@@ -341,6 +370,23 @@ mod tests {
     use crate::density::{Constant, DistanceFalloff};
     use crate::query::Sampler;
     use crate::tileset::TileSet;
+
+    #[test]
+    fn every_point_lies_in_the_chunk_said_to_contain_it() {
+        for size in [10.0, 0.3, 7.77, 1e-3] {
+            let border = |k: f64| k * size;
+            let hard = [-3.0, -1.0, 0.0, 1.0, 2.0, 1e6].map(border);
+            let nudged = hard.iter().flat_map(|&v| [v.next_down(), v, v.next_up()]);
+            let xs: Vec<f64> = nudged.chain([0.5 * size, -0.25 * size]).collect();
+            for &x in &xs {
+                for &y in &xs {
+                    let p = DVec2::new(x, y);
+                    let c = ChunkCoord::containing(p, size);
+                    assert!(c.rect(size).contains(p), "{size} {p} {c:?}");
+                }
+            }
+        }
+    }
 
     fn config() -> StreamingConfig {
         StreamingConfig {

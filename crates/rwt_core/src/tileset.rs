@@ -129,6 +129,29 @@ fn tile_err(tile: usize, problem: impl Into<String>) -> TileSetError {
 }
 
 impl TileSet {
+    /// A 64-bit hash of everything that decides the point set (colours, subdivision,
+    /// sequences, every tile's children, points and subdivision ranking): two sets with one
+    /// fingerprint give the same points for the same seed. Stored identities
+    /// ([`crate::edits::EditStamp`]) name the set they refer to by it.
+    pub fn fingerprint(&self) -> u64 {
+        let mut words = vec![
+            self.colors as u64,
+            self.subdivision as u64,
+            self.points_per_tile as u64,
+        ];
+        let sequences = self
+            .horizontal_sequences
+            .iter()
+            .chain(&self.vertical_sequences);
+        words.extend(sequences.flatten().map(|&c| c as u64));
+        for t in &self.tiles {
+            words.extend(t.children.iter().map(|&c| c as u64));
+            words.extend(t.points.iter().map(|p| (p[0] as u64) << 32 | p[1] as u64));
+            words.extend(t.subdivision.iter().map(|&e| e as u64));
+        }
+        crate::rng::hash_words(0xf1e9_e7a1, &words)
+    }
+
     /// The tile set shipped with rwt (`assets/tilesets/default.ron`), parsed and validated
     /// once per call; keep the result around.
     pub fn embedded() -> TileSet {

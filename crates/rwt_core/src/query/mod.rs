@@ -18,6 +18,7 @@
 //! its [`Point::threshold`], so raising the density anywhere only adds points, and splitting
 //! a rectangle into pieces (half-open: `[min, max)`) yields exactly the union of the pieces.
 
+mod locate;
 #[cfg(feature = "parallel")]
 mod parallel;
 mod point;
@@ -127,6 +128,8 @@ pub struct Sampler {
     seed: u64,
     tile_size: f64,
     budget: usize,
+    /// [`TileSet::fingerprint`] of the set.
+    fingerprint: u64,
 }
 
 impl Sampler {
@@ -147,6 +150,7 @@ impl Sampler {
             seed,
             tile_size: 1.0,
             budget: 50_000_000,
+            fingerprint: set.fingerprint(),
         }
     }
 
@@ -179,6 +183,11 @@ impl Sampler {
     /// The tiling seed.
     pub fn seed(&self) -> u64 {
         self.seed
+    }
+
+    /// [`TileSet::fingerprint`] of the set the sampler was made from.
+    pub fn tile_set_fingerprint(&self) -> u64 {
+        self.fingerprint
     }
 
     /// Points per tile of the underlying set.

@@ -21,6 +21,8 @@ pub(crate) struct PreparedTile {
     /// Subdivision points of rank `N..n^2 N` by child cell (`index` and `frac` in the child).
     pub sub_cells: Vec<Vec<CellPoint>>,
     pub children: Vec<u16>,
+    /// The tile's own points by index, in the tile (what [`super::Sampler::locate`] reads).
+    pub points: Vec<[f64; 2]>,
 }
 
 impl PreparedTile {
@@ -29,6 +31,11 @@ impl PreparedTile {
             base_cells: base_cells(set, tile),
             sub_cells: sub_cells(set, tile),
             children: tile.children.clone(),
+            points: tile
+                .points
+                .iter()
+                .map(|p| [fixed_to_unit(p[0]), fixed_to_unit(p[1])])
+                .collect(),
         }
     }
 }
