@@ -75,6 +75,40 @@ impl EntityQueue {
         }
     }
 
+    /// Takes point `id` of `chunk` away now, whatever the budget (an edit removed it);
+    /// returns whether this look showed it or was about to.
+    pub fn remove_now(&mut self, commands: &mut Commands, chunk: ChunkCoord, id: &PointId) -> bool {
+        let Some(c) = self.chunks.get_mut(&chunk) else {
+            return false;
+        };
+        if let Some((e, _)) = c.spawned.remove(id) {
+            commands.entity(e).try_despawn();
+            return true;
+        }
+        let queued = c.queued.len();
+        c.queued.retain(|p| p.id != *id);
+        c.queued.len() != queued
+    }
+
+    /// Spawns `p` now (an edit gave it another entity class) in place of the instance of
+    /// its point, which is despawned; returns whether this look showed the point or was
+    /// about to (otherwise nothing changes).
+    pub fn reclass_now(
+        &mut self,
+        commands: &mut Commands,
+        spawner: &Spawner,
+        chunk: ChunkCoord,
+        p: &Point,
+    ) -> bool {
+        if !self.remove_now(commands, chunk, &p.id) {
+            return false;
+        }
+        let e = spawn_instance(commands, spawner, p);
+        let c = self.chunks.entry(chunk).or_default();
+        c.spawned.insert(p.id, (e, p.class));
+        true
+    }
+
     /// Instances alive: those the chunks hold, plus those waiting in the despawn queue
     /// (still in the world until their turn comes).
     pub fn live(&self) -> usize {

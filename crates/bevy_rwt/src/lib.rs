@@ -103,6 +103,7 @@
 #[cfg(feature = "brush")]
 pub mod brush;
 pub mod diagnostics;
+pub mod edits;
 mod entities;
 pub mod gizmos;
 pub mod instancing;
@@ -136,6 +137,7 @@ pub mod prelude {
     pub use crate::brush::{
         BrushCommand, BrushSystems, BrushTarget, DensityBrush, PaintDab, RwtBrushPlugin,
     };
+    pub use crate::edits::{EditInstance, InstanceEdit, ScatterEdits};
     pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
     pub use crate::layers::file::{NamedAssets, ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{

@@ -10,18 +10,8 @@ use bevy::prelude::*;
 use bevy_rwt::instancing::InstancedChunk;
 use bevy_rwt::look::InstancedClassError;
 use bevy_rwt::prelude::*;
-use bevy_rwt::rwt_core::query::PointId;
 use common::*;
-use std::collections::{HashMap, HashSet};
-
-/// What an instance is: where, turned how far, how large, of which class.
-#[derive(Clone, Copy, Debug)]
-struct Placed {
-    position: Vec3,
-    yaw: f32,
-    scale: f32,
-    class: u16,
-}
+use std::collections::HashSet;
 
 /// A layer with an entity class (sparse) and a second class on a painted map, entity or
 /// instanced, with a level-of-detail fall-off.
@@ -39,65 +29,6 @@ fn two_class_layer(app: &mut App, instanced: bool) -> Handle<Image> {
     l.streaming.unload_distance = 96.0;
     app.world_mut().spawn(l);
     map
-}
-
-fn instanced_app() -> App {
-    let mut app = create_app();
-    app.world_mut()
-        .resource_mut::<RwtSettings>()
-        .keep_instance_ids = true;
-    app
-}
-
-/// Every live instance of either path, by identity.
-fn placed(app: &mut App) -> HashMap<PointId, Placed> {
-    let mut out = HashMap::new();
-    let mut entities = app.world_mut().query::<(&ScatterInstance, &Transform)>();
-    for (i, t) in entities.iter(app.world()) {
-        let (yaw, _, _) = t.rotation.to_euler(EulerRot::YXZ);
-        let p = Placed {
-            position: t.translation,
-            yaw: yaw.rem_euclid(std::f32::consts::TAU),
-            scale: t.scale.x,
-            class: i.class,
-        };
-        assert!(out.insert(i.id, p).is_none(), "{:?} twice", i.id);
-    }
-    let mut chunks = app.world_mut().query::<(&InstancedChunk, &Transform)>();
-    for (c, t) in chunks.iter(app.world()) {
-        assert_eq!(c.buffer.ids.len(), c.len(), "ids kept beside the buffer");
-        for (id, g) in c.buffer.ids.iter().zip(&c.buffer.instances) {
-            let p = Placed {
-                position: t.translation + Vec3::from_array(g.offset),
-                yaw: g.yaw_radians(),
-                scale: g.scale,
-                class: c.class,
-            };
-            assert!(out.insert(*id, p).is_none(), "{id:?} twice");
-        }
-    }
-    out
-}
-
-fn assert_same(entities: &HashMap<PointId, Placed>, instanced: &HashMap<PointId, Placed>) {
-    let a: HashSet<_> = entities.keys().collect();
-    let b: HashSet<_> = instanced.keys().collect();
-    assert_eq!(a.len(), b.len(), "instance counts differ");
-    assert!(a == b, "different points");
-    for (id, e) in entities {
-        let i = &instanced[id];
-        assert_eq!(e.class, i.class, "{id:?}");
-        assert_eq!(e.scale, i.scale, "{id:?}");
-        assert!(
-            e.position.distance(i.position) < 1e-3,
-            "{id:?}: {e:?} vs {i:?}"
-        );
-        let turn = (e.yaw - i.yaw).rem_euclid(std::f32::consts::TAU);
-        assert!(
-            turn.min(std::f32::consts::TAU - turn) < 2e-4,
-            "{id:?}: {e:?} vs {i:?}"
-        );
-    }
 }
 
 /// One (chunk, class) entity per loaded chunk with instances of the class; none elsewhere.

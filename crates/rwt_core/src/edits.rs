@@ -26,7 +26,7 @@
 //! assert_eq!(EditSet::from_bytes(&bytes, &stamp).unwrap(), edits);
 //!
 //! let before = points.len();
-//! edits.apply(&mut points);
+//! edits.apply(&mut points, 3);
 //! assert_eq!(points.len(), before - 1);
 //! assert_eq!(points[0].class, 2);
 //! ```
@@ -153,9 +153,10 @@ impl EditSet {
         self.0.iter()
     }
 
-    /// Applies the edits to `points`: removed ones leave, reclassed ones change class; the
-    /// others keep their order.
-    pub fn apply(&self, points: &mut Vec<Point>) {
+    /// Applies the edits to `points` of a set of `classes` classes: removed ones leave,
+    /// reclassed ones change class (a class at or past `classes`, from a layer that has lost
+    /// classes since, leaves the point as it is); the others keep their order.
+    pub fn apply(&self, points: &mut Vec<Point>, classes: usize) {
         if self.0.is_empty() {
             return;
         }
@@ -163,7 +164,9 @@ impl EditSet {
             None => true,
             Some(Edit::Remove) => false,
             Some(Edit::Reclass(class)) => {
-                p.class = *class;
+                if (*class as usize) < classes {
+                    p.class = *class;
+                }
                 true
             }
         });

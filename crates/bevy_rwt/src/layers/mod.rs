@@ -14,6 +14,7 @@ pub use plugin::RwtLayersPlugin;
 pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
 pub use status::{AssetStatus, ScatterLayerStatus};
 
+use crate::edits::ScatterEdits;
 use crate::look::{ClassLook, GroundPlane, InstancedLook, InstancedMaterial, MeshLod};
 use bevy::prelude::*;
 use rwt_core::density::{Constant, Density, NoiseDensity};
@@ -264,7 +265,7 @@ pub(crate) fn slope(height: &HeightFn, p: Vec2, step: f32) -> f32 {
 /// A scatter layer: instances of its classes, streamed around every [`crate::RwtViewer`].
 /// Removing the component (or despawning its entity) despawns all its instances.
 #[derive(Component, Clone, Debug)]
-#[require(Transform, Visibility, ScatterLayerStatus)]
+#[require(Transform, Visibility, ScatterLayerStatus, ScatterEdits)]
 pub struct ScatterLayer {
     /// Classes sharing the layer's point set.
     pub classes: Vec<ScatterClass>,

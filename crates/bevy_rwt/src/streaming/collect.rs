@@ -2,15 +2,19 @@
 //! entity look, instance buffers to the instanced look.
 
 use super::{ChunkContent, ChunkLoaded, LayerState};
+use crate::edits::EditSet;
+use crate::layers::ScatterLayer;
 use bevy::prelude::*;
 use bevy::tasks::futures::check_ready;
+use std::sync::Arc;
 
 /// Collects finished tasks and hands their content to each look.
 pub(super) fn collect_results(
-    mut layers: Query<(Entity, &mut LayerState)>,
+    mut layers: Query<(Entity, &ScatterLayer, &mut LayerState)>,
     mut loaded: MessageWriter<ChunkLoaded>,
 ) {
-    for (entity, mut state) in &mut layers {
+    for (entity, layer, mut state) in &mut layers {
+        let classes = layer.classes.len();
         let state = &mut *state;
         let mut finished = Vec::new();
         for (chunk, c) in state.states.iter_mut() {
@@ -25,7 +29,11 @@ pub(super) fn collect_results(
         }
         for (chunk, band, result) in finished {
             let c = state.states.get_mut(&chunk).expect("finished chunks exist");
-            let ChunkContent { points, packed } = match result {
+            let ChunkContent {
+                mut points,
+                packed,
+                edits,
+            } = match result {
                 Ok(content) => content,
                 Err(e) => {
                     c.refused = true;
@@ -39,7 +47,17 @@ pub(super) fn collect_results(
             c.lod = band;
             let packed_count: usize = packed.iter().map(|p| p.buffer.instances.len()).sum();
             let count = points.len() + packed_count;
-            state.instanced.show(chunk, packed);
+            let current = state.chunk_edits.get(&chunk);
+            if same_edits(edits.as_ref(), current) {
+                state.instanced.show(chunk, packed);
+            } else {
+                // Edited while generating: the entity points take the edits now; the
+                // instance buffers are made again.
+                if let Some(current) = current {
+                    current.apply(&mut points, classes);
+                }
+                c.stale = true;
+            }
             state.entities.show(chunk, points);
             loaded.write(ChunkLoaded {
                 layer: entity,
@@ -47,5 +65,15 @@ pub(super) fn collect_results(
                 instances: count,
             });
         }
+    }
+}
+
+/// Whether a task applied the chunk's current edits (a chunk's set is copied when edited
+/// while a task holds it).
+fn same_edits(applied: Option<&Arc<EditSet>>, current: Option<&Arc<EditSet>>) -> bool {
+    match (applied, current) {
+        (None, None) => true,
+        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+        _ => false,
     }
 }

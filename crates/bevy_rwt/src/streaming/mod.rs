@@ -11,6 +11,7 @@
 //! - `repaint`: painted maps mark the chunks they cover stale.
 
 mod collect;
+mod edit;
 mod plan;
 mod plugin;
 mod repaint;
@@ -19,6 +20,7 @@ mod spawn;
 
 pub use plugin::RwtStreamingPlugin;
 
+use crate::edits::EditSet;
 use crate::entities::EntityQueue;
 use crate::instancing::{InstancedClasses, InstancedQueue, PackedClass};
 #[cfg(feature = "brush")]
@@ -67,11 +69,12 @@ pub struct DensityMapPainted {
 #[derive(Resource, Clone)]
 pub(crate) struct RwtTileSet(pub Arc<TileSet>);
 
-/// What a chunk's generation task hands back: the points of entity classes, and the
-/// buffers of instanced ones (packed in the task).
+/// What a chunk's generation task hands back: the points of entity classes, the buffers
+/// of instanced ones (packed in the task), and the chunk's edits it applied.
 struct ChunkContent {
     points: Vec<Point>,
     packed: Vec<PackedClass>,
+    edits: Option<Arc<EditSet>>,
 }
 
 /// A chunk's generation task: its content, or why the query was refused (over the chunk
@@ -103,6 +106,12 @@ pub(crate) struct LayerState {
     entities: EntityQueue,
     /// What the instanced look draws and is about to draw.
     instanced: InstancedQueue,
+    /// The layer's edits by the chunk that holds each point, shared with generation tasks
+    /// (a changed chunk's set is copied on write, so a task's set tells whether its
+    /// result is out of date).
+    chunk_edits: HashMap<ChunkCoord, Arc<EditSet>>,
+    /// Whether `chunk_edits` was made from the layer's [`crate::edits::ScatterEdits`].
+    edits_indexed: bool,
     /// Whether a refused query was logged (once per layer).
     refusal_logged: bool,
 }
@@ -113,6 +122,16 @@ impl LayerState {
     #[cfg(feature = "brush")]
     pub(crate) fn height(&self) -> Option<&HeightFn> {
         self.sources.height()
+    }
+
+    /// The layer's sampler, made on first use.
+    fn sampler(&mut self, layer: &ScatterLayer, tile_set: &TileSet, budget: usize) -> Arc<Sampler> {
+        self.sampler
+            .get_or_insert_with(|| {
+                let sampler = Sampler::new(tile_set, layer.seed).with_budget(budget);
+                Arc::new(sampler.with_tile_size(layer.tile_size))
+            })
+            .clone()
     }
 
     /// Chunks with a generation task in flight or waiting for one.
@@ -140,6 +159,13 @@ impl LayerState {
         self.states.remove(&chunk);
         self.entities.unload(chunk);
         self.instanced.unload(chunk);
+    }
+
+    /// Marks `chunk` for regeneration, if loaded.
+    fn mark_chunk_stale(&mut self, chunk: ChunkCoord) {
+        if let Some(c) = self.states.get_mut(&chunk) {
+            c.stale = true;
+        }
     }
 
     /// Marks every chunk overlapping `region` for regeneration.

@@ -3,6 +3,7 @@
 
 use super::resolve::Sources;
 use super::{ChunkContent, ChunkTask, ChunkUnloaded, LayerState, RwtTileSet};
+use crate::edits::EditSet;
 use crate::instancing::InstancedClasses;
 use crate::layers::{AssetStatus, ScatterLayer, ScatterLayerStatus, report_assets, slope};
 use crate::settings::RwtSettings;
@@ -49,14 +50,8 @@ pub(super) fn plan_chunks(
             }
         };
         report_assets(entity, &mut status, AssetStatus::Ready);
-        let sampler = state
-            .sampler
-            .get_or_insert_with(|| {
-                let sampler = Sampler::new(&inputs.tile_set.0, layer.seed)
-                    .with_budget(inputs.settings.chunk_point_budget);
-                Arc::new(sampler.with_tile_size(layer.tile_size))
-            })
-            .clone();
+        let budget = inputs.settings.chunk_point_budget;
+        let sampler = state.sampler(layer, &inputs.tile_set.0, budget);
         let keep_ids = inputs.settings.keep_instance_ids;
         let instanced = state
             .instanced_classes
@@ -139,15 +134,16 @@ fn start_tasks(job: &Job, state: &mut LayerState, viewers: &[Viewer], free: usiz
         let band = layer
             .falloff
             .map_or(0, |f| f.chunk_band(chunk, size, viewers));
+        let edits = state.chunk_edits.get(&chunk).cloned();
         let c = state.states.get_mut(&chunk).expect("listed above");
         c.stale = false;
-        c.task = Some((start_task(job, chunk, band), band));
+        c.task = Some((start_task(job, chunk, band, edits), band));
     }
 }
 
 /// Starts a generation task for a chunk: the query at the band's density, the height and
-/// slope filters, then the packing of instanced classes.
-fn start_task(job: &Job, chunk: ChunkCoord, band: i64) -> ChunkTask {
+/// slope filters, the chunk's edits, then the packing of instanced classes.
+fn start_task(job: &Job, chunk: ChunkCoord, band: i64, edits: Option<Arc<EditSet>>) -> ChunkTask {
     let layer = job.layer;
     let (sampler, sources) = (job.sampler.clone(), job.sources);
     let instanced = job.instanced.clone();
@@ -156,6 +152,7 @@ fn start_task(job: &Job, chunk: ChunkCoord, band: i64) -> ChunkTask {
     let (range, max_slope) = (layer.height_range, layer.max_slope);
     let densities = sources.densities.clone();
     let height = sources.height.clone();
+    let classes = layer.classes.len();
     AsyncComputeTaskPool::get().spawn(async move {
         let scaled: Vec<_> = densities.iter().map(|d| Scale(d.clone(), factor)).collect();
         let mut out = Vec::new();
@@ -167,10 +164,14 @@ fn start_task(job: &Job, chunk: ChunkCoord, band: i64) -> ChunkTask {
                 out.push(p);
             }
         })?;
+        if let Some(edits) = &edits {
+            edits.apply(&mut out, classes);
+        }
         let packed = instanced.pack(&mut out, rect.min(), &height, &scaled, factor);
         Ok(ChunkContent {
             points: out,
             packed,
+            edits,
         })
     })
 }

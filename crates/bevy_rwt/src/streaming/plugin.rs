@@ -1,10 +1,12 @@
 //! The streaming feature plugin.
 
 use super::collect::collect_results;
+use super::edit::apply_edits;
 use super::plan::plan_chunks;
 use super::repaint::{PaintedRegions, repaint};
 use super::spawn::apply_budget;
 use super::*;
+use crate::edits::EditInstance;
 use crate::settings::RwtSystems;
 use bevy::ecs::schedule::InternedScheduleLabel;
 
@@ -23,12 +25,15 @@ impl Plugin for RwtStreamingPlugin {
             .add_message::<ChunkLoaded>()
             .add_message::<ChunkUnloaded>()
             .add_message::<DensityMapPainted>()
+            .add_message::<EditInstance>()
             .add_observer(on_layer_inserted)
             .add_observer(on_layer_removed)
             .add_systems(
                 self.schedule,
                 (
-                    (repaint, plan_chunks).chain().in_set(RwtSystems::Plan),
+                    (repaint, apply_edits, plan_chunks)
+                        .chain()
+                        .in_set(RwtSystems::Plan),
                     collect_results.in_set(RwtSystems::Collect),
                     apply_budget.in_set(RwtSystems::Apply),
                     update_status.in_set(RwtSystems::Stats),

@@ -4,9 +4,10 @@
 
 use bevy::asset::AssetPlugin;
 use bevy::prelude::*;
+use bevy_rwt::instancing::InstancedChunk;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::time::Duration;
 
 pub fn create_app() -> App {
@@ -184,4 +185,76 @@ pub fn solid_map(app: &mut App, rgba: [u8; 4], scale: f64) -> (Handle<Image>, La
         scale,
     };
     (handle, density)
+}
+
+/// What an instance is: where, turned how far, how large, of which class.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placed {
+    pub position: Vec3,
+    pub yaw: f32,
+    pub scale: f32,
+    pub class: u16,
+}
+
+/// A headless app that keeps the identities of instanced points beside their buffers.
+pub fn instanced_app() -> App {
+    let mut app = create_app();
+    app.world_mut()
+        .resource_mut::<RwtSettings>()
+        .keep_instance_ids = true;
+    app
+}
+
+/// Every live instance of either path, by identity.
+pub fn placed(app: &mut App) -> HashMap<PointId, Placed> {
+    let mut out = HashMap::new();
+    let mut entities = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    for (i, t) in entities.iter(app.world()) {
+        let (yaw, _, _) = t.rotation.to_euler(EulerRot::YXZ);
+        let p = Placed {
+            position: t.translation,
+            yaw: yaw.rem_euclid(std::f32::consts::TAU),
+            scale: t.scale.x,
+            class: i.class,
+        };
+        assert!(out.insert(i.id, p).is_none(), "{:?} twice", i.id);
+    }
+    let mut chunks = app.world_mut().query::<(&InstancedChunk, &Transform)>();
+    for (c, t) in chunks.iter(app.world()) {
+        assert_eq!(c.buffer.ids.len(), c.len(), "ids kept beside the buffer");
+        for (id, g) in c.buffer.ids.iter().zip(&c.buffer.instances) {
+            let p = Placed {
+                position: t.translation + Vec3::from_array(g.offset),
+                yaw: g.yaw_radians(),
+                scale: g.scale,
+                class: c.class,
+            };
+            assert!(out.insert(*id, p).is_none(), "{id:?} twice");
+        }
+    }
+    out
+}
+
+/// Asserts that two worlds hold the same points with the same classes and scales, in the
+/// same places and turns (to the precision of the instanced path's chunk offsets and 16-bit
+/// turns, as the entity and the instanced path of one point differ).
+pub fn assert_same(entities: &HashMap<PointId, Placed>, instanced: &HashMap<PointId, Placed>) {
+    let a: HashSet<_> = entities.keys().collect();
+    let b: HashSet<_> = instanced.keys().collect();
+    assert_eq!(a.len(), b.len(), "instance counts differ");
+    assert!(a == b, "different points");
+    for (id, e) in entities {
+        let i = &instanced[id];
+        assert_eq!(e.class, i.class, "{id:?}");
+        assert_eq!(e.scale, i.scale, "{id:?}");
+        assert!(
+            e.position.distance(i.position) < 1e-3,
+            "{id:?}: {e:?} vs {i:?}"
+        );
+        let turn = (e.yaw - i.yaw).rem_euclid(std::f32::consts::TAU);
+        assert!(
+            turn.min(std::f32::consts::TAU - turn) < 2e-4,
+            "{id:?}: {e:?} vs {i:?}"
+        );
+    }
 }

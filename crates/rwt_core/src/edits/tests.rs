@@ -70,17 +70,22 @@ fn a_set_round_trips_bit_for_bit() {
 fn edits_apply_to_exactly_their_points() {
     let (_, points) = points(3.0, 30.0);
     let edits = sample_edits(&points);
-    let mut edited = points.clone();
-    edits.apply(&mut edited);
-    let mut expected = Vec::new();
-    for p in &points {
-        match edits.get(&p.id) {
-            None => expected.push(*p),
-            Some(Edit::Remove) => {}
-            Some(Edit::Reclass(c)) => expected.push(Point { class: c, ..*p }),
+    for classes in [300, 100] {
+        let mut edited = points.clone();
+        edits.apply(&mut edited, classes);
+        let mut expected = Vec::new();
+        for p in &points {
+            match edits.get(&p.id) {
+                None => expected.push(*p),
+                Some(Edit::Remove) => {}
+                Some(Edit::Reclass(c)) if (c as usize) < classes => {
+                    expected.push(Point { class: c, ..*p })
+                }
+                Some(Edit::Reclass(_)) => expected.push(*p),
+            }
         }
+        assert_eq!(edited, expected);
     }
-    assert_eq!(edited, expected);
     let mut restored = edits.clone();
     for p in &points {
         restored.restore(&p.id);

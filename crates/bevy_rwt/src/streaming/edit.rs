@@ -1,0 +1,130 @@
+//! Per-instance edits reach the chunk that holds the point: its generation tasks apply the
+//! chunk's edits, and the entity look despawns or swaps an edited instance at once.
+
+use super::{LayerState, RwtTileSet};
+use crate::edits::{EditError, EditInstance, EditSet, InstanceEdit, ScatterEdits};
+use crate::entities::Spawner;
+use crate::layers::ScatterLayer;
+use crate::look::ClassLook;
+use crate::settings::RwtSettings;
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use rwt_core::query::{Point, Sampler};
+use rwt_core::streaming::ChunkCoord;
+use std::sync::Arc;
+
+/// Indexes replaced edit sets by chunk, then applies the frame's [`EditInstance`]s.
+pub(super) fn apply_edits(
+    mut messages: MessageReader<EditInstance>,
+    mut layers: Query<(Entity, &ScatterLayer, &mut LayerState, &mut ScatterEdits)>,
+    tile_set: Res<RwtTileSet>,
+    settings: Res<RwtSettings>,
+    mut commands: Commands,
+) {
+    let budget = settings.chunk_point_budget;
+    for (_, layer, mut state, edits) in &mut layers {
+        if edits.is_changed() || !state.edits_indexed {
+            let sampler = state.sampler(layer, &tile_set.0, budget);
+            index_edits(&mut state, layer, &sampler, edits.edits());
+        }
+    }
+    for message in messages.read() {
+        let Ok((entity, layer, mut state, mut edits)) = layers.get_mut(message.layer) else {
+            warn!("{}", EditError::NoLayer(message.layer));
+            continue;
+        };
+        let sampler = state.sampler(layer, &tile_set.0, budget);
+        // Single edits do not count as a replaced set (see `index_edits`).
+        let edits = edits.bypass_change_detection();
+        if let Err(e) = apply_edit(
+            &mut commands,
+            entity,
+            layer,
+            &mut state,
+            &sampler,
+            edits,
+            message,
+        ) {
+            warn!("scatter layer {entity}: edit refused: {e}");
+        }
+    }
+}
+
+/// Makes the by-chunk index of a layer's (new) edits; the chunks the old or the new edits
+/// touch are generated again.
+fn index_edits(state: &mut LayerState, layer: &ScatterLayer, sampler: &Sampler, edits: &EditSet) {
+    let size = layer.streaming.chunk_size;
+    let mut by_chunk: HashMap<ChunkCoord, EditSet> = HashMap::new();
+    for (id, edit) in edits.iter() {
+        // An identity the tiling lacks names no point: it can never apply.
+        if let Some(p) = sampler.locate(id) {
+            let chunk = ChunkCoord::containing(p, size);
+            by_chunk.entry(chunk).or_default().set(*id, *edit);
+        }
+    }
+    let old = std::mem::take(&mut state.chunk_edits);
+    for chunk in old.keys().chain(by_chunk.keys()) {
+        state.mark_chunk_stale(*chunk);
+    }
+    state.chunk_edits = by_chunk
+        .into_iter()
+        .map(|(chunk, set)| (chunk, Arc::new(set)))
+        .collect();
+    state.edits_indexed = true;
+}
+
+/// Applies one edit: to the layer's set, to its chunk's set, and to what the looks show.
+fn apply_edit(
+    commands: &mut Commands,
+    entity: Entity,
+    layer: &ScatterLayer,
+    state: &mut LayerState,
+    sampler: &Sampler,
+    edits: &mut ScatterEdits,
+    message: &EditInstance,
+) -> Result<(), EditError> {
+    let id = message.id;
+    let position = sampler.locate(&id).ok_or(EditError::NoSuchPoint(id))?;
+    let class = match message.edit {
+        InstanceEdit::Reclass(class) => {
+            let classes = layer.classes.len();
+            if class as usize >= classes {
+                return Err(EditError::NoSuchClass { class, classes });
+            }
+            Some(class)
+        }
+        _ => None,
+    };
+    edits.apply(id, message.edit);
+    let chunk = ChunkCoord::containing(position, layer.streaming.chunk_size);
+    let chunk_set = Arc::make_mut(state.chunk_edits.entry(chunk).or_default());
+    match edits.get(&id) {
+        Some(edit) => chunk_set.set(id, edit),
+        None => chunk_set.restore(&id),
+    };
+    let entity_class =
+        class.filter(|c| !matches!(layer.classes[*c as usize].look, ClassLook::Instanced(_)));
+    let shown = match (message.edit, entity_class, state.sources.height()) {
+        (InstanceEdit::Remove, _, _) => state.entities.remove_now(commands, chunk, &id),
+        (InstanceEdit::Reclass(_), Some(class), Some(height)) => {
+            let spawner = Spawner {
+                entity,
+                layer,
+                height,
+            };
+            let p = Point {
+                position,
+                id,
+                threshold: 0.0,
+                class,
+            };
+            state.entities.reclass_now(commands, &spawner, chunk, &p)
+        }
+        _ => false,
+    };
+    // Otherwise the point is instanced, restored, or not shown: its chunk is generated again.
+    if !shown {
+        state.mark_chunk_stale(chunk);
+    }
+    Ok(())
+}
