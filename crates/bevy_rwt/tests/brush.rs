@@ -4,6 +4,7 @@ mod common;
 
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushError, PaintedMaps};
+use bevy_rwt::edits::{EditInstance, ScatterEdits};
 use bevy_rwt::layers::file::NamedAssets;
 use bevy_rwt::prelude::*;
 use common::*;
@@ -159,7 +160,10 @@ fn maps_save_and_load_into_another_world() {
         .truncate(1);
     name_marker_assets(&app);
     let saved = command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
-    assert!(saved.contains("saved 1 maps and 1 layer files"), "{saved}");
+    assert!(
+        saved.contains("saved 1 maps, 1 layer files and 0 edits"),
+        "{saved}"
+    );
     let index = PaintedMaps::read(&dir).unwrap();
     assert_eq!(index.maps.len(), 1);
     assert_eq!(
@@ -336,6 +340,110 @@ fn two_map_app(names: [&str; 2], seed: u32) -> App {
     app
 }
 
+/// Removes every `every`-th instance of every layer (per-instance edits), and runs until
+/// streaming settles.
+fn chop_some(app: &mut App, every: usize) {
+    let mut q = app.world_mut().query::<&ScatterInstance>();
+    let mut all: Vec<ScatterInstance> = q.iter(app.world()).copied().collect();
+    all.sort_by_key(|i| (i.layer, i.id));
+    let chop = all.iter().step_by(every);
+    let messages: Vec<_> = chop.map(|i| EditInstance::remove(i.layer, i.id)).collect();
+    assert!(messages.len() > 10, "{} edits", messages.len());
+    app.world_mut().write_message_batch(messages);
+    tick_app(app, 2_000);
+}
+
+/// Every layer's edits by its name.
+fn edits_by_name(app: &mut App) -> BTreeMap<String, ScatterEdits> {
+    let mut q = app.world_mut().query::<(&Name, &ScatterEdits)>();
+    q.iter(app.world())
+        .map(|(n, e)| (n.to_string(), e.clone()))
+        .collect()
+}
+
+#[test]
+fn edits_save_and_load_with_the_maps() {
+    let dir = scratch("edits");
+    let mut app = two_map_app(["meadow", "noise"], 1);
+    let unedited = layered(&mut app);
+    chop_some(&mut app, 7);
+    let chopped = layered(&mut app);
+    let edits = edits_by_name(&mut app);
+    let count: usize = edits.values().map(|e| e.len()).sum();
+    assert!(
+        chopped.len() + count == unedited.len(),
+        "every edit removed one"
+    );
+    let saved = command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
+    assert!(saved.contains(&format!("and {count} edits")), "{saved}");
+    let index = PaintedMaps::read(&dir).unwrap();
+    let files: Vec<_> = index.edits.iter().map(|e| e.file.as_str()).collect();
+    assert_eq!(files, ["layer_meadow.edits", "layer_noise.edits"]);
+    let bytes: u64 = files
+        .iter()
+        .map(|f| std::fs::metadata(dir.join(f)).unwrap().len())
+        .sum();
+    assert!(
+        bytes < 16 * count as u64 + 100,
+        "{bytes} bytes for {count} edits"
+    );
+
+    // Another world of the same layers gets the chopped world back.
+    let mut fresh = two_map_app(["meadow", "noise"], 1);
+    let loaded = command(&mut fresh, BrushCommand::Load(dir.clone())).unwrap();
+    assert!(loaded.contains(&format!("and {count} edits")), "{loaded}");
+    tick_app(&mut fresh, 2_000);
+    assert_eq!(edits_by_name(&mut fresh), edits);
+    assert_eq!(layered(&mut fresh), chopped);
+
+    // Damaged, cut short or foreign edits: a typed error naming the file, nothing changes.
+    let mut other = two_map_app(["meadow", "noise"], 1);
+    chop_some(&mut other, 11);
+    let before = (layered(&mut other), edits_by_name(&mut other));
+    let file = dir.join("layer_noise.edits");
+    let good = std::fs::read(&file).unwrap();
+    let mut flipped = good.clone();
+    flipped[good.len() / 2] ^= 1;
+    for (bad, check) in [
+        (good[..good.len() - 3].to_vec(), "cut short"),
+        (flipped, "damaged"),
+        (b"RWTE".to_vec(), "header only"),
+    ] {
+        std::fs::write(&file, &bad).unwrap();
+        let err = command(&mut other, BrushCommand::Load(dir.clone())).unwrap_err();
+        assert!(
+            matches!(&err, BrushError::Edits { file: f, .. } if f.ends_with("layer_noise.edits")),
+            "{check}: {err:?}"
+        );
+        tick_app(&mut other, 2_000);
+        assert_eq!(
+            (layered(&mut other), edits_by_name(&mut other)),
+            before,
+            "{check}"
+        );
+    }
+    std::fs::write(&file, &good).unwrap();
+    // The same names over another point set (another seed): its identities would name
+    // other points.
+    let layer = other
+        .world_mut()
+        .query::<(Entity, &Name)>()
+        .iter(other.world())
+        .find(|(_, n)| n.as_str() == "layer noise")
+        .map(|(e, _)| e)
+        .unwrap();
+    let mut reseeded = other.world().get::<ScatterLayer>(layer).unwrap().clone();
+    reseeded.seed = 555;
+    other.world_mut().entity_mut(layer).insert(reseeded);
+    tick_app(&mut other, 2_000);
+    let before = (layered(&mut other), edits_by_name(&mut other));
+    let err = command(&mut other, BrushCommand::Load(dir.clone())).unwrap_err();
+    assert!(err.to_string().contains("not seed 555"), "{err}");
+    tick_app(&mut other, 2_000);
+    assert_eq!((layered(&mut other), edits_by_name(&mut other)), before);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// Run by `a_full_disk_during_a_save_keeps_the_previous_save`, in a child process whose
 /// files may not grow past 8 KB (writes beyond fail as on a full disk).
 #[test]
@@ -353,10 +461,11 @@ fn a_full_disk_during_a_save_keeps_the_previous_save() {
     let mut app = two_map_app(["meadow", "noise"], 1);
     stroke(&mut app, 0, Vec2::new(10.0, 5.0), 0.8, 2);
     tick_app(&mut app, 2_000);
+    chop_some(&mut app, 40);
     let painted = layered(&mut app);
     command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
     let before = folder(&dir);
-    assert_eq!(before.len(), 5, "{:?}", before.keys());
+    assert_eq!(before.len(), 7, "{:?}", before.keys());
     assert!(before["noise.png"].len() > 60_000);
     // A save of other paint by a process whose disk is full past 8 KB: the small map and
     // files are staged, the noise map's PNG runs out of space.

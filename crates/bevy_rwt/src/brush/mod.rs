@@ -74,7 +74,7 @@ mod plugin;
 mod ray;
 
 pub use paint::blank_map;
-pub use persist::{PaintedMapEntry, PaintedMaps};
+pub use persist::{PaintedMapEntry, PaintedMaps, SavedEdits};
 pub use plugin::RwtBrushPlugin;
 pub use ray::ground_hit;
 
@@ -292,6 +292,17 @@ pub enum BrushError {
         /// The encoder's words.
         reason: String,
     },
+    /// A saved edits file is damaged, cut short, or made for another point set.
+    #[error("{}: {error}", file.display())]
+    Edits {
+        /// The file.
+        file: std::path::PathBuf,
+        /// Why.
+        error: rwt_core::edits::EditsError,
+    },
+    /// Two layers have one name: their edits could not be told apart when loaded.
+    #[error("two scatter layers are named {0:?}: names identify edits in a save")]
+    DuplicateLayer(String),
     /// Two targets have one name: their maps could not be told apart when loaded.
     #[error("two brush targets are named {0:?}: names identify maps in a save")]
     DuplicateTarget(String),

@@ -1,5 +1,6 @@
 //! Painted maps on disk: one 16-bit grey PNG per target, a layer file per target layer that
-//! reads them, and a RON index of where each lies.
+//! reads them, the per-instance edits of every named layer, and a RON index of where each
+//! lies.
 //!
 //! A save is one transaction ([`rwt_core::files::SaveTransaction`]): every file is staged
 //! and synced, then all are renamed into place, so a full disk, an unreadable map or a crash
@@ -8,9 +9,11 @@
 
 use super::paint::{set_texel_luminance, target_map};
 use super::{BrushError, BrushTarget, DensityBrush};
+use crate::edits::{EditSet, EditStamp};
 use crate::layers::file::{LayerDescription, NamedAssets};
 use crate::layers::{ScatterLayer, texel_luminance};
 use bevy::prelude::*;
+use rwt_core::edits::MAX_EDITS_FILE_BYTES;
 use rwt_core::files::{SaveTransaction, is_plain_name, read_limited, recover};
 use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, HashSet};
@@ -49,6 +52,19 @@ pub struct PaintedMaps {
     /// read the maps (`./name.png`) and load with a [`crate::layers::file::ScatterLayerSource`].
     #[serde(default)]
     pub layers: Vec<String>,
+    /// The per-instance edits of every named layer (one file each, see
+    /// [`rwt_core::edits`]); a load gives each layer of that name its edits.
+    #[serde(default)]
+    pub edits: Vec<SavedEdits>,
+}
+
+/// A layer's edits in a save.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct SavedEdits {
+    /// The layer's `Name`.
+    pub layer: String,
+    /// The edits file, relative to the index.
+    pub file: String,
 }
 
 impl PaintedMaps {
@@ -61,7 +77,13 @@ impl PaintedMaps {
             file: path.clone(),
             reason: e.to_string(),
         })?;
-        let names = index.maps.iter().map(|m| &m.file).chain(&index.layers);
+        let edits = index.edits.iter().map(|e| &e.file);
+        let names = index
+            .maps
+            .iter()
+            .map(|m| &m.file)
+            .chain(&index.layers)
+            .chain(edits);
         if let Some(bad) = names.into_iter().find(|f| !is_plain_name(f)) {
             return Err(BrushError::OutsideFolder { file: bad.clone() });
         }
@@ -153,12 +175,22 @@ fn read_map(path: &Path, width: u32, height: u32) -> Result<Vec<f32>, BrushError
     Ok(png.pixels().map(|p| p[0] as f32 / 65535.0).collect())
 }
 
-/// What a save reads: the layers, their names, the names of assets, the maps.
+/// What a save reads: the layers, their names, the names of assets, the maps, the edits.
 pub(super) struct SaveSources<'a, 'w, 's, 'q> {
     pub layers: &'a Query<'w, 's, &'q ScatterLayer>,
     pub layer_name: &'a dyn Fn(Entity) -> Option<String>,
     pub names: &'a NamedAssets,
     pub images: &'a Assets<Image>,
+    /// Every named layer's edits.
+    pub edits: &'a [LayerEdits<'a>],
+}
+
+/// A named layer's edits, and what their identities refer to.
+pub(super) struct LayerEdits<'a> {
+    pub name: String,
+    pub entity: Entity,
+    pub edits: &'a EditSet,
+    pub stamp: EditStamp,
 }
 
 /// Writes every target's map, the layer file of every target's layer (reading the maps
@@ -173,6 +205,10 @@ pub(super) fn save(
     let mut seen = HashSet::new();
     if let Some(t) = brush.targets.iter().find(|t| !seen.insert(&t.name)) {
         return Err(BrushError::DuplicateTarget(t.name.clone()));
+    }
+    let mut seen = HashSet::new();
+    if let Some(l) = from.edits.iter().find(|l| !seen.insert(&l.name)) {
+        return Err(BrushError::DuplicateLayer(l.name.clone()));
     }
     let mut save = SaveTransaction::begin(dir)?;
     let mut names = FileNames::default();
@@ -204,13 +240,23 @@ pub(super) fn save(
         });
     }
     let unwritten = stage_layer_files(brush, from, &saved, &mut names, &mut save, &mut index)?;
+    let mut edited = 0;
+    for layer in from.edits {
+        let file = names.claim(&layer.name, "edits");
+        save.write(&file, &layer.edits.to_bytes(&layer.stamp))?;
+        edited += layer.edits.len();
+        index.edits.push(SavedEdits {
+            layer: layer.name.clone(),
+            file,
+        });
+    }
     save.write(INDEX_FILE, index.to_ron().as_bytes())?;
     save.commit()?;
     if !unwritten.is_empty() {
         return Err(BrushError::LayerNotSaved(unwritten.join("; ")));
     }
     Ok(format!(
-        "saved {} maps and {} layer files to {}",
+        "saved {} maps, {} layer files and {edited} edits to {}",
         index.maps.len(),
         index.layers.len(),
         dir.display()
@@ -253,15 +299,24 @@ fn stage_layer_files(
     Ok(unwritten)
 }
 
-/// Reads the maps of `dir`'s index into the targets of the same name, once every map and
-/// layer file of the save has been read and checked; on any error nothing changes.
+/// A loaded save: what it says, and the edits each named layer gets.
+pub(super) struct Loaded {
+    pub message: String,
+    pub edits: Vec<(Entity, EditSet)>,
+}
+
+/// Reads the maps of `dir`'s index into the targets of the same name, once every map, layer
+/// file and edits file of the save has been read and checked; on any error nothing changes.
+/// The edits of the layers named in `named` are returned, for the caller to put in place.
 pub(super) fn load(
     brush: &DensityBrush,
     layers: &Query<&ScatterLayer>,
     images: &mut Assets<Image>,
     dir: &Path,
-) -> Result<String, BrushError> {
+    named: &[LayerEdits],
+) -> Result<Loaded, BrushError> {
     let index = PaintedMaps::read(dir)?;
+    let edits = read_edits(&index, dir, named)?;
     let mut read = Vec::new();
     for entry in &index.maps {
         let Some(i) = brush.targets.iter().position(|t| t.name == entry.name) else {
@@ -294,7 +349,35 @@ pub(super) fn load(
             }
         }
     }
-    Ok(format!("loaded {} maps from {}", read.len(), dir.display()))
+    let count: usize = edits.iter().map(|(_, e)| e.len()).sum();
+    Ok(Loaded {
+        message: format!(
+            "loaded {} maps and {count} edits from {}",
+            read.len(),
+            dir.display()
+        ),
+        edits,
+    })
+}
+
+/// Reads and checks the edits file of every layer in `named` that the index lists.
+fn read_edits(
+    index: &PaintedMaps,
+    dir: &Path,
+    named: &[LayerEdits],
+) -> Result<Vec<(Entity, EditSet)>, BrushError> {
+    let mut out = Vec::new();
+    for saved in &index.edits {
+        let Some(layer) = named.iter().find(|l| l.name == saved.layer) else {
+            continue;
+        };
+        let path = dir.join(&saved.file);
+        let bytes = read_limited(&path, MAX_EDITS_FILE_BYTES)?;
+        let set = EditSet::from_bytes(&bytes, &layer.stamp)
+            .map_err(|error| BrushError::Edits { file: path, error })?;
+        out.push((layer.entity, set));
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -1,12 +1,14 @@
 //! The brush plugin: cursor, input, dabs, strokes and their undo, files, the gizmo circle.
 
 use super::paint::{StrokeRecord, dab, restore, target_map};
-use super::persist::{SaveSources, load, save};
+use super::persist::{LayerEdits, SaveSources, load, save};
 use super::{BrushCommand, BrushError, BrushSystems, DensityBrush, PaintDab, ground_hit};
+use crate::edits::ScatterEdits;
 use crate::layers::file::NamedAssets;
 use crate::layers::{HeightFn, ScatterLayer};
 use crate::streaming::DensityMapPainted;
 use crate::streaming::LayerState;
+use crate::streaming::RwtTileSet;
 use crate::viewers::RwtViewer;
 use bevy::ecs::system::SystemParam;
 use bevy::input::mouse::AccumulatedMouseScroll;
@@ -239,45 +241,77 @@ fn apply_dabs(
     }
 }
 
-/// What saving layer files reads: the names of assets and of layers.
+/// What saving and loading layer files and edits use: the names of assets and of layers,
+/// the edits, and commands to put loaded edits in place.
 #[derive(SystemParam)]
 struct LayerFiles<'w, 's> {
+    commands: Commands<'w, 's>,
     names: Res<'w, NamedAssets>,
-    layer_names: Query<'w, 's, &'static Name, With<ScatterLayer>>,
+    named: Query<
+        'w,
+        's,
+        (
+            Entity,
+            &'static Name,
+            &'static ScatterLayer,
+            &'static ScatterEdits,
+        ),
+    >,
+    tile_set: Res<'w, RwtTileSet>,
+}
+
+impl LayerFiles<'_, '_> {
+    /// Every named layer's edits.
+    fn edits(&self) -> Vec<LayerEdits<'_>> {
+        self.named
+            .iter()
+            .map(|(entity, name, layer, edits)| LayerEdits {
+                name: name.to_string(),
+                entity,
+                edits: edits.edits(),
+                stamp: self.tile_set.stamp(layer.seed),
+            })
+            .collect()
+    }
 }
 
 fn apply_commands(
     mut brush: ResMut<DensityBrush>,
     mut history: ResMut<BrushHistory>,
-    mut commands: MessageReader<BrushCommand>,
+    mut received: MessageReader<BrushCommand>,
     mut painted: MessageWriter<DensityMapPainted>,
     mut images: ResMut<Assets<Image>>,
     layers: Query<&ScatterLayer>,
-    files: LayerFiles,
+    mut files: LayerFiles,
 ) {
-    for command in commands.read() {
+    for command in received.read() {
         let depth = brush.undo_depth;
         history.close(depth);
         let outcome = match command {
             BrushCommand::Undo => undo(&mut history, &mut images, &mut painted),
             BrushCommand::Save(dir) => {
-                let layer_name = |e: Entity| files.layer_names.get(e).ok().map(|n| n.to_string());
+                let layer_name = |e: Entity| files.named.get(e).ok().map(|n| n.1.to_string());
+                let edits = files.edits();
                 let from = SaveSources {
                     layers: &layers,
                     layer_name: &layer_name,
                     names: &files.names,
                     images: &images,
+                    edits: &edits,
                 };
                 save(&brush, &from, dir)
             }
             BrushCommand::Load(dir) => {
-                let loaded = load(&brush, &layers, &mut images, dir);
+                let loaded = load(&brush, &layers, &mut images, dir, &files.edits());
                 // Strokes before a load cannot be undone over it; a failed load changed
                 // nothing, so they still can.
-                if loaded.is_ok() {
+                loaded.map(|loaded| {
                     history.done.clear();
-                }
-                loaded
+                    for (layer, set) in loaded.edits {
+                        files.commands.entity(layer).insert(ScatterEdits::new(set));
+                    }
+                    loaded.message
+                })
             }
         };
         brush.last = Some(outcome);

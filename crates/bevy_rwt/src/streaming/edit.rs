@@ -24,7 +24,7 @@ pub(super) fn apply_edits(
     let budget = settings.chunk_point_budget;
     for (_, layer, mut state, edits) in &mut layers {
         if edits.is_changed() || !state.edits_indexed {
-            let sampler = state.sampler(layer, &tile_set.0, budget);
+            let sampler = state.sampler(layer, &tile_set.set, budget);
             index_edits(&mut state, layer, &sampler, edits.edits());
         }
     }
@@ -33,7 +33,7 @@ pub(super) fn apply_edits(
             warn!("{}", EditError::NoLayer(message.layer));
             continue;
         };
-        let sampler = state.sampler(layer, &tile_set.0, budget);
+        let sampler = state.sampler(layer, &tile_set.set, budget);
         // Single edits do not count as a replaced set (see `index_edits`).
         let edits = edits.bypass_change_detection();
         if let Err(e) = apply_edit(

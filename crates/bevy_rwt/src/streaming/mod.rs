@@ -20,7 +20,7 @@ mod spawn;
 
 pub use plugin::RwtStreamingPlugin;
 
-use crate::edits::EditSet;
+use crate::edits::{EditSet, EditStamp};
 use crate::entities::EntityQueue;
 use crate::instancing::{InstancedClasses, InstancedQueue, PackedClass};
 #[cfg(feature = "brush")]
@@ -67,7 +67,26 @@ pub struct DensityMapPainted {
 
 /// The tile set every layer samples (the shipped one unless the plugin was given another).
 #[derive(Resource, Clone)]
-pub(crate) struct RwtTileSet(pub Arc<TileSet>);
+pub(crate) struct RwtTileSet {
+    pub set: Arc<TileSet>,
+    /// [`TileSet::fingerprint`], which saved edits name their tile set by.
+    pub fingerprint: u64,
+}
+
+impl RwtTileSet {
+    pub fn new(set: Arc<TileSet>) -> Self {
+        let fingerprint = set.fingerprint();
+        Self { set, fingerprint }
+    }
+
+    /// What the point identities of a layer of `seed` refer to.
+    pub fn stamp(&self, seed: u64) -> EditStamp {
+        EditStamp {
+            seed,
+            tile_set: self.fingerprint,
+        }
+    }
+}
 
 /// What a chunk's generation task hands back: the points of entity classes, the buffers
 /// of instanced ones (packed in the task), and the chunk's edits it applied.

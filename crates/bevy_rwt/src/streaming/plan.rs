@@ -51,7 +51,7 @@ pub(super) fn plan_chunks(
         };
         report_assets(entity, &mut status, AssetStatus::Ready);
         let budget = inputs.settings.chunk_point_budget;
-        let sampler = state.sampler(layer, &inputs.tile_set.0, budget);
+        let sampler = state.sampler(layer, &inputs.tile_set.set, budget);
         let keep_ids = inputs.settings.keep_instance_ids;
         let instanced = state
             .instanced_classes

@@ -20,7 +20,7 @@ pub struct RwtStreamingPlugin {
 
 impl Plugin for RwtStreamingPlugin {
     fn build(&self, app: &mut App) {
-        app.insert_resource(RwtTileSet(self.tile_set.clone()))
+        app.insert_resource(RwtTileSet::new(self.tile_set.clone()))
             .init_resource::<PaintedRegions>()
             .add_message::<ChunkLoaded>()
             .add_message::<ChunkUnloaded>()
