@@ -105,6 +105,7 @@ pub mod brush;
 pub mod diagnostics;
 pub mod edits;
 mod entities;
+pub mod footprints;
 pub mod gizmos;
 pub mod instancing;
 pub mod layers;
@@ -138,6 +139,7 @@ pub mod prelude {
         BrushCommand, BrushSystems, BrushTarget, DensityBrush, PaintDab, RwtBrushPlugin,
     };
     pub use crate::edits::{EditInstance, InstanceEdit, ScatterEdits};
+    pub use crate::footprints::{Footprint, FootprintShape};
     pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
     pub use crate::layers::file::{NamedAssets, ScatterLayerAsset, ScatterLayerSource};
     pub use crate::{

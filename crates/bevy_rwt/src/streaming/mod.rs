@@ -12,6 +12,7 @@
 
 mod collect;
 mod edit;
+mod footprint;
 mod plan;
 mod plugin;
 mod repaint;

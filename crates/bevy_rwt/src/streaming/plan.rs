@@ -1,9 +1,11 @@
 //! Planning: which chunks each layer loads and unloads, which need regenerating, and the
 //! generation tasks for the nearest of them.
 
+use super::footprint::KnownFootprints;
 use super::resolve::Sources;
 use super::{ChunkContent, ChunkTask, ChunkUnloaded, LayerState, RwtTileSet};
 use crate::edits::EditSet;
+use crate::footprints::GroundFootprint;
 use crate::instancing::InstancedClasses;
 use crate::layers::{AssetStatus, ScatterLayer, ScatterLayerStatus, report_assets, slope};
 use crate::settings::RwtSettings;
@@ -23,6 +25,7 @@ pub(super) struct PlanInputs<'w> {
     server: Option<Res<'w, AssetServer>>,
     tile_set: Res<'w, RwtTileSet>,
     settings: Res<'w, RwtSettings>,
+    footprints: Res<'w, KnownFootprints>,
 }
 
 /// Plans chunks for every layer whose assets are there and starts the generation tasks
@@ -67,6 +70,8 @@ pub(super) fn plan_chunks(
             .max_tasks_in_flight
             .saturating_sub(state.in_flight());
         let job = Job {
+            entity,
+            footprints: &inputs.footprints,
             layer,
             sampler: &sampler,
             sources: &sources,
@@ -115,6 +120,9 @@ fn mark_band_changes(layer: &ScatterLayer, state: &mut LayerState, viewers: &[Vi
 
 /// What every generation task of a layer shares.
 struct Job<'a> {
+    /// The layer entity.
+    entity: Entity,
+    footprints: &'a KnownFootprints,
     layer: &'a ScatterLayer,
     sampler: &'a Arc<Sampler>,
     sources: &'a Sources,
@@ -134,16 +142,27 @@ fn start_tasks(job: &Job, state: &mut LayerState, viewers: &[Viewer], free: usiz
         let band = layer
             .falloff
             .map_or(0, |f| f.chunk_band(chunk, size, viewers));
-        let edits = state.chunk_edits.get(&chunk).cloned();
+        let changes = Changes {
+            edits: state.chunk_edits.get(&chunk).cloned(),
+            footprints: job
+                .footprints
+                .clearing(job.entity, layer.plane, &chunk.rect(size)),
+        };
         let c = state.states.get_mut(&chunk).expect("listed above");
         c.stale = false;
-        c.task = Some((start_task(job, chunk, band, edits), band));
+        c.task = Some((start_task(job, chunk, band, changes), band));
     }
 }
 
+/// What a game changed in a chunk: its per-instance edits and the footprints over it.
+struct Changes {
+    edits: Option<Arc<EditSet>>,
+    footprints: Vec<GroundFootprint>,
+}
+
 /// Starts a generation task for a chunk: the query at the band's density, the height and
-/// slope filters, the chunk's edits, then the packing of instanced classes.
-fn start_task(job: &Job, chunk: ChunkCoord, band: i64, edits: Option<Arc<EditSet>>) -> ChunkTask {
+/// slope filters, the chunk's edits and footprints, then the packing of instanced classes.
+fn start_task(job: &Job, chunk: ChunkCoord, band: i64, changes: Changes) -> ChunkTask {
     let layer = job.layer;
     let (sampler, sources) = (job.sampler.clone(), job.sources);
     let instanced = job.instanced.clone();
@@ -164,8 +183,12 @@ fn start_task(job: &Job, chunk: ChunkCoord, band: i64, edits: Option<Arc<EditSet
                 out.push(p);
             }
         })?;
+        let Changes { edits, footprints } = changes;
         if let Some(edits) = &edits {
             edits.apply(&mut out, classes);
+        }
+        if !footprints.is_empty() {
+            out.retain(|p| !footprints.iter().any(|f| f.clears(p.position, p.class)));
         }
         let packed = instanced.pack(&mut out, rect.min(), &height, &scaled, factor);
         Ok(ChunkContent {

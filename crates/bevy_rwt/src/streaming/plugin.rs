@@ -2,6 +2,7 @@
 
 use super::collect::collect_results;
 use super::edit::apply_edits;
+use super::footprint::{KnownFootprints, track_footprints};
 use super::plan::plan_chunks;
 use super::repaint::{PaintedRegions, repaint};
 use super::spawn::apply_budget;
@@ -22,6 +23,7 @@ impl Plugin for RwtStreamingPlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(RwtTileSet::new(self.tile_set.clone()))
             .init_resource::<PaintedRegions>()
+            .init_resource::<KnownFootprints>()
             .add_message::<ChunkLoaded>()
             .add_message::<ChunkUnloaded>()
             .add_message::<DensityMapPainted>()
@@ -31,7 +33,7 @@ impl Plugin for RwtStreamingPlugin {
             .add_systems(
                 self.schedule,
                 (
-                    (repaint, apply_edits, plan_chunks)
+                    (repaint, apply_edits, track_footprints, plan_chunks)
                         .chain()
                         .in_set(RwtSystems::Plan),
                     collect_results.in_set(RwtSystems::Collect),

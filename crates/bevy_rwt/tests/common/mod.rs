@@ -2,6 +2,8 @@
 //! assets, no renderer), frame stepping until streaming settles, viewers, layers, painting.
 #![allow(dead_code)] // each test file uses some of them
 
+pub mod forest;
+
 use bevy::asset::AssetPlugin;
 use bevy::prelude::*;
 use bevy_rwt::instancing::InstancedChunk;

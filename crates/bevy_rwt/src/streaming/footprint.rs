@@ -1,0 +1,96 @@
+//! Footprints reach the chunks they cover: a footprint that appears, moves, changes or goes
+//! marks the chunks under it (before and after) for generation, whose tasks leave out the
+//! points it clears.
+
+use super::LayerState;
+use crate::footprints::{Footprint, GroundFootprint};
+use crate::layers::ScatterLayer;
+use crate::look::GroundPlane;
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::transform::helper::TransformHelper;
+use glam::DVec2;
+use rwt_core::Rect;
+
+/// Every footprint as last seen, placed by its transform at the time.
+#[derive(Resource, Default)]
+pub(super) struct KnownFootprints(HashMap<Entity, (Footprint, GlobalTransform)>);
+
+impl KnownFootprints {
+    /// The footprints that clear points of `layer` on `plane` in `region`.
+    pub fn clearing(
+        &self,
+        layer: Entity,
+        plane: GroundPlane,
+        region: &Rect,
+    ) -> Vec<GroundFootprint> {
+        self.0
+            .values()
+            .filter(|(f, _)| f.clears_layer(layer))
+            .map(|(f, t)| f.on_ground(t, plane))
+            .filter(|g| g.bounds().is_some_and(|b| overlaps(&b, region)))
+            .collect()
+    }
+}
+
+/// A footprint that is new, changed, or whose transform (or a parent's) changed.
+type Moved = Or<(
+    Changed<Footprint>,
+    Changed<Transform>,
+    Changed<GlobalTransform>,
+)>;
+
+/// Notes added, changed, moved and removed footprints and marks the chunks they cover, before
+/// and after, for generation.
+pub(super) fn track_footprints(
+    changed: Query<Entity, (With<Footprint>, Moved)>,
+    footprints: Query<&Footprint>,
+    transforms: TransformHelper,
+    mut removed: RemovedComponents<Footprint>,
+    mut known: ResMut<KnownFootprints>,
+    mut layers: Query<(Entity, &ScatterLayer, &mut LayerState)>,
+) {
+    let mut touched = Vec::new();
+    for entity in &changed {
+        // The transform as of now, whether or not propagation ran since it changed.
+        let (Ok(footprint), Ok(transform)) = (
+            footprints.get(entity),
+            transforms.compute_global_transform(entity),
+        ) else {
+            continue;
+        };
+        let now = (footprint.clone(), transform);
+        match known.0.insert(entity, now.clone()) {
+            Some(before) if before == now => continue,
+            Some(before) => touched.push(before),
+            None => {}
+        }
+        touched.push(now);
+    }
+    for entity in removed.read() {
+        touched.extend(known.0.remove(&entity));
+    }
+    if touched.is_empty() {
+        return;
+    }
+    for (entity, layer, mut state) in &mut layers {
+        let size = layer.streaming.chunk_size;
+        for (footprint, transform) in touched.iter().filter(|(f, _)| f.clears_layer(entity)) {
+            if let Some(bounds) = footprint.on_ground(transform, layer.plane).bounds() {
+                state.mark_stale(size, &widen(&bounds));
+            }
+        }
+    }
+}
+
+/// Whether a footprint's (closed) bounds reach into a (half-open) region.
+fn overlaps(bounds: &Rect, region: &Rect) -> bool {
+    widen(bounds).overlaps(region)
+}
+
+/// `r` grown a little, so that a closed shape's edge on a chunk border reaches the chunk
+/// beyond it.
+fn widen(r: &Rect) -> Rect {
+    let by = DVec2::splat(1e-9) * (DVec2::ONE + r.min().abs().max(r.max().abs()));
+    Rect::new(r.min() - by, r.max() + by).unwrap_or(*r)
+}
