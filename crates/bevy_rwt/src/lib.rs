@@ -110,6 +110,7 @@ pub mod gizmos;
 pub mod instancing;
 pub mod layers;
 pub mod look;
+pub mod picking;
 mod settings;
 pub mod streaming;
 pub mod viewers;
@@ -142,6 +143,7 @@ pub mod prelude {
     pub use crate::footprints::{Footprint, FootprintShape};
     pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
     pub use crate::layers::file::{NamedAssets, ScatterLayerAsset, ScatterLayerSource};
+    pub use crate::picking::{PickFilter, ScatterHit, ScatterPicking};
     pub use crate::{
         AssetStatus, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
         HeightSource, InstancedChunk, InstancedMaterial, LayerDensity, RwtFadeIn, RwtPlugin,

@@ -110,6 +110,10 @@ pub struct ScatterClass {
     pub scale_variation: f32,
     /// A cheaper look from some distance on (for [`ClassLook::Mesh`] classes).
     pub lod: Option<MeshLod>,
+    /// Bounds (min, max) of one instance at scale 1, for picking
+    /// ([`crate::picking::ScatterPicking`]); `None` uses the class mesh's bounds, or for a
+    /// [`ClassLook::Custom`] class a unit box standing on the ground.
+    pub pick_bounds: Option<(Vec3, Vec3)>,
 }
 
 impl ScatterClass {
@@ -173,7 +177,15 @@ impl ScatterClass {
             scale: 1.0,
             scale_variation: 0.2,
             lod: None,
+            pick_bounds: None,
         }
+    }
+
+    /// Picks instances by these bounds (min, max) at scale 1 (e.g. a tree's trunk and
+    /// crown), instead of the mesh's.
+    pub fn with_pick_bounds(mut self, min: Vec3, max: Vec3) -> Self {
+        self.pick_bounds = Some((min, max));
+        self
     }
 }
 

@@ -44,6 +44,7 @@ pub(super) fn collect_results(
                 }
             };
             c.refused = false;
+            c.shown = true;
             c.lod = band;
             let packed_count: usize = packed.iter().map(|p| p.buffer.instances.len()).sum();
             let count = points.len() + packed_count;

@@ -14,7 +14,7 @@ use rwt_core::Rect;
 
 /// Every footprint as last seen, placed by its transform at the time.
 #[derive(Resource, Default)]
-pub(super) struct KnownFootprints(HashMap<Entity, (Footprint, GlobalTransform)>);
+pub(crate) struct KnownFootprints(HashMap<Entity, (Footprint, GlobalTransform)>);
 
 impl KnownFootprints {
     /// The footprints that clear points of `layer` on `plane` in `region`.

@@ -13,12 +13,15 @@
 mod collect;
 mod edit;
 mod footprint;
+mod generate;
 mod plan;
 mod plugin;
 mod repaint;
 mod resolve;
 mod spawn;
 
+pub(crate) use footprint::KnownFootprints;
+pub(crate) use generate::{Changes, Generator};
 pub use plugin::RwtStreamingPlugin;
 
 use crate::edits::{EditSet, EditStamp};
@@ -111,6 +114,22 @@ struct ChunkState {
     /// The last query was refused (over the chunk point budget): the chunk shows what it
     /// showed before, or nothing.
     refused: bool,
+    /// Whether a generation finished since the chunk loaded (at level of detail `lod`).
+    shown: bool,
+}
+
+/// A layer's points as shown: see [`LayerState::shown`].
+pub(crate) struct ShownLayer {
+    pub generator: Generator,
+    pub chunks: Vec<ShownChunk>,
+}
+
+/// A chunk that shows points.
+pub(crate) struct ShownChunk {
+    pub chunk: ChunkCoord,
+    /// Level-of-detail factor of what it shows.
+    pub factor: f64,
+    pub edits: Option<Arc<EditSet>>,
 }
 
 /// Per-layer streaming state, added with the layer.
@@ -179,6 +198,25 @@ impl LayerState {
         self.states.remove(&chunk);
         self.entities.unload(chunk);
         self.instanced.unload(chunk);
+    }
+
+    /// What picking needs to make a layer's shown points again: how they are generated,
+    /// and each shown chunk with its level-of-detail factor and edits (`None` until the
+    /// layer's sources are made).
+    pub(crate) fn shown(&self, layer: &ScatterLayer) -> Option<ShownLayer> {
+        let sampler = self.sampler.clone()?;
+        let generator = Generator::new(layer, sampler, &self.sources.ready()?);
+        let chunks = self
+            .states
+            .iter()
+            .filter(|(_, c)| c.shown)
+            .map(|(chunk, c)| ShownChunk {
+                chunk: *chunk,
+                factor: layer.falloff.map_or(1.0, |f| f.factor(c.lod)),
+                edits: self.chunk_edits.get(chunk).cloned(),
+            })
+            .collect();
+        Some(ShownLayer { generator, chunks })
     }
 
     /// Marks `chunk` for regeneration, if loaded.

@@ -2,20 +2,15 @@
 //! generation tasks for the nearest of them.
 
 use super::footprint::KnownFootprints;
-use super::resolve::Sources;
+use super::generate::{Changes, Generator};
 use super::{ChunkContent, ChunkTask, ChunkUnloaded, LayerState, RwtTileSet};
-use crate::edits::EditSet;
-use crate::footprints::GroundFootprint;
 use crate::instancing::InstancedClasses;
-use crate::layers::{AssetStatus, ScatterLayer, ScatterLayerStatus, report_assets, slope};
+use crate::layers::{AssetStatus, ScatterLayer, ScatterLayerStatus, report_assets};
 use crate::settings::RwtSettings;
 use crate::viewers::Viewers;
 use bevy::prelude::*;
 use bevy::tasks::AsyncComputeTaskPool;
-use rwt_core::density::Scale;
-use rwt_core::query::Sampler;
 use rwt_core::streaming::{ChunkCoord, Viewer, nearest_first};
-use std::sync::Arc;
 
 /// The resources planning reads.
 #[derive(bevy::ecs::system::SystemParam)]
@@ -73,8 +68,7 @@ pub(super) fn plan_chunks(
             entity,
             footprints: &inputs.footprints,
             layer,
-            sampler: &sampler,
-            sources: &sources,
+            generator: Generator::new(layer, sampler, &sources),
             instanced: &instanced,
         };
         start_tasks(&job, state, viewers, free);
@@ -124,8 +118,7 @@ struct Job<'a> {
     entity: Entity,
     footprints: &'a KnownFootprints,
     layer: &'a ScatterLayer,
-    sampler: &'a Arc<Sampler>,
-    sources: &'a Sources,
+    generator: Generator,
     instanced: &'a InstancedClasses,
 }
 
@@ -154,47 +147,22 @@ fn start_tasks(job: &Job, state: &mut LayerState, viewers: &[Viewer], free: usiz
     }
 }
 
-/// What a game changed in a chunk: its per-instance edits and the footprints over it.
-struct Changes {
-    edits: Option<Arc<EditSet>>,
-    footprints: Vec<GroundFootprint>,
-}
-
-/// Starts a generation task for a chunk: the query at the band's density, the height and
-/// slope filters, the chunk's edits and footprints, then the packing of instanced classes.
+/// Starts a generation task for a chunk: its points (see [`Generator::points`]), then the
+/// packing of instanced classes.
 fn start_task(job: &Job, chunk: ChunkCoord, band: i64, changes: Changes) -> ChunkTask {
     let layer = job.layer;
-    let (sampler, sources) = (job.sampler.clone(), job.sources);
+    let generator = job.generator.clone();
     let instanced = job.instanced.clone();
     let rect = chunk.rect(layer.streaming.chunk_size);
     let factor = layer.falloff.map_or(1.0, |f| f.factor(band));
-    let (range, max_slope) = (layer.height_range, layer.max_slope);
-    let densities = sources.densities.clone();
-    let height = sources.height.clone();
-    let classes = layer.classes.len();
     AsyncComputeTaskPool::get().spawn(async move {
-        let scaled: Vec<_> = densities.iter().map(|d| Scale(d.clone(), factor)).collect();
-        let mut out = Vec::new();
-        sampler.query_classes(rect, &scaled, |p| {
-            let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
-            let in_range = range.is_none_or(|(lo, hi)| (lo..=hi).contains(&height(ground)));
-            let flat_enough = max_slope.is_none_or(|m| slope(&height, ground, 0.25) <= m);
-            if in_range && flat_enough {
-                out.push(p);
-            }
-        })?;
-        let Changes { edits, footprints } = changes;
-        if let Some(edits) = &edits {
-            edits.apply(&mut out, classes);
-        }
-        if !footprints.is_empty() {
-            out.retain(|p| !footprints.iter().any(|f| f.clears(p.position, p.class)));
-        }
-        let packed = instanced.pack(&mut out, rect.min(), &height, &scaled, factor);
+        let scaled = generator.scaled(factor, None);
+        let mut out = generator.points(rect, &scaled, &changes)?;
+        let packed = instanced.pack(&mut out, rect.min(), &generator.height, &scaled, factor);
         Ok(ChunkContent {
             points: out,
             packed,
-            edits,
+            edits: changes.edits,
         })
     })
 }

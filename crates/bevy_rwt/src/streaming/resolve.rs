@@ -141,6 +141,14 @@ impl Resolved {
         })
     }
 
+    /// The task inputs as last made (`None` until every snapshot is there).
+    pub fn ready(&self) -> Option<Sources> {
+        Some(Sources {
+            densities: self.combined.clone()?,
+            height: self.height.clone()?,
+        })
+    }
+
     /// The height snapshot, once made.
     pub fn height(&self) -> Option<&HeightFn> {
         self.height.as_ref()
