@@ -120,8 +120,8 @@ use bevy::prelude::*;
 pub use diagnostics::RwtStats;
 pub use instancing::{InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind};
 pub use layers::{
-    AssetStatus, HeightSource, LayerDensity, ScatterClass, ScatterInstance, ScatterLayer,
-    ScatterLayerStatus,
+    AssetStatus, HeightSource, LayerDensity, Promotion, ScatterClass, ScatterInstance,
+    ScatterLayer, ScatterLayerStatus,
 };
 pub use look::{
     ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, MeshLod, Pose,

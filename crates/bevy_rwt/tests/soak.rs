@@ -1,6 +1,7 @@
 //! The streaming soak test: a long random walk with painting and layer changes, checked
-//! every frame for duplicate identities and every few hundred frames for bounded entity,
-//! task and memory counts; back at the start, the world is as it was.
+//! every frame for duplicate identities, instances that move (none may: promotion to
+//! entities near the viewer and back included) and every few hundred frames for bounded
+//! entity, task and memory counts; back at the start, the world is as it was.
 
 mod common;
 
@@ -32,7 +33,10 @@ fn instances(app: &mut App) -> HashMap<(u64, PointId), Vec3> {
     for (i, t) in q.iter(app.world()) {
         insert(seeds[&i.layer], i.id, t.translation);
     }
-    let mut chunks = app.world_mut().query::<(&InstancedChunk, &Transform)>();
+    // Chunk entities (promoted instances draw with a child, counted by their parent).
+    let mut chunks = app
+        .world_mut()
+        .query_filtered::<(&InstancedChunk, &Transform), Without<ChildOf>>();
     for (c, t) in chunks.iter(app.world()) {
         for (id, g) in c.buffer.ids.iter().zip(&c.buffer.instances) {
             insert(
@@ -83,9 +87,14 @@ struct Soak {
     second: Entity,
 }
 
+/// What a promoted bush gets (a collider, in a game).
+#[derive(Component)]
+struct Solid;
+
 /// The most of each figure over the walk.
 #[derive(Default)]
 struct Peaks {
+    promoted: usize,
     live: usize,
     live_instanced: usize,
     buffer_bytes: usize,
@@ -128,12 +137,17 @@ impl Soak {
         .with_seed(5)
         .with_falloff(20.0, 48.0);
         app.world_mut().spawn(painted);
-        // Instanced grass, with a fall-off so that chunks change band as the walk goes.
+        // Instanced grass, with a fall-off so that chunks change band as the walk goes, and
+        // instanced bushes that become solid entities near the viewer.
         let grass = ScatterClass::instanced(LayerDensity::Constant(0.5), default(), default());
+        let bushes = ScatterClass::instanced(LayerDensity::Constant(0.04), default(), default())
+            .with_promotion(12.0, |e| {
+                e.insert(Solid);
+            });
         let mut instanced = layer(LayerDensity::Constant(0.0))
             .with_seed(11)
             .with_falloff(20.0, 56.0);
-        instanced.classes = vec![grass];
+        instanced.classes = vec![grass, bushes];
         app.world_mut().spawn(instanced);
         let constant = layer(LayerDensity::Constant(0.2));
         let second = app.world_mut().spawn(constant.clone()).id();
@@ -149,7 +163,14 @@ impl Soak {
 
     /// One frame of the walk: move, sometimes paint or replace the constant layer, update,
     /// and check that no identity is live twice and the figures agree.
-    fn step(&mut self, frame: usize, at: Vec2, rng: &mut Rng, peaks: &mut Peaks) {
+    fn step(
+        &mut self,
+        frame: usize,
+        at: Vec2,
+        rng: &mut Rng,
+        peaks: &mut Peaks,
+        before: &mut HashMap<(u64, PointId), Vec3>,
+    ) {
         let app = &mut self.app;
         move_viewer(app, self.viewer, Vec3::new(at.x, 0.0, at.y));
         if frame % 250 == 125 {
@@ -172,9 +193,27 @@ impl Soak {
                 .id();
         }
         app.update();
-        let live = instances(app).len(); // panics on a duplicate PointId
+        let now = instances(app); // panics on a duplicate PointId
+        // An instance never moves: not when its chunk is generated again, not when it is
+        // promoted to an entity or handed back.
+        for (key, at) in &now {
+            if let Some(was) = before.get(key) {
+                assert_eq!(was, at, "{key:?} moved in frame {frame}");
+            }
+        }
+        let live = now.len();
+        *before = now;
         let stats = app.world().resource::<RwtStats>().clone();
         assert_eq!(live, stats.live_instances + stats.live_instanced);
+        let mut solid = app.world_mut().query_filtered::<(), With<Solid>>();
+        let promoted: usize = app
+            .world_mut()
+            .query::<&ScatterLayerStatus>()
+            .iter(app.world())
+            .map(|s| s.promoted_instances)
+            .sum();
+        assert_eq!(solid.iter(app.world()).count(), promoted);
+        peaks.promoted = peaks.promoted.max(promoted);
         peaks.live = peaks.live.max(stats.live_instances);
         peaks.live_instanced = peaks.live_instanced.max(stats.live_instanced);
         peaks.buffer_bytes = peaks.buffer_bytes.max(buffer_bytes(app));
@@ -193,6 +232,7 @@ impl Soak {
         let mut rng = Rng::new(2006, 1);
         let mut at = Vec2::ZERO;
         let mut heading = 0.0f32;
+        let mut before = HashMap::new();
         for frame in 0..FRAMES {
             heading += (rng.next_f64() as f32 - 0.5) * 0.6;
             if at.length() > 250.0 {
@@ -200,7 +240,7 @@ impl Soak {
             }
             let step = 0.5 + 3.5 * rng.next_f64() as f32;
             at += Vec2::new(heading.cos(), heading.sin()) * step;
-            self.step(frame, at, &mut rng, peaks);
+            self.step(frame, at, &mut rng, peaks, &mut before);
         }
         at
     }
@@ -240,6 +280,7 @@ fn assert_bounded(peaks: &Peaks) {
         "{most_entities} entities"
     );
     let most_instanced = peaks.live_instanced;
+    assert!(peaks.promoted > 5, "{} promoted at most", peaks.promoted);
     assert!(
         most_instanced > 1_000 && (most_instanced as f64) < 0.5 * disc,
         "{most_instanced} live instanced"
@@ -255,9 +296,10 @@ fn assert_bounded(peaks: &Peaks) {
     let grown = resident_bytes().saturating_sub(peaks.rss_after_warm_up);
     eprintln!(
         "soak: {FRAMES} frames, at most {most_live} live instances, {most_entities} entities, \
-         {most_instanced} instanced in {} KiB of buffers, {} queued spawns; resident memory \
-         grew {} KiB after frame 500",
+         {most_instanced} instanced in {} KiB of buffers ({} promoted), {} queued spawns; \
+         resident memory grew {} KiB after frame 500",
         peaks.buffer_bytes >> 10,
+        peaks.promoted,
         peaks.queued,
         grown >> 10
     );
@@ -305,8 +347,11 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
         .find(|(l, _)| l.seed == 11)
         .map(|(_, s)| s.loaded_chunks.len())
         .unwrap();
-    let mut chunks = soak.app.world_mut().query::<&InstancedChunk>();
-    assert!(chunks.iter(soak.app.world()).count() <= instanced_chunks);
+    let mut chunks = soak
+        .app
+        .world_mut()
+        .query_filtered::<&InstancedChunk, Without<ChildOf>>();
+    assert!(chunks.iter(soak.app.world()).count() <= 2 * instanced_chunks);
 }
 
 /// Entities that are neither instances nor instanced chunks.

@@ -160,14 +160,35 @@ impl EditSet {
         if self.0.is_empty() {
             return;
         }
-        points.retain_mut(|p| match self.0.get(&p.id) {
-            None => true,
-            Some(Edit::Remove) => false,
-            Some(Edit::Reclass(class)) => {
-                if (*class as usize) < classes {
-                    p.class = *class;
+        // Queries yield a tile's points one after another: the tile's edits are looked up
+        // once per run of points, and most tiles have none.
+        let mut tile = None;
+        let mut edits: Vec<(u16, Edit)> = Vec::new();
+        points.retain_mut(|p| {
+            let key = (p.id.level, p.id.x, p.id.y);
+            if tile != Some(key) {
+                tile = Some(key);
+                edits.clear();
+                let first = PointId { index: 0, ..p.id };
+                let last = PointId {
+                    index: u16::MAX,
+                    ..p.id
+                };
+                edits.extend(self.0.range(first..=last).map(|(id, e)| (id.index, *e)));
+            }
+            // In index order (the set's order within a tile).
+            match edits
+                .binary_search_by_key(&p.id.index, |(index, _)| *index)
+                .map(|k| edits[k].1)
+            {
+                Err(_) => true,
+                Ok(Edit::Remove) => false,
+                Ok(Edit::Reclass(class)) => {
+                    if (class as usize) < classes {
+                        p.class = class;
+                    }
+                    true
                 }
-                true
             }
         });
     }

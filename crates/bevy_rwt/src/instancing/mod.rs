@@ -16,12 +16,14 @@
 mod mesh;
 mod pack;
 mod plugin;
+mod promote;
 mod queue;
 mod render;
 
 pub use mesh::InstancedMeshes;
 pub(crate) use pack::{InstancedClasses, PackedClass};
 pub use plugin::RwtInstancingPlugin;
+pub use promote::PromotedInstance;
 pub(crate) use queue::{InstancedQueue, Upload};
 
 use crate::look::InstancedMaterial;

@@ -16,10 +16,10 @@ const TINT_SALT: u64 = 0x7117;
 /// What packing needs of a layer: which classes are instanced, with their scale.
 #[derive(Clone, Debug)]
 pub(crate) struct InstancedClasses {
-    /// Per class: `(scale, scale variation)` when instanced.
-    classes: Arc<[Option<(f32, f32)>]>,
+    /// Per class: `(scale, scale variation, keep ids)` when instanced (promoted classes
+    /// keep their instances' identities).
+    classes: Arc<[Option<(f32, f32, bool)>]>,
     seed: u64,
-    keep_ids: bool,
     /// Whether the layer's plane can show them (the x-z ground only); their points are left
     /// out otherwise.
     drawable: bool,
@@ -38,14 +38,17 @@ impl InstancedClasses {
             .classes
             .iter()
             .map(|c| match c.look {
-                ClassLook::Instanced(_) => Some((c.scale, c.scale_variation)),
+                ClassLook::Instanced(_) => Some((
+                    c.scale,
+                    c.scale_variation,
+                    keep_ids || c.promotion.is_some(),
+                )),
                 _ => None,
             })
             .collect();
         let packing = Self {
             classes,
             seed: layer.seed,
-            keep_ids,
             drawable: layer.plane == GroundPlane::Xz,
         };
         if packing.any() && !packing.drawable {
@@ -97,7 +100,7 @@ impl InstancedClasses {
             buffer
                 .instances
                 .push(self.instance(p, corner, height, appear));
-            if self.keep_ids {
+            if matches!(self.classes[p.class as usize], Some((_, _, true))) {
                 buffer.ids.push(p.id);
             }
             false
@@ -118,7 +121,7 @@ impl InstancedClasses {
 
     /// One instance: the same place, turn and scale as the entity path would give it.
     fn instance(&self, p: &Point, corner: DVec2, height: &HeightFn, appear: f64) -> GpuInstance {
-        let (scale, variation) = self.classes[p.class as usize].unwrap_or((1.0, 0.0));
+        let (scale, variation, _) = self.classes[p.class as usize].unwrap_or((1.0, 0.0, false));
         let pose = Pose::of(&p.id, self.seed, scale, variation);
         let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
         let offset = p.position - corner;
@@ -153,7 +156,7 @@ fn unit_u16(v: f64) -> u16 {
 }
 
 /// Bounds of the instances' offsets (zero for no instance).
-fn bounds(instances: &[GpuInstance]) -> (Vec3, Vec3) {
+pub(super) fn bounds(instances: &[GpuInstance]) -> (Vec3, Vec3) {
     let mut it = instances.iter().map(|i| Vec3::from_array(i.offset));
     let Some(first) = it.next() else {
         return (Vec3::ZERO, Vec3::ZERO);

@@ -1,21 +1,35 @@
 //! The instanced look's side of streaming: each chunk's instance buffers (packed in its
 //! generation task) wait for the upload budget, then go to one [`InstancedChunk`] entity per
 //! (chunk, class), spawned when new, updated in place, despawned when empty or unloaded.
+//! Instances of a promoted class near a viewer are held by entities instead
+//! ([`super::promote`]); the chunk's buffer draws the others.
 
-use super::{InstancedChunk, InstancedMeshes, PackedClass};
+use super::{InstanceBuffer, InstancedChunk, InstancedMeshes, PackedClass, pack};
 use crate::layers::ScatterLayer;
 use crate::look::ClassLook;
+use bevy::camera::primitives::Aabb;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
+use rwt_core::query::PointId;
 use rwt_core::streaming::ChunkCoord;
 use std::collections::VecDeque;
+use std::sync::Arc;
+
+/// A chunk's instances of one class.
+pub(super) struct ClassBuffer {
+    /// The entity drawing the instances that are not promoted (none when there are none).
+    pub entity: Option<Entity>,
+    /// The instances as generated, promoted ones included.
+    pub whole: Arc<InstanceBuffer>,
+    /// Promoted instances and the entities that hold them.
+    pub promoted: HashMap<PointId, Entity>,
+}
 
 /// A chunk's instanced classes.
 #[derive(Default)]
-struct ChunkBuffers {
-    /// The chunk entity of each instanced class, with its instance count.
-    drawn: HashMap<u16, (Entity, usize)>,
-    /// Buffers generated but not yet handed to their entities.
+pub(super) struct ChunkBuffers {
+    pub classes: HashMap<u16, ClassBuffer>,
+    /// Buffers generated but not yet handed over.
     waiting: Vec<PackedClass>,
     /// Whether the chunk is in the upload order.
     in_order: bool,
@@ -24,12 +38,21 @@ struct ChunkBuffers {
 /// A layer's instanced chunks: what each chunk draws and is about to draw.
 #[derive(Default)]
 pub(crate) struct InstancedQueue {
-    chunks: HashMap<ChunkCoord, ChunkBuffers>,
+    pub(super) chunks: HashMap<ChunkCoord, ChunkBuffers>,
     /// Chunks with buffers to hand over, in the order they finished.
     upload_order: VecDeque<ChunkCoord>,
-    /// Chunk entities of unloaded chunks: despawned at once, whatever the budget (one
-    /// entity each).
+    /// Entities of unloaded chunks (chunk entities, promoted instances): despawned at once,
+    /// whatever the budget.
     retired: Vec<Entity>,
+}
+
+impl ClassBuffer {
+    /// Every entity it holds.
+    fn entities(&self) -> impl Iterator<Item = Entity> + '_ {
+        self.entity
+            .into_iter()
+            .chain(self.promoted.values().copied())
+    }
 }
 
 impl InstancedQueue {
@@ -49,13 +72,39 @@ impl InstancedQueue {
     /// Forgets a chunk that unloaded: its entities are retired.
     pub fn unload(&mut self, chunk: ChunkCoord) {
         if let Some(c) = self.chunks.remove(&chunk) {
-            self.retired.extend(c.drawn.values().map(|(e, _)| *e));
+            let entities = c.classes.values().flat_map(ClassBuffer::entities);
+            self.retired.extend(entities);
         }
     }
 
-    /// Instances in the chunks' buffers.
+    /// Takes a promoted instance of `chunk` away now (an edit removed it); returns whether
+    /// one was there. Instances in buffers are left to the chunk's regeneration.
+    pub fn remove_now(&mut self, commands: &mut Commands, chunk: ChunkCoord, id: &PointId) -> bool {
+        let Some(c) = self.chunks.get_mut(&chunk) else {
+            return false;
+        };
+        for class in c.classes.values_mut() {
+            if let Some(e) = class.promoted.remove(id) {
+                commands.entity(e).try_despawn();
+                class.whole = Arc::new(without(&class.whole, |i| i == id));
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Instances of the layer's instanced classes (promoted ones included).
     pub fn live(&self) -> usize {
-        let per_chunk = |c: &ChunkBuffers| c.drawn.values().map(|(_, n)| n).sum::<usize>();
+        let per_chunk = |c: &ChunkBuffers| -> usize {
+            c.classes.values().map(|b| b.whole.instances.len()).sum()
+        };
+        self.chunks.values().map(per_chunk).sum()
+    }
+
+    /// Promoted instances.
+    pub fn promoted(&self) -> usize {
+        let per_chunk =
+            |c: &ChunkBuffers| -> usize { c.classes.values().map(|b| b.promoted.len()).sum() };
         self.chunks.values().map(per_chunk).sum()
     }
 
@@ -67,19 +116,37 @@ impl InstancedQueue {
         self.chunks.values().map(waiting).sum()
     }
 
-    /// Despawns every chunk entity, drawn or retired.
+    /// Despawns every entity: chunk entities, promoted instances, retired ones.
     pub fn despawn_all(&self, commands: &mut Commands) {
-        let drawn = self.chunks.values().flat_map(|c| c.drawn.values());
-        for e in drawn.map(|(e, _)| *e).chain(self.retired.iter().copied()) {
+        let held = self.chunks.values().flat_map(|c| c.classes.values());
+        let held = held.flat_map(ClassBuffer::entities);
+        for e in held.chain(self.retired.iter().copied()) {
             commands.entity(e).try_despawn();
         }
     }
 
-    /// Despawns the chunk entities of unloaded chunks.
+    /// Despawns the entities of unloaded chunks.
     pub fn despawn_retired(&mut self, commands: &mut Commands) {
         for e in self.retired.drain(..) {
             commands.entity(e).try_despawn();
         }
+    }
+}
+
+/// `buffer` without the instances whose identity `drop` says (identities are kept for the
+/// classes this is used on).
+pub(super) fn without(buffer: &InstanceBuffer, drop: impl Fn(&PointId) -> bool) -> InstanceBuffer {
+    let (instances, ids): (Vec<_>, Vec<_>) = buffer
+        .instances
+        .iter()
+        .zip(&buffer.ids)
+        .filter(|(_, id)| !drop(id))
+        .map(|(g, id)| (*g, *id))
+        .unzip();
+    InstanceBuffer {
+        bounds: pack::bounds(&instances),
+        instances,
+        ids,
     }
 }
 
@@ -92,6 +159,14 @@ pub(crate) struct Upload<'a> {
     checked: &'a mut InstancedMeshes,
     /// Whether no chunk was handed over yet this frame (one always is).
     first: bool,
+}
+
+/// A layer's chunk: where buffers of its classes go.
+#[derive(Clone, Copy)]
+pub(super) struct Target<'a> {
+    pub entity: Entity,
+    pub layer: &'a ScatterLayer,
+    pub chunk: ChunkCoord,
 }
 
 impl<'a> Upload<'a> {
@@ -131,75 +206,113 @@ impl<'a> Upload<'a> {
             self.first = false;
             queue.upload_order.pop_front();
             c.in_order = false;
+            let target = Target {
+                entity,
+                layer,
+                chunk,
+            };
             for packed in std::mem::take(&mut c.waiting) {
-                let class = packed.class;
-                let slot = c.drawn.get(&class).map(|(e, _)| *e);
-                let len = packed.buffer.instances.len();
-                let target = Target {
-                    entity,
-                    layer,
-                    chunk,
-                    slot,
-                };
-                match self.hand_over(commands, target, packed) {
-                    Some(e) => c.drawn.insert(class, (e, len)),
-                    None => c.drawn.remove(&class),
-                };
+                let slot = c.classes.remove(&packed.class);
+                if let Some(class) = self.hand_over(commands, target, slot, packed) {
+                    c.classes.insert(class.0, class.1);
+                }
             }
         }
     }
 
-    /// Puts one class's buffer on its chunk entity (spawned when new, despawned when the
-    /// buffer is empty); returns the entity that holds it.
+    /// Puts one class's new buffer in place: promoted instances still in it stay promoted,
+    /// the others go; the rest is drawn by the class's chunk entity.
     fn hand_over(
         &mut self,
         commands: &mut Commands,
         target: Target,
+        slot: Option<ClassBuffer>,
         packed: PackedClass,
-    ) -> Option<Entity> {
+    ) -> Option<(u16, ClassBuffer)> {
+        let (mut entity, mut promoted) =
+            slot.map_or((None, HashMap::new()), |s| (s.entity, s.promoted));
+        let kept: std::collections::HashSet<&PointId> = packed.buffer.ids.iter().collect();
+        promoted.retain(|id, e| {
+            let keep = kept.contains(id);
+            if !keep {
+                commands.entity(*e).try_despawn();
+            }
+            keep
+        });
+        let mut class = ClassBuffer {
+            entity: entity.take(),
+            whole: packed.buffer,
+            promoted,
+        };
+        self.redraw(commands, target, packed.class, &mut class);
+        (!class.whole.instances.is_empty()).then_some((packed.class, class))
+    }
+
+    /// Draws the class's instances that are not promoted with its chunk entity (spawned,
+    /// updated, or despawned when none is left).
+    pub(super) fn redraw(
+        &mut self,
+        commands: &mut Commands,
+        target: Target,
+        class: u16,
+        buffer: &mut ClassBuffer,
+    ) {
+        let drawn = if buffer.promoted.is_empty() {
+            buffer.whole.clone()
+        } else {
+            Arc::new(without(&buffer.whole, |id| {
+                buffer.promoted.contains_key(id)
+            }))
+        };
+        let component = match drawn.instances.is_empty() {
+            true => None,
+            false => self.component(target, class, drawn),
+        };
+        match (component, buffer.entity) {
+            (Some(bundle), Some(e)) => {
+                commands.entity(e).insert(bundle);
+            }
+            (Some(bundle), None) => {
+                let corner = target.chunk.rect(target.layer.streaming.chunk_size).min();
+                let transform = Transform::from_xyz(corner.x as f32, 0.0, corner.y as f32);
+                buffer.entity = Some(commands.spawn((bundle, transform)).id());
+            }
+            (None, Some(e)) => {
+                commands.entity(e).try_despawn();
+                buffer.entity = None;
+            }
+            (None, None) => {}
+        }
+    }
+
+    /// The component drawing `buffer` of a class of the target's layer, with its bounds
+    /// (`None` when the class is not instanced).
+    pub(super) fn component(
+        &mut self,
+        target: Target,
+        class: u16,
+        buffer: Arc<InstanceBuffer>,
+    ) -> Option<(InstancedChunk, Aabb)> {
         let layer = target.layer;
-        let class = layer.classes.get(packed.class as usize)?;
-        let ClassLook::Instanced(look) = &class.look else {
+        let c = layer.classes.get(class as usize)?;
+        let ClassLook::Instanced(look) = &c.look else {
             return None;
         };
-        if packed.buffer.instances.is_empty() {
-            if let Some(e) = target.slot {
-                commands.entity(e).try_despawn();
-            }
-            return None;
-        }
-        let corner = target.chunk.rect(layer.streaming.chunk_size).min();
-        let max_scale = class.scale * (1.0 + class.scale_variation.abs());
         let mesh_bounds = self.checked.bounds(&look.mesh, self.meshes);
         let component = InstancedChunk {
             layer: target.entity,
             chunk: target.chunk,
-            class: packed.class,
+            class,
             mesh: look.mesh.clone(),
             material: look.material.clone(),
             mesh_top: mesh_bounds.1.y.max(1e-3),
-            max_scale,
+            max_scale: c.scale * (1.0 + c.scale_variation.abs()),
             falloff: layer
                 .falloff
                 .map(|f| (f.near as f32, f.far as f32, f.floor as f32)),
-            buffer: packed.buffer,
+            buffer,
         };
         let aabb = component.aabb(mesh_bounds);
-        let transform = Transform::from_xyz(corner.x as f32, 0.0, corner.y as f32);
-        Some(match target.slot {
-            Some(e) => {
-                commands.entity(e).insert((component, aabb));
-                e
-            }
-            None => commands.spawn((component, aabb, transform)).id(),
-        })
+        Some((component, aabb))
     }
-}
-
-/// Where a buffer goes: a layer's chunk, and the entity that draws its class there, if any.
-struct Target<'a> {
-    entity: Entity,
-    layer: &'a ScatterLayer,
-    chunk: ChunkCoord,
-    slot: Option<Entity>,
 }

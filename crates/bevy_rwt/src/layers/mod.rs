@@ -15,7 +15,9 @@ pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
 pub use status::{AssetStatus, ScatterLayerStatus};
 
 use crate::edits::ScatterEdits;
-use crate::look::{ClassLook, GroundPlane, InstancedLook, InstancedMaterial, MeshLod};
+use crate::look::{
+    ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, MeshLod,
+};
 use bevy::prelude::*;
 use rwt_core::density::{Constant, Density, NoiseDensity};
 use rwt_core::streaming::{Falloff, StreamingConfig};
@@ -114,6 +116,37 @@ pub struct ScatterClass {
     /// ([`crate::picking::ScatterPicking`]); `None` uses the class mesh's bounds, or for a
     /// [`ClassLook::Custom`] class a unit box standing on the ground.
     pub pick_bounds: Option<(Vec3, Vec3)>,
+    /// For a [`ClassLook::Instanced`] class: its instances near a viewer become entities
+    /// (colliders, game logic), drawn exactly as before.
+    pub promotion: Option<Promotion>,
+}
+
+/// Near instances of an instanced class become entities: within `distance` (on the ground)
+/// of any viewer, an instance leaves its chunk's buffer for an entity with a
+/// [`ScatterInstance`], its `Transform` as drawn and what `insert` puts on it (a collider),
+/// drawn by a child with the same instance; a little beyond the distance
+/// ([`Promotion::HYSTERESIS`]) it goes back to the buffer. Both happen within one frame,
+/// so the instance is never drawn twice or missing.
+#[derive(Clone)]
+pub struct Promotion {
+    /// Ground distance to the nearest viewer within which instances are entities.
+    pub distance: f32,
+    /// What a promoted instance gets.
+    pub insert: InstanceInserter,
+}
+
+impl Promotion {
+    /// Instances go back to the buffer beyond `distance` times this (so that one standing
+    /// at the distance does not change every frame).
+    pub const HYSTERESIS: f32 = 1.1;
+}
+
+impl std::fmt::Debug for Promotion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Promotion")
+            .field("distance", &self.distance)
+            .finish_non_exhaustive()
+    }
 }
 
 impl ScatterClass {
@@ -178,7 +211,22 @@ impl ScatterClass {
             scale_variation: 0.2,
             lod: None,
             pick_bounds: None,
+            promotion: None,
         }
+    }
+
+    /// Makes the instances of this instanced class within `distance` of a viewer entities
+    /// with what `insert` puts on them (see [`Promotion`]).
+    pub fn with_promotion(
+        mut self,
+        distance: f32,
+        insert: impl Fn(&mut EntityCommands) + Send + Sync + 'static,
+    ) -> Self {
+        self.promotion = Some(Promotion {
+            distance,
+            insert: Arc::new(insert),
+        });
+        self
     }
 
     /// Picks instances by these bounds (min, max) at scale 1 (e.g. a tree's trunk and

@@ -29,8 +29,11 @@ pub struct ScatterLayerStatus {
     pub loaded_chunks: HashSet<ChunkCoord>,
     /// Entity instances alive (spawned and not yet despawned).
     pub live_instances: usize,
-    /// Instances of instanced classes alive (in chunk buffers; no entity each).
+    /// Instances of instanced classes alive (in chunk buffers, no entity each, or
+    /// promoted to entities near a viewer).
     pub live_instanced: usize,
+    /// Instances of instanced classes promoted to entities (see [`super::Promotion`]).
+    pub promoted_instances: usize,
     /// Chunks being generated or waiting to be.
     pub pending_tasks: usize,
     /// Instances waiting for the spawn budget (or, for instanced classes, the upload budget).

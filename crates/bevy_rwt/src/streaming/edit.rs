@@ -105,7 +105,10 @@ fn apply_edit(
     let entity_class =
         class.filter(|c| !matches!(layer.classes[*c as usize].look, ClassLook::Instanced(_)));
     let shown = match (message.edit, entity_class, state.sources.height()) {
-        (InstanceEdit::Remove, _, _) => state.entities.remove_now(commands, chunk, &id),
+        (InstanceEdit::Remove, _, _) => {
+            state.entities.remove_now(commands, chunk, &id)
+                || state.instanced.remove_now(commands, chunk, &id)
+        }
         (InstanceEdit::Reclass(_), Some(class), Some(height)) => {
             let spawner = Spawner {
                 entity,

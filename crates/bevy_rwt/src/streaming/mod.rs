@@ -275,6 +275,7 @@ fn update_status(mut layers: Query<(&LayerState, &mut ScatterLayerStatus)>) {
         let status = status.bypass_change_detection();
         status.live_instances = state.entities.live();
         status.live_instanced = state.instanced.live();
+        status.promoted_instances = state.instanced.promoted();
         status.pending_tasks = state.pending();
         status.queued_spawns = state.entities.queued() + state.instanced.queued();
         status.refused_chunks = state.states.values().filter(|c| c.refused).count();

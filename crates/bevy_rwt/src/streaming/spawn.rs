@@ -6,6 +6,7 @@ use crate::entities::Spawner;
 use crate::instancing::{InstancedMeshes, Upload};
 use crate::layers::ScatterLayer;
 use crate::settings::RwtSettings;
+use crate::viewers::Viewers;
 use bevy::prelude::*;
 
 /// Despawns and spawns entity instances and hands instance buffers to their chunk entities,
@@ -16,6 +17,7 @@ pub(super) fn apply_budget(
     settings: Res<RwtSettings>,
     meshes: Option<Res<Assets<Mesh>>>,
     mut checked: ResMut<InstancedMeshes>,
+    viewers: Res<Viewers>,
 ) {
     let mut spawn_budget = settings.spawn_budget;
     let mut despawn_budget = settings.despawn_budget;
@@ -37,5 +39,7 @@ pub(super) fn apply_budget(
                 .spawn_queued(&mut commands, &spawner, &mut spawn_budget);
         }
         upload.chunks(&mut commands, entity, layer, &mut state.instanced);
+        let viewers = viewers.on(layer.plane);
+        upload.promote(&mut commands, entity, layer, &mut state.instanced, viewers);
     }
 }

@@ -221,7 +221,10 @@ pub fn placed(app: &mut App) -> HashMap<PointId, Placed> {
         };
         assert!(out.insert(i.id, p).is_none(), "{:?} twice", i.id);
     }
-    let mut chunks = app.world_mut().query::<(&InstancedChunk, &Transform)>();
+    // Chunk entities; the children of promoted instances draw what their parents hold.
+    let mut chunks = app
+        .world_mut()
+        .query_filtered::<(&InstancedChunk, &Transform), Without<ChildOf>>();
     for (c, t) in chunks.iter(app.world()) {
         assert_eq!(c.buffer.ids.len(), c.len(), "ids kept beside the buffer");
         for (id, g) in c.buffer.ids.iter().zip(&c.buffer.instances) {
