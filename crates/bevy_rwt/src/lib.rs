@@ -29,6 +29,50 @@
 //! diffs the points by [`rwt_core::PointId`] → `apply_budget` spawns what appeared and
 //! despawns what went. `docs/ARCHITECTURE.md` draws it whole.
 //!
+//! ## Acting on the world
+//!
+//! A game changes single instances through their stable identity, without storing the
+//! world: [`edits`] ([`edits::EditInstance`] to remove, restore or reclass one instance; a
+//! [`edits::ScatterEdits`] set per layer, saved by the brush), [`footprints`] (a
+//! [`footprints::Footprint`] on any entity clears the ground under it), [`picking`]
+//! ([`picking::ScatterPicking`]: the instance a ray hits) and promotion
+//! ([`ScatterClass::with_promotion`]: near instances of an instanced class become entities
+//! with the class's components). Each module's page has a worked example.
+//!
+//! ```
+//! use bevy::prelude::*;
+//! use bevy_rwt::prelude::*;
+//!
+//! let mut app = App::new();
+//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugin::default()));
+//! app.finish();
+//! app.cleanup();
+//! app.world_mut().spawn((RwtViewer::all_around(), Transform::default(), GlobalTransform::default()));
+//! let trees = ScatterClass::new(LayerDensity::Constant(0.05), Handle::default(), Handle::default());
+//! let stumps = ScatterClass::new(LayerDensity::Constant(0.0), Handle::default(), Handle::default());
+//! let layer = app.world_mut().spawn(ScatterLayer::new(vec![trees, stumps])).id();
+//! let settle = |app: &mut App| {
+//!     for _ in 0..500 {
+//!         app.update();
+//!         let stats = app.world().resource::<RwtStats>();
+//!         if stats.live_instances > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
+//!             break;
+//!         }
+//!         std::thread::sleep(std::time::Duration::from_millis(2));
+//!     }
+//! };
+//! settle(&mut app);
+//! // Chop a tree: a stump (class 1) takes its place, now and whenever its chunk comes back.
+//! let tree = *app.world_mut().query::<&ScatterInstance>().iter(app.world()).next().unwrap();
+//! app.world_mut().write_message(EditInstance::reclass(layer, tree.id, 1));
+//! settle(&mut app);
+//! let edits = app.world().get::<ScatterEdits>(layer).unwrap();
+//! assert_eq!(edits.len(), 1);
+//! let now = app.world_mut().query::<&ScatterInstance>().iter(app.world())
+//!     .find(|i| i.id == tree.id).copied().unwrap();
+//! assert_eq!(now.class, 1);
+//! ```
+//!
 //! ## Names
 //!
 //! - `Rwt*`: the plugin and its parts, their resources, system sets and the viewer marker

@@ -119,7 +119,7 @@ impl Pose {
 const DEPTH_SALT: u64 = 0xde97;
 
 /// The plane a layer lies on. Ground positions `(u, v)` of the point set and the height
-/// `h` of the [`HeightSource`] become these world positions.
+/// `h` of the [`crate::HeightSource`] become these world positions.
 #[derive(
     Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
 )]

@@ -6,7 +6,7 @@
 //!   only for the maps that change;
 //! - `plan`: chunks to load and unload, generation tasks for the nearest stale chunks;
 //! - `collect`: finished tasks handed to the look that shows them: points of entity
-//!   classes to [`crate::entities`], instance buffers to [`crate::instancing`];
+//!   classes to the entity look (`entities`), instance buffers to [`crate::instancing`];
 //! - `spawn`: each look's queue spent within the per-frame budgets;
 //! - `repaint`: painted maps mark the chunks they cover stale.
 

@@ -131,7 +131,7 @@ pub enum MeshDescription {
         /// Size on x, y, z.
         size: (f32, f32, f32),
     },
-    /// A grass blade for instanced classes (see [`crate::instancing::blade_mesh`]).
+    /// A grass blade for instanced classes (see [`crate::look::blade_mesh`]).
     Blade {
         /// Width at the root.
         width: f32,
