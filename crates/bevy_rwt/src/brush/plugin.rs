@@ -33,7 +33,7 @@ impl Plugin for RwtBrushPlugin {
                 (locate_cursor, brush_input, apply_dabs, apply_commands)
                     .chain()
                     .in_set(BrushSystems)
-                    .before(crate::RwtSystems::Viewers),
+                    .before(crate::settings::RwtSystems::Viewers),
             );
     }
 

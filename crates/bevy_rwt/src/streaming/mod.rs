@@ -24,7 +24,9 @@ pub(crate) use footprint::KnownFootprints;
 pub(crate) use generate::{Changes, Generator};
 pub use plugin::RwtStreamingPlugin;
 
-use crate::edits::{EditSet, EditStamp};
+use crate::edits::EditSet;
+#[cfg(feature = "brush")]
+use crate::edits::EditStamp;
 use crate::entities::EntityQueue;
 use crate::instancing::{InstancedClasses, InstancedQueue, PackedClass};
 #[cfg(feature = "brush")]
@@ -74,16 +76,21 @@ pub struct DensityMapPainted {
 pub(crate) struct RwtTileSet {
     pub set: Arc<TileSet>,
     /// [`TileSet::fingerprint`], which saved edits name their tile set by.
-    pub fingerprint: u64,
+    #[cfg(feature = "brush")]
+    fingerprint: u64,
 }
 
 impl RwtTileSet {
     pub fn new(set: Arc<TileSet>) -> Self {
-        let fingerprint = set.fingerprint();
-        Self { set, fingerprint }
+        Self {
+            #[cfg(feature = "brush")]
+            fingerprint: set.fingerprint(),
+            set,
+        }
     }
 
-    /// What the point identities of a layer of `seed` refer to.
+    /// What the point identities of a layer of `seed` refer to (in the brush's saves).
+    #[cfg(feature = "brush")]
     pub fn stamp(&self, seed: u64) -> EditStamp {
         EditStamp {
             seed,
