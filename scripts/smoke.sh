@@ -4,7 +4,8 @@
 # screenshot is missing or blank (luminance variance < 20), or it reports 0 instances
 # (entities and instanced together), or open_world has fewer than a million instanced blades
 # or its scripted brush stroke changed no instance (`painted 0`) or its brush did not save
-# the painted maps and layer files.
+# the painted maps and layer files, or (its `eye` view) the trees it chopped and the ground
+# its cabin cleared did not persist through a flight 3 km away and back.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -73,6 +74,16 @@ for run in "${runs[@]}"; do
         fi
         if [ "${painted:-0}" -eq 0 ]; then
             echo "FAIL $name: the scripted brush stroke changed no instance"; failed=1
+        fi
+        if [ -z "$view" ] || [ "$view" = eye ]; then
+            # The scripted gameplay: trees chopped, a cabin's footprint cleared, all still so
+            # after flying 3 km away and back.
+            play=$(grep -E '^rwt-smoke: gameplay chopped' "$out/$name.log" || true)
+            echo "${play:-FAIL $name: no gameplay line}"
+            read -r c k p < <(sed -nE 's/.*chopped ([0-9]+) cleared ([0-9]+) persisted ([0-9]+)$/\1 \2 \3/p' <<<"$play")
+            if [ -z "${c:-}" ] || [ "$c" -eq 0 ] || [ "$k" -eq 0 ] || [ "$p" -ne $((c + k)) ]; then
+                echo "FAIL $name: chopped and cleared instances did not all persist"; failed=1
+            fi
         fi
         grep -E '^rwt-smoke: brush' "$out/$name.log" || true
         if ! grep -qE '^rwt-smoke: brush saved 4 maps, 2 layer files and [0-9]+ edits' "$out/$name.log"; then

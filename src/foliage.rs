@@ -150,6 +150,75 @@ pub fn bush() -> Mesh {
     faceted(merged(parts))
 }
 
+/// What a chopped tree leaves: a short stump with a pale cut face.
+pub fn stump() -> Mesh {
+    let bark = Color::srgb(0.24, 0.17, 0.1);
+    let wood = Color::srgb(0.72, 0.6, 0.42);
+    let face = Cylinder::new(0.3, 0.04)
+        .mesh()
+        .resolution(9)
+        .build()
+        .translated_by(Vec3::Y * 0.62);
+    faceted(merged(vec![
+        painted(trunk(0.36, 0.62, 9), bark),
+        painted(face, wood),
+    ]))
+}
+
+/// A log cabin, 6 m by 4 m, standing on its origin, with a pitched roof along x.
+pub fn cabin() -> Mesh {
+    let logs = Color::srgb(0.42, 0.28, 0.16);
+    let roof = Color::srgb(0.3, 0.12, 0.1);
+    let door = Color::srgb(0.2, 0.13, 0.08);
+    let walls = Cuboid::new(6.0, 2.6, 4.0)
+        .mesh()
+        .build()
+        .translated_by(Vec3::Y * 1.3);
+    let slab = |side: f32| {
+        Cuboid::new(6.6, 0.16, 2.7)
+            .mesh()
+            .build()
+            .rotated_by(Quat::from_rotation_x(side * 0.62))
+            .translated_by(Vec3::new(0.0, 3.25, side * 1.08))
+    };
+    let attic = prism(Vec3::new(6.0, 1.35, 4.0)).translated_by(Vec3::Y * 2.6);
+    let entrance = Cuboid::new(0.05, 1.9, 1.0)
+        .mesh()
+        .build()
+        .translated_by(Vec3::new(3.01, 0.95, 0.0));
+    let parts = vec![
+        painted(walls, logs),
+        painted(attic, logs),
+        painted(slab(-1.0), roof),
+        painted(slab(1.0), roof),
+        painted(entrance, door),
+    ];
+    faceted(merged(parts))
+}
+
+/// A triangular prism along x: `size.x` long, `size.z` wide at its base (y = 0), `size.y`
+/// high at its ridge.
+fn prism(size: Vec3) -> Mesh {
+    let (x, y, z) = (size.x / 2.0, size.y, size.z / 2.0);
+    let positions = vec![
+        [-x, 0.0, -z],
+        [-x, 0.0, z],
+        [-x, y, 0.0],
+        [x, 0.0, -z],
+        [x, 0.0, z],
+        [x, y, 0.0],
+    ];
+    let indices = vec![0, 1, 2, 3, 5, 4, 0, 2, 5, 0, 5, 3, 1, 4, 5, 1, 5, 2];
+    Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0, 1.0, 0.0]; 6])
+    .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, vec![[0.0, 0.0]; 6])
+    .with_inserted_indices(Indices::U32(indices))
+}
+
 /// A boulder, half sunk into the ground.
 pub fn rock() -> Mesh {
     let stone = Sphere::new(1.0).mesh().ico(2).expect("small ico sphere");

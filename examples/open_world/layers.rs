@@ -87,6 +87,10 @@ fn painted_map(images: &mut Assets<Image>, seed: u32, scale: f64, feature: f64) 
     density
 }
 
+/// The tree layer's classes: the three species, then their stump.
+pub const TREE_SPECIES: [u16; 3] = [0, 1, 2];
+pub const STUMP: u16 = 3;
+
 /// The forests' noise seeds and bases, one per species.
 pub const FORESTS: [(u32, f64); 3] = [(11, -0.1), (12, -0.2), (13, -0.35)];
 
@@ -115,7 +119,7 @@ fn trees(
         (foliage::broadleaf(), b),
         (foliage::birch(), c),
     ];
-    let classes = species
+    let mut classes: Vec<ScatterClass> = species
         .into_iter()
         .map(|(tree, density)| {
             let near = meshes.add(tree.near);
@@ -129,6 +133,15 @@ fn trees(
             class
         })
         .collect();
+    // Nowhere until a tree is chopped (an edit gives its point this class); the same scale
+    // rule as the trees, so a stump is as thick as its tree was.
+    let mut stump = ScatterClass::new(
+        LayerDensity::Constant(0.0),
+        meshes.add(foliage::stump()),
+        material.clone(),
+    );
+    stump.scale_variation = 0.3;
+    classes.push(stump);
     ScatterLayer::new(classes)
         .with_seed(1)
         .with_tile_size(128.0)

@@ -10,9 +10,13 @@
 //! - B toggles the brush: left mouse paints, right erases, the wheel sizes it, T sets the
 //!   strength, 1-4 choose the map, Z undoes, F5 saves the maps and the flower and bush
 //!   layer files to `painted/` (or `RWT_PAINT_DIR`), F9 loads the maps;
-//! - V toggles the wind, F the fade-in (see the popping it hides), G chunk outlines.
+//! - V toggles the wind, F the fade-in (see the popping it hides), G chunk outlines;
+//! - with the brush off, a left click chops the tree under the cursor (a stump stays), C
+//!   places a cabin that clears the ground under it; F5 saves these edits with the maps.
 
+mod gameplay;
 mod layers;
+mod play;
 mod script;
 
 use bevy::light::CascadeShadowConfigBuilder;
@@ -41,6 +45,7 @@ fn main() {
             RwtPlugin::default().with_max_tasks(32),
             RwtGizmosPlugin,
             RwtBrushPlugin,
+            gameplay::GameplayPlugin,
             script::ScriptPlugin,
         ))
         .add_systems(Startup, (setup_scene, layers::setup_layers))
@@ -236,7 +241,7 @@ fn hud(
         })
         .collect();
     hud.lines = vec![
-        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | V wind, F fade-in, G chunks".into(),
+        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | click chops a tree, C cabin | V wind, F fade-in, G chunks".into(),
         format!(
             "position {:.0}, {:.0} m, altitude {:.0} m, speed {:.0} m/s",
             t.translation.x, t.translation.z, t.translation.y, cam.speed

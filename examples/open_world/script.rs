@@ -1,10 +1,12 @@
 //! The scripted session (`RWT_SCREENSHOT`): a 1.5 km flight, then down to the view the
 //! screenshot shows (`RWT_VIEW`: `eye` in the grass, the default; `forest` at a forest
 //! edge; `aerial` to the horizon; `brush` painting from above), and one brush stroke of red
-//! flowers, whose added instances the smoke line reports; then the brush saves the painted
-//! world (maps and layer files) to `RWT_PAINT_DIR`.
+//! flowers, whose added instances the smoke line reports; in the `eye` view the gameplay of
+//! [`crate::play`] (chop, cabin, away and back); then the brush saves the painted world
+//! (maps, layer files and edits) to `RWT_PAINT_DIR`.
 
 use crate::layers::{FORESTS, forest};
+use crate::play::{Play, play};
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushCommand, BrushSystems, DensityBrush, PaintDab};
 use bevy_rwt::prelude::*;
@@ -21,11 +23,17 @@ pub struct ScriptSystems;
 
 impl Plugin for ScriptPlugin {
     fn build(&self, app: &mut App) {
-        app.insert_resource(Script::from_env())
+        let script = Script::from_env();
+        let mut gameplay = Play::default();
+        if script.view != View::Eye {
+            gameplay.skip();
+        }
+        app.insert_resource(script)
+            .insert_resource(gameplay)
             .configure_sets(Update, ScriptSystems.after(BrushSystems))
             .add_systems(
                 Update,
-                (fly, stroke, save_painting)
+                (fly, stroke, play, save_painting)
                     .chain()
                     .in_set(ScriptSystems)
                     .run_if(|s: Res<Smoke>| s.active()),
@@ -49,6 +57,12 @@ struct Script {
     end: Option<(Vec3, f32, f32)>,
     stroke: Stroke,
     save: Save,
+}
+
+/// Whether the stroke's count may still change (not once the gameplay began: its trip
+/// away and the cabin change the flower layer too).
+fn counting(gameplay: &Play) -> bool {
+    !gameplay.started()
 }
 
 /// The save after the stroke.
@@ -99,11 +113,18 @@ fn path(t: f32) -> (Vec2, f32) {
 fn fly(
     smoke: Res<Smoke>,
     terrain: Res<Terrain>,
+    gameplay: Res<Play>,
     mut script: ResMut<Script>,
     mut camera: Query<(&mut FlyCamera, &mut Transform)>,
 ) {
-    let t = (smoke.progress() / FLIGHT).min(1.0);
-    let landing = ((smoke.progress() - FLIGHT) / LANDING).clamp(0.0, 1.0);
+    let mut t = (smoke.progress() / FLIGHT).min(1.0);
+    let mut landing = ((smoke.progress() - FLIGHT) / LANDING).clamp(0.0, 1.0);
+    // Back from the scripted gameplay's trip away: the end of the flight again (its last
+    // tenth), then the landing.
+    if let Some(back) = gameplay.returning(smoke.frame) {
+        t = 0.9 + 0.1 * (back * 2.0).min(1.0);
+        landing = (back * 2.0 - 1.0).max(0.0);
+    }
     let (p, yaw) = path(t);
     let cruise = Vec3::new(p.x, terrain.height(p).max(WATER) + 22.0, p.y);
     let view = script.view;
@@ -115,6 +136,9 @@ fn fly(
         cam.yaw = yaw + (end_yaw - yaw) * s;
         cam.pitch = -0.12 + (end_pitch + 0.12) * s;
         transform.translation = cruise.lerp(end, s);
+        if let Some(away) = gameplay.away(end) {
+            transform.translation = away;
+        }
         transform.rotation = cam.rotation();
     }
 }
@@ -179,6 +203,7 @@ fn stroke(
     camera: Query<&Transform, With<FlyCamera>>,
     terrain: Res<Terrain>,
     stats: Res<RwtStats>,
+    gameplay: Res<Play>,
 ) {
     let Ok(eye) = camera.single() else { return };
     let (ahead, radius, count) = match script.view {
@@ -216,7 +241,7 @@ fn stroke(
         }
         Stroke::Painting { baseline, .. } => Stroke::Done { baseline },
         Stroke::Done { baseline } => {
-            if let Some(now) = settled {
+            if let Some(now) = settled.filter(|_| counting(&gameplay)) {
                 report.painted = Some(now.abs_diff(baseline));
             }
             Stroke::Done { baseline }
@@ -234,13 +259,14 @@ fn stroke(
 
 /// Saves the painted world once the stroke is counted, and reports how it went.
 fn save_painting(
+    gameplay: Res<Play>,
     mut script: ResMut<Script>,
     mut brush: ResMut<DensityBrush>,
     mut report: ResMut<SmokeReport>,
     mut commands: MessageWriter<BrushCommand>,
 ) {
     match script.save {
-        Save::NotYet if report.painted.is_some() => {
+        Save::NotYet if report.painted.is_some() && gameplay.done() => {
             brush.last = None;
             commands.write(BrushCommand::Save(brush.save_dir.clone()));
             script.save = Save::Asked;

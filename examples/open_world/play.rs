@@ -1,0 +1,194 @@
+//! The scripted gameplay of the smoke session (the `eye` view): after the brush stroke, chop
+//! the three nearest trees (stumps stay), place a cabin ahead (on a tree when one stands
+//! there) whose footprint clears what grows under it, fly 3 km away (every layer's chunks
+//! there unload, the trees' at 2.8 km) and back along the end of the session's flight, then
+//! count what is still chopped or cleared:
+//! `rwt-smoke: gameplay chopped C cleared K persisted P`.
+
+use crate::gameplay::{Cabins, spawn_cabin, tree_layer, trees_only};
+use crate::layers::STUMP;
+use bevy::prelude::*;
+use bevy_rwt::prelude::*;
+use bevy_rwt::rwt_core::query::PointId;
+use glam::DVec2;
+use rwt_examples::prelude::*;
+use rwt_examples::terrain::Terrain;
+use std::collections::{HashMap, HashSet};
+
+/// How far the script flies away.
+const AWAY: f32 = 3_000.0;
+/// Frames of the return: the end of the session's flight, then its landing.
+const RETURN_FRAMES: u32 = 40;
+/// Radius around the cabin that holds everything its footprint can clear.
+const CABIN_REACH: f32 = 10.0;
+
+/// Where the scripted gameplay stands.
+#[derive(Resource, Default)]
+pub struct Play {
+    phase: Phase,
+    chopped: Vec<PointId>,
+    cleared: Vec<(Entity, PointId)>,
+    cabin: Vec2,
+    /// The frame the phase began.
+    since: u32,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum Phase {
+    #[default]
+    Waiting,
+    Away,
+    Back,
+    Reported,
+    /// Another view: no gameplay.
+    Skipped,
+}
+
+impl Play {
+    /// Whether the gameplay is over (reported or skipped).
+    pub fn done(&self) -> bool {
+        matches!(self.phase, Phase::Reported | Phase::Skipped)
+    }
+
+    /// Where the camera is while away, if it is.
+    pub fn away(&self, home: Vec3) -> Option<Vec3> {
+        (self.phase == Phase::Away).then(|| home + Vec3::X * AWAY)
+    }
+
+    /// While flying back from the trip: how far along the return, 0..1.
+    pub fn returning(&self, frame: u32) -> Option<f32> {
+        let f = frame.saturating_sub(self.since);
+        (self.phase == Phase::Back && f < RETURN_FRAMES).then(|| f as f32 / RETURN_FRAMES as f32)
+    }
+
+    /// Whether the gameplay began (what the session counted before it is final).
+    pub fn started(&self) -> bool {
+        self.phase != Phase::Waiting
+    }
+
+    /// Skips the gameplay (views other than `eye`).
+    pub fn skip(&mut self) {
+        self.phase = Phase::Skipped;
+    }
+}
+
+/// What the gameplay reads.
+#[derive(bevy::ecs::system::SystemParam)]
+pub struct Stage<'w, 's> {
+    smoke: Res<'w, Smoke>,
+    stats: Res<'w, RwtStats>,
+    terrain: Res<'w, Terrain>,
+    cabins: Res<'w, Cabins>,
+    layers: Query<'w, 's, (Entity, &'static Name), With<ScatterLayer>>,
+    instances: Query<'w, 's, &'static ScatterInstance>,
+    camera: Query<'w, 's, &'static Transform, With<FlyCamera>>,
+    picking: ScatterPicking<'w, 's>,
+}
+
+/// Runs the gameplay once the stroke is counted (`painted`), one phase a frame.
+pub fn play(
+    mut play: ResMut<Play>,
+    mut report: ResMut<SmokeReport>,
+    world: Stage,
+    mut edits: MessageWriter<EditInstance>,
+    mut commands: Commands,
+) {
+    let settled = world.stats.pending_tasks == 0 && world.stats.queued_spawns == 0;
+    let frame = world.smoke.frame;
+    let waited = frame.saturating_sub(play.since);
+    let next = match play.phase {
+        Phase::Waiting if report.painted.is_some() && settled => {
+            start(&mut play, &world, &mut edits, &mut commands);
+            Phase::Away
+        }
+        Phase::Away if waited > 10 && settled => Phase::Back,
+        Phase::Back if waited > RETURN_FRAMES + 10 && settled => {
+            let persisted = persisted(&play, &world);
+            eprintln!(
+                "rwt-smoke: gameplay chopped {} cleared {} persisted {persisted}",
+                play.chopped.len(),
+                play.cleared.len()
+            );
+            Phase::Reported
+        }
+        phase => phase,
+    };
+    if next != play.phase {
+        eprintln!("rwt-smoke: frame {frame}: gameplay {next:?}");
+        play.phase = next;
+        play.since = frame;
+    }
+    report.hold |= !play.done();
+}
+
+/// Places a cabin ahead (on a tree 12 to 40 m away in view, or 15 m ahead) and chops the
+/// three trees nearest to the camera that it does not clear.
+fn start(
+    play: &mut Play,
+    world: &Stage,
+    edits: &mut MessageWriter<EditInstance>,
+    commands: &mut Commands,
+) {
+    let (Ok(eye), Some(layer)) = (world.camera.single(), tree_layer(&world.layers)) else {
+        return;
+    };
+    let forward = eye.forward().xz().normalize_or(Vec2::Y);
+    let here = eye.translation.xz();
+    // Trees around, nearest first.
+    let trees = world.picking.near(here, 300.0, &trees_only(layer));
+    let in_view = |h: &&ScatterHit| {
+        let d = h.transform.translation.xz() - here;
+        (12.0..40.0).contains(&d.length()) && d.normalize_or_zero().dot(forward) > 0.9
+    };
+    let cabin = trees
+        .iter()
+        .find(in_view)
+        .map(|h| h.transform.translation.xz())
+        .unwrap_or(here + forward * 15.0);
+    let (transform, footprint) =
+        spawn_cabin(commands, &world.cabins, &world.terrain, cabin, -forward);
+    play.cabin = cabin;
+    let ground = footprint.on_ground(&GlobalTransform::from(transform), GroundPlane::Xz);
+    let clears = |h: &ScatterHit| {
+        let p = h.transform.translation;
+        ground.clears(DVec2::new(p.x as f64, p.z as f64), h.class)
+    };
+    play.cleared = world
+        .picking
+        .near(cabin, CABIN_REACH, &PickFilter::default())
+        .iter()
+        .filter(|h| clears(h))
+        .map(|h| (h.layer, h.id))
+        .collect();
+    for hit in trees.iter().filter(|h| !clears(h)).take(3) {
+        edits.write(EditInstance::reclass(hit.layer, hit.id, STUMP));
+        play.chopped.push(hit.id);
+    }
+}
+
+/// The chopped trees that are stumps and the cleared instances that are gone, now.
+fn persisted(play: &Play, world: &Stage) -> usize {
+    let live: HashMap<(Entity, PointId), u16> = world
+        .instances
+        .iter()
+        .map(|i| ((i.layer, i.id), i.class))
+        .collect();
+    let layer = tree_layer(&world.layers);
+    let stumps = play
+        .chopped
+        .iter()
+        .filter(|id| layer.and_then(|l| live.get(&(l, **id))) == Some(&STUMP))
+        .count();
+    let shown: HashSet<(Entity, PointId)> = world
+        .picking
+        .near(play.cabin, CABIN_REACH, &PickFilter::default())
+        .iter()
+        .map(|h| (h.layer, h.id))
+        .collect();
+    let gone = play
+        .cleared
+        .iter()
+        .filter(|key| !live.contains_key(key) && !shown.contains(key))
+        .count();
+    stumps + gone
+}
