@@ -1,7 +1,7 @@
 //! Acting on the world: a left click (brush off) chops the tree under the cursor, leaving a
-//! stump; C places a cabin 14 m ahead whose footprint clears trees, rocks, bushes, grass and
-//! flowers under it. Both persist (edits, and a footprint on an entity) and the brush's F5
-//! saves the edits with the painted maps.
+//! stump; H places a cabin (a house) 14 m ahead whose footprint clears trees, rocks, bushes,
+//! grass and flowers under it. Both persist (edits, and a footprint on an entity) and the
+//! brush's F5 saves the edits with the painted maps.
 
 use crate::layers::{STUMP, TREE_SPECIES};
 use bevy::prelude::*;
@@ -11,7 +11,7 @@ use rwt_examples::foliage;
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::Terrain;
 
-/// Click to chop, C for a cabin.
+/// Click to chop, H for a cabin.
 pub struct GameplayPlugin;
 
 impl Plugin for GameplayPlugin {
@@ -86,7 +86,7 @@ fn chop_on_click(
     }
 }
 
-/// C: a cabin 14 m ahead of the camera, facing it.
+/// H: a cabin 14 m ahead of the camera, facing it (C is the fly camera's down key).
 fn place_cabin_on_key(
     keys: Res<ButtonInput<KeyCode>>,
     camera: Query<&Transform, With<FlyCamera>>,
@@ -94,7 +94,7 @@ fn place_cabin_on_key(
     cabins: Res<Cabins>,
     mut commands: Commands,
 ) {
-    if !keys.just_pressed(KeyCode::KeyC) {
+    if !keys.just_pressed(KeyCode::KeyH) {
         return;
     }
     let Ok(eye) = camera.single() else { return };

@@ -11,7 +11,7 @@
 //!   strength, 1-4 choose the map, Z undoes, F5 saves the maps and the flower and bush
 //!   layer files to `painted/` (or `RWT_PAINT_DIR`), F9 loads the maps;
 //! - V toggles the wind, F the fade-in (see the popping it hides), G chunk outlines;
-//! - with the brush off, a left click chops the tree under the cursor (a stump stays), C
+//! - with the brush off, a left click chops the tree under the cursor (a stump stays), H
 //!   places a cabin that clears the ground under it; F5 saves these edits with the maps.
 
 mod gameplay;
@@ -241,7 +241,7 @@ fn hud(
         })
         .collect();
     hud.lines = vec![
-        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | click chops a tree, C cabin | V wind, F fade-in, G chunks".into(),
+        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | click chops a tree, H cabin | V wind, F fade-in, G chunks".into(),
         format!(
             "position {:.0}, {:.0} m, altitude {:.0} m, speed {:.0} m/s",
             t.translation.x, t.translation.z, t.translation.y, cam.speed
