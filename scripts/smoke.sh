@@ -5,7 +5,8 @@
 # (entities and instanced together), or open_world has fewer than a million instanced blades
 # or its scripted brush stroke changed no instance (`painted 0`) or its brush did not save
 # the painted maps and layer files, or (its `eye` view) the trees it chopped and the ground
-# its cabin cleared did not persist through a flight 3 km away and back.
+# its cabin cleared did not persist through a flight 3 km away and back, or its walker on
+# foot did not stop at a tree's trunk.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -83,6 +84,13 @@ for run in "${runs[@]}"; do
             read -r c k p < <(sed -nE 's/.*chopped ([0-9]+) cleared ([0-9]+) persisted ([0-9]+)$/\1 \2 \3/p' <<<"$play")
             if [ -z "${c:-}" ] || [ "$c" -eq 0 ] || [ "$k" -eq 0 ] || [ "$p" -ne $((c + k)) ]; then
                 echo "FAIL $name: chopped and cleared instances did not all persist"; failed=1
+            fi
+            # On foot, into a trunk: the capsule stops at it.
+            walked=$(grep -E '^rwt-smoke: walked into a trunk' "$out/$name.log" || true)
+            echo "${walked:-FAIL $name: no walk line}"
+            read -r closest contact < <(sed -nE 's/.*closest ([0-9.]+) m from its axis, collision at ([0-9.]+) m$/\1 \2/p' <<<"$walked")
+            if [ -z "${closest:-}" ] || ! python3 -c "import sys; sys.exit(0 if $closest >= $contact - 0.05 and $closest < $contact + 1.0 else 1)"; then
+                echo "FAIL $name: the walker did not stop at the trunk"; failed=1
             fi
         fi
         grep -E '^rwt-smoke: brush' "$out/$name.log" || true

@@ -12,12 +12,14 @@
 //!   layer files to `painted/` (or `RWT_PAINT_DIR`), F9 loads the maps;
 //! - V toggles the wind, F the fade-in (see the popping it hides), G chunk outlines;
 //! - with the brush off, a left click chops the tree under the cursor (a stump stays), H
-//!   places a cabin that clears the ground under it; F5 saves these edits with the maps.
+//!   places a cabin that clears the ground under it; F5 saves these edits with the maps;
+//! - K walks on foot (a capsule that trunks, stumps and rocks stop; avian3d), K again flies.
 
 mod gameplay;
 mod layers;
 mod play;
 mod script;
+mod walk;
 
 use bevy::light::CascadeShadowConfigBuilder;
 use bevy::pbr::{DistanceFog, FogFalloff};
@@ -46,6 +48,7 @@ fn main() {
             RwtGizmosPlugin,
             RwtBrushPlugin,
             gameplay::GameplayPlugin,
+            walk::WalkPlugin,
             script::ScriptPlugin,
         ))
         .add_systems(Startup, (setup_scene, layers::setup_layers))
@@ -241,7 +244,7 @@ fn hud(
         })
         .collect();
     hud.lines = vec![
-        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | click chops a tree, H cabin | V wind, F fade-in, G chunks".into(),
+        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | click chops a tree, H cabin, K walk | V wind, F fade-in, G chunks".into(),
         format!(
             "position {:.0}, {:.0} m, altitude {:.0} m, speed {:.0} m/s",
             t.translation.x, t.translation.z, t.translation.y, cam.speed

@@ -3,10 +3,13 @@
 //! there) whose footprint clears what grows under it, fly 3 km away (every layer's chunks
 //! there unload, the trees' at 2.8 km) and back along the end of the session's flight, then
 //! count what is still chopped or cleared:
-//! `rwt-smoke: gameplay chopped C cleared K persisted P`.
+//! `rwt-smoke: gameplay chopped C cleared K persisted P`. Then a walker on foot
+//! ([`crate::walk`]) heads straight for a tree's trunk and must stop at it:
+//! `rwt-smoke: walked into a trunk: closest D m from its axis, collision at R m`.
 
 use crate::gameplay::{Cabins, spawn_cabin, tree_layer, trees_only};
 use crate::layers::STUMP;
+use crate::walk::{RADIUS as WALKER_RADIUS, TRUNK_RADIUS, Walker, spawn_walker};
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
@@ -31,6 +34,9 @@ pub struct Play {
     cabin: Vec2,
     /// The frame the phase began.
     since: u32,
+    /// The walk into a trunk: the walker, the trunk's axis, the collision distance and the
+    /// closest the walker came.
+    walk: Option<(Entity, Vec2, f32, f32)>,
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -39,6 +45,8 @@ enum Phase {
     Waiting,
     Away,
     Back,
+    /// On foot, walking into a trunk.
+    Walking,
     Reported,
     /// Another view: no gameplay.
     Skipped,
@@ -82,6 +90,7 @@ pub struct Stage<'w, 's> {
     layers: Query<'w, 's, (Entity, &'static Name), With<ScatterLayer>>,
     instances: Query<'w, 's, &'static ScatterInstance>,
     camera: Query<'w, 's, &'static Transform, With<FlyCamera>>,
+    walkers: Query<'w, 's, &'static Transform, (With<Walker>, Without<FlyCamera>)>,
     picking: ScatterPicking<'w, 's>,
 }
 
@@ -96,7 +105,8 @@ pub fn play(
     let settled = world.stats.pending_tasks == 0 && world.stats.queued_spawns == 0;
     let frame = world.smoke.frame;
     let waited = frame.saturating_sub(play.since);
-    let next = match play.phase {
+    let phase = play.phase;
+    let next = match phase {
         Phase::Waiting if report.painted.is_some() && settled => {
             start(&mut play, &world, &mut edits, &mut commands);
             Phase::Away
@@ -109,6 +119,11 @@ pub fn play(
                 play.chopped.len(),
                 play.cleared.len()
             );
+            play.walk = start_walk(&world, &mut commands);
+            Phase::Walking
+        }
+        Phase::Walking if follow_walk(&mut play, &world, waited) => {
+            finish_walk(&play, &mut commands);
             Phase::Reported
         }
         phase => phase,
@@ -191,4 +206,47 @@ fn persisted(play: &Play, world: &Stage) -> usize {
         .filter(|key| !live.contains_key(key) && !shown.contains(key))
         .count();
     stumps + gone
+}
+
+/// Frames of the walk into a trunk.
+const WALK_FRAMES: u32 = 45;
+
+/// A walker 3 m from the nearest tree, heading for its axis.
+fn start_walk(world: &Stage, commands: &mut Commands) -> Option<(Entity, Vec2, f32, f32)> {
+    let eye = world.camera.single().ok()?;
+    let layer = tree_layer(&world.layers)?;
+    let trees = world
+        .picking
+        .near(eye.translation.xz(), 200.0, &trees_only(layer));
+    let tree = trees.first()?;
+    let axis = tree.transform.translation.xz();
+    let from = axis + Vec2::new(3.0, 0.0);
+    let walker = spawn_walker(commands, &world.terrain, from, true);
+    commands.entity(walker).insert(Walker {
+        intent: (axis - from).normalize() * 4.0,
+        scripted: true,
+    });
+    let contact = TRUNK_RADIUS * tree.transform.scale.x + WALKER_RADIUS;
+    Some((walker, axis, contact, f32::INFINITY))
+}
+
+/// Tracks the closest the walker came to the trunk's axis; returns whether the walk is over.
+fn follow_walk(play: &mut Play, world: &Stage, waited: u32) -> bool {
+    let Some((walker, axis, _, closest)) = play.walk.as_mut() else {
+        return true;
+    };
+    if let Ok(at) = world.walkers.get(*walker) {
+        *closest = closest.min(at.translation.xz().distance(*axis));
+    }
+    waited >= WALK_FRAMES
+}
+
+/// Reports the walk and goes back to flying.
+fn finish_walk(play: &Play, commands: &mut Commands) {
+    if let Some((walker, _, contact, closest)) = play.walk {
+        eprintln!(
+            "rwt-smoke: walked into a trunk: closest {closest:.2} m from its axis, collision at {contact:.2} m"
+        );
+        commands.entity(walker).despawn();
+    }
 }

@@ -1,0 +1,178 @@
+//! Walking on foot (K toggles): a capsule on the terrain that avian's move-and-slide keeps
+//! out of tree trunks, stumps and rocks; the camera rides at eye height and looks with the
+//! mouse as the fly camera does. Trunks and rocks get static colliders as `bevy_rwt`
+//! spawns them (an observer on `ScatterInstance`): the plugin knows nothing of physics.
+
+use crate::layers::{STUMP, TREE_SPECIES};
+use avian3d::prelude::*;
+use bevy::prelude::*;
+use bevy::transform::TransformSystems;
+use bevy_rwt::prelude::*;
+use rwt_examples::prelude::*;
+use rwt_examples::terrain::{Terrain, WATER};
+
+/// Capsule radius and the length of its straight part.
+pub const RADIUS: f32 = 0.35;
+/// Radius of a trunk's collider at scale 1.
+pub const TRUNK_RADIUS: f32 = 0.32;
+const LENGTH: f32 = 1.0;
+/// Eye height above the ground.
+const EYE: f32 = 1.65;
+
+/// Physics, colliders for trunks and rocks, and the walker.
+pub struct WalkPlugin;
+
+impl Plugin for WalkPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_plugins(PhysicsPlugins::default())
+            .add_observer(add_colliders)
+            .add_systems(Update, toggle_walk)
+            .add_systems(
+                PostUpdate,
+                (steer, walk).chain().before(TransformSystems::Propagate),
+            );
+    }
+}
+
+/// The player on foot.
+#[derive(Component, Default)]
+pub struct Walker {
+    /// Where it wants to go, on the ground (x, z), in metres per second.
+    pub intent: Vec2,
+    /// Whether a script steers it (the keys do otherwise, and the camera rides it).
+    pub scripted: bool,
+}
+
+/// The collider of a trunk, stump or rock at scale 1 (`None` for what one walks through).
+fn collider_of(layer: &str, class: u16) -> Option<Collider> {
+    match layer {
+        "trees" if TREE_SPECIES.contains(&class) => Some(Collider::cylinder(TRUNK_RADIUS, 10.0)),
+        "trees" if class == STUMP => Some(Collider::cylinder(0.36, 1.4)),
+        "rocks" => Some(Collider::sphere(0.9)),
+        _ => None,
+    }
+}
+
+fn add_colliders(
+    add: On<Add, ScatterInstance>,
+    instances: Query<&ScatterInstance>,
+    names: Query<&Name>,
+    mut commands: Commands,
+) {
+    let Ok(i) = instances.get(add.entity) else {
+        return;
+    };
+    let Some(collider) = names
+        .get(i.layer)
+        .ok()
+        .and_then(|n| collider_of(n.as_str(), i.class))
+    else {
+        return;
+    };
+    commands
+        .entity(add.entity)
+        .insert((RigidBody::Static, collider));
+}
+
+/// K: on foot where the camera is, or back to flying.
+fn toggle_walk(
+    keys: Res<ButtonInput<KeyCode>>,
+    walkers: Query<Entity, With<Walker>>,
+    camera: Query<&Transform, With<FlyCamera>>,
+    terrain: Res<Terrain>,
+    mut commands: Commands,
+) {
+    if !keys.just_pressed(KeyCode::KeyK) {
+        return;
+    }
+    match walkers.single() {
+        Ok(walker) => commands.entity(walker).despawn(),
+        Err(_) => {
+            if let Ok(eye) = camera.single() {
+                spawn_walker(&mut commands, &terrain, eye.translation.xz(), false);
+            }
+        }
+    }
+}
+
+/// A walker standing at ground position `at`.
+pub fn spawn_walker(
+    commands: &mut Commands,
+    terrain: &Terrain,
+    at: Vec2,
+    scripted: bool,
+) -> Entity {
+    let centre = Vec3::new(at.x, ground(terrain, at) + RADIUS + LENGTH / 2.0, at.y);
+    commands
+        .spawn((
+            Walker {
+                intent: Vec2::ZERO,
+                scripted,
+            },
+            Transform::from_translation(centre),
+            RigidBody::Kinematic,
+            Collider::capsule(RADIUS, LENGTH),
+        ))
+        .id()
+}
+
+fn ground(terrain: &Terrain, at: Vec2) -> f32 {
+    terrain.height(at).max(WATER)
+}
+
+/// WASD in the camera's heading, 4 m/s (Shift 9).
+fn steer(
+    keys: Res<ButtonInput<KeyCode>>,
+    camera: Query<&FlyCamera>,
+    mut walkers: Query<&mut Walker>,
+) {
+    let Ok(cam) = camera.single() else { return };
+    for mut walker in walkers.iter_mut().filter(|w| !w.scripted) {
+        let key = |k: KeyCode| keys.pressed(k) as i32 as f32;
+        let ahead = key(KeyCode::KeyW) - key(KeyCode::KeyS);
+        let right = key(KeyCode::KeyD) - key(KeyCode::KeyA);
+        let (s, c) = cam.yaw.sin_cos();
+        // The fly camera looks along -z turned by its yaw.
+        let forward = Vec2::new(-s, -c);
+        let side = Vec2::new(c, -s);
+        let speed = if keys.pressed(KeyCode::ShiftLeft) {
+            9.0
+        } else {
+            4.0
+        };
+        walker.intent = (forward * ahead + side * right).normalize_or_zero() * speed;
+    }
+}
+
+/// Moves the walker by its intent, sliding along what it touches, on the ground; the camera
+/// follows a walker the keys steer, at eye height.
+fn walk(
+    time: Res<Time>,
+    terrain: Res<Terrain>,
+    move_and_slide: MoveAndSlide,
+    mut walkers: Query<(Entity, &mut Transform, &Collider, &Walker)>,
+    mut camera: Query<&mut Transform, (With<FlyCamera>, Without<Walker>)>,
+) {
+    for (entity, mut transform, collider, walker) in &mut walkers {
+        let velocity = Vec3::new(walker.intent.x, 0.0, walker.intent.y);
+        let moved = move_and_slide.move_and_slide(
+            collider,
+            transform.translation,
+            transform.rotation,
+            velocity,
+            time.delta(),
+            &MoveAndSlideConfig::default(),
+            &SpatialQueryFilter::from_excluded_entities([entity]),
+            |_| MoveAndSlideHitResponse::Accept,
+        );
+        let at = moved.position.xz();
+        let feet = ground(&terrain, at);
+        transform.translation = Vec3::new(at.x, feet + RADIUS + LENGTH / 2.0, at.y);
+        if walker.scripted {
+            continue;
+        }
+        for mut eye in &mut camera {
+            eye.translation = Vec3::new(at.x, feet + EYE, at.y);
+        }
+    }
+}
