@@ -150,10 +150,17 @@ impl ScatterEdits {
 
     /// Applies one edit to the set.
     pub(crate) fn apply(&mut self, id: PointId, edit: InstanceEdit) {
-        match edit {
-            InstanceEdit::Remove => self.0.set(id, Edit::Remove),
-            InstanceEdit::Reclass(class) => self.0.set(id, Edit::Reclass(class)),
-            InstanceEdit::Restore => self.0.restore(&id),
+        edit.apply_to(&mut self.0, id);
+    }
+}
+
+impl InstanceEdit {
+    /// Applies this edit of point `id` to `set` (a layer's, or one chunk's share of it).
+    pub(crate) fn apply_to(self, set: &mut EditSet, id: PointId) {
+        match self {
+            InstanceEdit::Remove => set.set(id, Edit::Remove),
+            InstanceEdit::Reclass(class) => set.set(id, Edit::Reclass(class)),
+            InstanceEdit::Restore => set.restore(&id),
         };
     }
 }

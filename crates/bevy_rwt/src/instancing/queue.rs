@@ -229,18 +229,22 @@ impl<'a> Upload<'a> {
         slot: Option<ClassBuffer>,
         packed: PackedClass,
     ) -> Option<(u16, ClassBuffer)> {
-        let (mut entity, mut promoted) =
+        let (entity, mut promoted) =
             slot.map_or((None, HashMap::new()), |s| (s.entity, s.promoted));
-        let kept: std::collections::HashSet<&PointId> = packed.buffer.ids.iter().collect();
-        promoted.retain(|id, e| {
-            let keep = kept.contains(id);
-            if !keep {
-                commands.entity(*e).try_despawn();
-            }
-            keep
-        });
+        // Promoted instances that are no longer in the buffer go (only promoted classes
+        // have any).
+        if !promoted.is_empty() {
+            let kept: std::collections::HashSet<&PointId> = packed.buffer.ids.iter().collect();
+            promoted.retain(|id, e| {
+                let keep = kept.contains(id);
+                if !keep {
+                    commands.entity(*e).try_despawn();
+                }
+                keep
+            });
+        }
         let mut class = ClassBuffer {
-            entity: entity.take(),
+            entity,
             whole: packed.buffer,
             promoted,
         };

@@ -97,11 +97,10 @@ fn apply_edit(
     };
     edits.apply(id, message.edit);
     let chunk = ChunkCoord::containing(position, layer.streaming.chunk_size);
-    let chunk_set = Arc::make_mut(state.chunk_edits.entry(chunk).or_default());
-    match edits.get(&id) {
-        Some(edit) => chunk_set.set(id, edit),
-        None => chunk_set.restore(&id),
-    };
+    message.edit.apply_to(
+        Arc::make_mut(state.chunk_edits.entry(chunk).or_default()),
+        id,
+    );
     let entity_class =
         class.filter(|c| !matches!(layer.classes[*c as usize].look, ClassLook::Instanced(_)));
     let shown = match (message.edit, entity_class, state.sources.height()) {

@@ -14,7 +14,35 @@ use rwt_core::Rect;
 
 /// Every footprint as last seen, placed by its transform at the time.
 #[derive(Resource, Default)]
-pub(crate) struct KnownFootprints(HashMap<Entity, (Footprint, GlobalTransform)>);
+pub(crate) struct KnownFootprints(HashMap<Entity, Known>);
+
+/// A footprint and its transform, and where it lies on each ground plane (made once, when
+/// it is seen, for every generation task that reads it).
+#[derive(Clone)]
+struct Known {
+    footprint: Footprint,
+    transform: GlobalTransform,
+    xz: GroundFootprint,
+    xy: GroundFootprint,
+}
+
+impl Known {
+    fn new(footprint: Footprint, transform: GlobalTransform) -> Self {
+        Self {
+            xz: footprint.on_ground(&transform, GroundPlane::Xz),
+            xy: footprint.on_ground(&transform, GroundPlane::Xy),
+            footprint,
+            transform,
+        }
+    }
+
+    fn on(&self, plane: GroundPlane) -> &GroundFootprint {
+        match plane {
+            GroundPlane::Xz => &self.xz,
+            GroundPlane::Xy => &self.xy,
+        }
+    }
+}
 
 impl KnownFootprints {
     /// The footprints that clear points of `layer` on `plane` in `region`.
@@ -26,9 +54,10 @@ impl KnownFootprints {
     ) -> Vec<GroundFootprint> {
         self.0
             .values()
-            .filter(|(f, _)| f.clears_layer(layer))
-            .map(|(f, t)| f.on_ground(t, plane))
+            .filter(|k| k.footprint.clears_layer(layer))
+            .map(|k| k.on(plane))
             .filter(|g| g.bounds().is_some_and(|b| overlaps(&b, region)))
+            .cloned()
             .collect()
     }
 }
@@ -59,12 +88,12 @@ pub(super) fn track_footprints(
         ) else {
             continue;
         };
-        let now = (footprint.clone(), transform);
-        match known.0.insert(entity, now.clone()) {
-            Some(before) if before == now => continue,
-            Some(before) => touched.push(before),
-            None => {}
+        let was = known.0.get(&entity);
+        if was.is_some_and(|k| k.footprint == *footprint && k.transform == transform) {
+            continue;
         }
+        let now = Known::new(footprint.clone(), transform);
+        touched.extend(known.0.insert(entity, now.clone()));
         touched.push(now);
     }
     for entity in removed.read() {
@@ -75,8 +104,8 @@ pub(super) fn track_footprints(
     }
     for (entity, layer, mut state) in &mut layers {
         let size = layer.streaming.chunk_size;
-        for (footprint, transform) in touched.iter().filter(|(f, _)| f.clears_layer(entity)) {
-            if let Some(bounds) = footprint.on_ground(transform, layer.plane).bounds() {
+        for k in touched.iter().filter(|k| k.footprint.clears_layer(entity)) {
+            if let Some(bounds) = k.on(layer.plane).bounds() {
                 state.mark_stale(size, &widen(&bounds));
             }
         }
