@@ -10,18 +10,29 @@
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
-#                                    # open_world's four views (RWT_VIEW=eye|forest|aerial|brush)
+#                                    # open_world's five views (RWT_VIEW=eye|forest|aerial|brush|
+#                                    # clearing, the eye view's gameplay seen from above)
+#   scripts/smoke.sh --docs open_world:clearing   # only the runs named
 set -euo pipefail
 cd "$(dirname "$0")/.."
 docs=0
-[ "${1:-}" = "--docs" ] && docs=1
+[ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
 examples=(quickstart open_world paint_density stipple_zoom)
+runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    cargo build --release --examples
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom)
+fi
+[ $# -gt 0 ] && runs=("$@")
+# The examples the runs need, once each.
+mapfile -t needed < <(printf '%s\n' "${runs[@]%%:*}" | sort -u)
+build=()
+for ex in "${needed[@]}"; do build+=(--example "$ex"); done
+if [ $docs = 1 ]; then
+    cargo build --release "${build[@]}"
     bin=target/release/examples
 else
-    cargo build --examples
+    cargo build "${build[@]}"
     bin=target/debug/examples
 fi
 out=target/smoke
@@ -35,11 +46,6 @@ sleep 2
 icd=$(ls /usr/share/vulkan/icd.d/lvp_icd*.json | head -1)
 export VK_ICD_FILENAMES=$icd VK_DRIVER_FILES=$icd WGPU_BACKEND=vulkan
 export BEVY_ASSET_ROOT=$PWD RUST_LOG=${RUST_LOG:-warn} RWT_PAINT_DIR=$PWD/$out/painted
-
-runs=("${examples[@]}")
-if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush paint_density stipple_zoom)
-fi
 
 failed=0
 for run in "${runs[@]}"; do
@@ -76,7 +82,7 @@ for run in "${runs[@]}"; do
         if [ "${painted:-0}" -eq 0 ]; then
             echo "FAIL $name: the scripted brush stroke changed no instance"; failed=1
         fi
-        if [ -z "$view" ] || [ "$view" = eye ]; then
+        if [ -z "$view" ] || [ "$view" = eye ] || [ "$view" = clearing ]; then
             # The scripted gameplay: trees chopped, a cabin's footprint cleared, all still so
             # after flying 3 km away and back.
             play=$(grep -E '^rwt-smoke: gameplay chopped' "$out/$name.log" || true)

@@ -74,7 +74,21 @@ impl Play {
         self.phase != Phase::Waiting
     }
 
-    /// Skips the gameplay (views other than `eye`).
+    /// Frames since the gameplay was reported (0 before).
+    pub fn frames_done(&self, frame: u32) -> u32 {
+        if self.phase == Phase::Reported {
+            frame.saturating_sub(self.since)
+        } else {
+            0
+        }
+    }
+
+    /// Where the cabin stands, once placed.
+    pub fn cabin(&self) -> Option<Vec2> {
+        self.started().then_some(self.cabin)
+    }
+
+    /// Skips the gameplay (views other than `eye` and `clearing`).
     pub fn skip(&mut self) {
         self.phase = Phase::Skipped;
     }

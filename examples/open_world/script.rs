@@ -2,8 +2,9 @@
 //! screenshot shows (`RWT_VIEW`: `eye` in the grass, the default; `forest` at a forest
 //! edge; `aerial` to the horizon; `brush` painting from above), and one brush stroke of red
 //! flowers, whose added instances the smoke line reports; in the `eye` view the gameplay of
-//! [`crate::play`] (chop, cabin, away and back); then the brush saves the painted world
-//! (maps, layer files and edits) to `RWT_PAINT_DIR`.
+//! [`crate::play`] (chop, cabin, away and back; `clearing` plays it too, then looks down at
+//! the cabin's clearing from above); then the brush saves the painted world (maps, layer
+//! files and edits) to `RWT_PAINT_DIR`.
 
 use crate::layers::{FORESTS, forest};
 use crate::play::{Play, play};
@@ -25,7 +26,7 @@ impl Plugin for ScriptPlugin {
     fn build(&self, app: &mut App) {
         let script = Script::from_env();
         let mut gameplay = Play::default();
-        if script.view != View::Eye {
+        if !matches!(script.view, View::Eye | View::Clearing) {
             gameplay.skip();
         }
         app.insert_resource(script)
@@ -33,7 +34,7 @@ impl Plugin for ScriptPlugin {
             .configure_sets(Update, ScriptSystems.after(BrushSystems))
             .add_systems(
                 Update,
-                (fly, stroke, play, save_painting)
+                (fly, stroke, play, save_painting, overlook)
                     .chain()
                     .in_set(ScriptSystems)
                     .run_if(|s: Res<Smoke>| s.active()),
@@ -45,6 +46,8 @@ impl Plugin for ScriptPlugin {
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum View {
     Eye,
+    /// The eye view's gameplay, then the cabin's clearing from above.
+    Clearing,
     Forest,
     Aerial,
     Brush,
@@ -88,6 +91,7 @@ impl Script {
             Ok("forest") => View::Forest,
             Ok("aerial") => View::Aerial,
             Ok("brush") => View::Brush,
+            Ok("clearing") => View::Clearing,
             _ => View::Eye,
         };
         Self {
@@ -143,11 +147,48 @@ fn fly(
     }
 }
 
+/// How far back from the cabin, and how high above its ground, the `clearing` view looks.
+const OVERLOOK: (f32, f32) = (17.0, 11.0);
+/// Frames the `clearing` view holds the screenshot after moving, for streaming to follow.
+const OVERLOOK_FRAMES: u32 = 30;
+
+/// The `clearing` view, once the gameplay is over: above and behind where the eye stood,
+/// looking down at the cabin, its clearing and the stumps.
+fn overlook(
+    smoke: Res<Smoke>,
+    terrain: Res<Terrain>,
+    gameplay: Res<Play>,
+    script: Res<Script>,
+    mut report: ResMut<SmokeReport>,
+    mut camera: Query<(&mut FlyCamera, &mut Transform)>,
+) {
+    let (View::Clearing, Some(cabin), Some((eye, ..))) =
+        (script.view, gameplay.cabin(), script.end)
+    else {
+        return;
+    };
+    if !gameplay.done() {
+        return;
+    }
+    let back = (eye.xz() - cabin).normalize_or(Vec2::Y);
+    let at = cabin + back * OVERLOOK.0;
+    let ground = terrain.height(cabin);
+    let from = Vec3::new(at.x, ground.max(WATER) + OVERLOOK.1, at.y);
+    let look = (Vec3::new(cabin.x, ground + 1.5, cabin.y) - from).normalize();
+    for (mut cam, mut transform) in &mut camera {
+        cam.yaw = (-look.x).atan2(-look.z);
+        cam.pitch = look.y.asin();
+        transform.translation = from;
+        transform.rotation = cam.rotation();
+    }
+    report.hold |= gameplay.frames_done(smoke.frame) < OVERLOOK_FRAMES;
+}
+
 /// Where each view ends, from the end of the flight at `(p, yaw)`.
 fn end_pose(view: View, terrain: &Terrain, (p, yaw): (Vec2, f32)) -> (Vec3, f32, f32) {
     let ground = |p: Vec2| terrain.height(p).max(WATER);
     match view {
-        View::Eye => (Vec3::new(p.x, ground(p) + 1.5, p.y), yaw, -0.1),
+        View::Eye | View::Clearing => (Vec3::new(p.x, ground(p) + 1.5, p.y), yaw, -0.1),
         View::Aerial => (Vec3::new(p.x, ground(p) + 230.0, p.y), yaw, -0.16),
         View::Brush => (Vec3::new(p.x, ground(p) + 16.0, p.y), yaw, -0.62),
         View::Forest => {
