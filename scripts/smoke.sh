@@ -6,7 +6,8 @@
 # or its scripted brush stroke changed no instance (`painted 0`) or its brush did not save
 # the painted maps and layer files, or (its `eye` view) the trees it chopped and the ground
 # its cabin cleared did not persist through a flight 3 km away and back, or its walker on
-# foot did not stop at a tree's trunk.
+# foot did not stop at a tree's trunk; and runs instanced_passes, which fails unless
+# instanced grass receives and casts shadows and is drawn with the prepasses and SSAO.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -18,10 +19,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom)
+examples=(quickstart open_world paint_density stipple_zoom instanced_passes)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom instanced_passes)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -55,6 +56,17 @@ for run in "${runs[@]}"; do
     png=$out/$name.png
     rm -f "$png"
     start=$(date +%s)
+    if [ "$ex" = instanced_passes ]; then
+        # Its own screenshots, compared region by region: grass receives and casts
+        # shadows, and is drawn with the prepasses and SSAO.
+        RWT_PASSES_DIR=$out/passes timeout 1200 "$bin/$ex" >"$out/$name.log" 2>&1 || true
+        line=$(grep -E '^rwt-passes: receive' "$out/$name.log" || true)
+        echo "$name: ${line:-no result line}, $(( $(date +%s) - start )) s"
+        if [ -z "$line" ] || grep -qE '^rwt-passes: FAIL|ERROR' "$out/$name.log"; then
+            echo "FAIL $name"; grep -E 'FAIL|ERROR' -A6 "$out/$name.log" | head -30; failed=1
+        fi
+        continue
+    fi
     if ! RWT_VIEW=$view RWT_SCREENSHOT=$png timeout 1200 "$bin/$ex" >"$out/$name.log" 2>&1; then
         echo "FAIL $name: exited with an error"; tail -20 "$out/$name.log"; failed=1; continue
     fi

@@ -12,6 +12,8 @@ use rwt_examples::terrain::{Terrain, WATER};
 
 /// The painted maps: `MAP_TEXELS` a side over `MAP_SIZE` metres centred on the origin.
 const MAP_TEXELS: u32 = 2048;
+/// Grass and flowers cast shadows this close to the camera (metres).
+const GRASS_SHADOWS: f32 = 25.0;
 const MAP_SIZE: f32 = 4096.0;
 
 /// Flower colours (petals), one painted map and instanced class each.
@@ -231,6 +233,8 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
         InstancedMaterial {
             base_color: Color::srgb(0.05, 0.13, 0.025),
             tip_color: Color::srgb(0.33, 0.47, 0.12),
+            // Blades cast near the player only: far grass costs nothing in shadow passes.
+            shadows: InstancedShadows::Within(GRASS_SHADOWS),
             ..default()
         },
     );
@@ -273,6 +277,7 @@ fn flowers(
                     color_variation: 0.15,
                     wind_response: 0.2,
                     tip_from: 0.86,
+                    shadows: InstancedShadows::Within(GRASS_SHADOWS),
                     ..default()
                 },
             );

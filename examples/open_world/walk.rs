@@ -1,5 +1,5 @@
 //! Walking on foot (K toggles): a capsule on the terrain that avian's move-and-slide keeps
-//! out of tree trunks, stumps and rocks; the camera rides at eye height and looks with the
+//! out of tree trunks, stumps and rocks, and that grass parts around (a `Bender`); the camera rides at eye height and looks with the
 //! mouse as the fly camera does. Trunks and rocks get static colliders as `bevy_rwt`
 //! spawns them (an observer on `ScatterInstance`): the plugin knows nothing of physics.
 
@@ -112,6 +112,11 @@ pub fn spawn_walker(
             Transform::from_translation(centre),
             RigidBody::Kinematic,
             Collider::capsule(RADIUS, LENGTH),
+            // Grass and flowers part around the walker and stand up behind it.
+            Bender {
+                radius: 0.8,
+                strength: 1.0,
+            },
         ))
         .id()
 }

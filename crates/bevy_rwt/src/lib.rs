@@ -162,13 +162,14 @@ pub mod viewers;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 pub use diagnostics::RwtStats;
-pub use instancing::{InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind};
+pub use instancing::{Bender, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind};
 pub use layers::{
     AssetStatus, HeightSource, LayerDensity, Promotion, ScatterClass, ScatterInstance,
     ScatterLayer, ScatterLayerStatus,
 };
 pub use look::{
-    ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, MeshLod, Pose,
+    ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, InstancedShadows,
+    MeshLod, Pose,
 };
 pub use rwt_core;
 use rwt_core::tileset::TileSet;
@@ -189,10 +190,10 @@ pub mod prelude {
     pub use crate::layers::file::{NamedAssets, ScatterLayerAsset, ScatterLayerSource};
     pub use crate::picking::{PickFilter, ScatterHit, ScatterPicking};
     pub use crate::{
-        AssetStatus, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
-        HeightSource, InstancedChunk, InstancedMaterial, LayerDensity, RwtFadeIn, RwtPlugin,
-        RwtSettings, RwtStats, RwtSystems, RwtViewer, RwtWind, ScatterClass, ScatterInstance,
-        ScatterLayer, ScatterLayerStatus, ViewCone,
+        AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
+        HeightSource, InstancedChunk, InstancedMaterial, InstancedShadows, LayerDensity, RwtFadeIn,
+        RwtPlugin, RwtSettings, RwtStats, RwtSystems, RwtViewer, RwtWind, ScatterClass,
+        ScatterInstance, ScatterLayer, ScatterLayerStatus, ViewCone,
     };
     pub use rwt_core::streaming::{Falloff, StreamingConfig};
 }

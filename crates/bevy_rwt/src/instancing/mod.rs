@@ -13,6 +13,7 @@
 //! layer with a [`Falloff`](rwt_core::streaming::Falloff) neither pops when chunks change
 //! band nor at the streaming edge.
 
+mod bend;
 mod mesh;
 mod pack;
 mod plugin;
@@ -20,6 +21,7 @@ mod promote;
 mod queue;
 mod render;
 
+pub use bend::{BEND_FIELD_TEXELS, BEND_RECOVERY, BEND_TEXEL, BendField, Bender};
 pub use mesh::InstancedMeshes;
 pub(crate) use pack::{InstancedClasses, PackedClass};
 pub use plugin::RwtInstancingPlugin;

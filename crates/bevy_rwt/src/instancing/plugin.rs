@@ -1,13 +1,13 @@
 //! The instancing feature plugin: the wind resource, and the render-world systems that draw
 //! every [`InstancedChunk`] with one instanced draw.
 
-use super::{InstancedChunk, InstancedMeshes, RwtFadeIn, RwtWind};
-use super::{mesh, render};
+use super::{BendField, Bender, InstancedChunk, InstancedMeshes, RwtFadeIn, RwtWind};
+use super::{bend, mesh, render};
 use crate::settings::RwtSystems;
-use bevy::asset::embedded_asset;
-use bevy::core_pipeline::core_3d::Transparent3d;
+use bevy::core_pipeline::core_3d::Opaque3d;
+use bevy::core_pipeline::prepass::Opaque3dPrepass;
 use bevy::ecs::schedule::InternedScheduleLabel;
-use bevy::pbr::MeshPipelineSystems;
+use bevy::pbr::{MeshPipelineSystems, Shadow, init_prepass_pipeline};
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
 use bevy::render::extract_resource::ExtractResourcePlugin;
@@ -28,10 +28,13 @@ impl Plugin for RwtInstancingPlugin {
         app.init_resource::<RwtWind>()
             .init_resource::<RwtFadeIn>()
             .init_resource::<InstancedMeshes>()
+            .init_resource::<BendField>()
+            .register_type::<Bender>()
             .add_systems(
                 self.schedule,
                 (
                     mesh::refit_changed_meshes.before(RwtSystems::Apply),
+                    bend::update_bend_field,
                     mesh::report_class_errors
                         .after(RwtSystems::Apply)
                         .before(RwtSystems::Stats),
@@ -40,26 +43,45 @@ impl Plugin for RwtInstancingPlugin {
         if app.get_sub_app(RenderApp).is_none() {
             return;
         }
-        embedded_asset!(app, "instanced.wgsl");
+        render::embed_shader(app);
         app.add_plugins((
             ExtractComponentPlugin::<InstancedChunk>::default(),
             ExtractResourcePlugin::<RwtWind>::default(),
             ExtractResourcePlugin::<RwtFadeIn>::default(),
+            ExtractResourcePlugin::<BendField>::default(),
         ));
         let render_app = app.sub_app_mut(RenderApp);
         render_app
-            .add_render_command::<Transparent3d, render::DrawInstancedChunk>()
+            .add_render_command::<Opaque3d, render::DrawInstancedChunk>()
+            .add_render_command::<Opaque3dPrepass, render::DrawInstancedDepth>()
+            .add_render_command::<Shadow, render::DrawInstancedDepth>()
             .init_resource::<SpecializedMeshPipelines<render::InstancedPipeline>>()
+            .init_resource::<SpecializedMeshPipelines<render::InstancedDepthPipeline>>()
             .init_resource::<render::ReportedMeshes>()
+            .init_resource::<render::MainViewer>()
+            .init_resource::<render::Queued<Opaque3d>>()
+            .init_resource::<render::Queued<Opaque3dPrepass>>()
+            .init_resource::<render::Queued<Shadow>>()
             .add_systems(
                 RenderStartup,
-                render::init_pipeline.after(MeshPipelineSystems),
+                (
+                    render::init_bindings,
+                    render::init_main_pipeline.after(MeshPipelineSystems),
+                    render::init_depth_pipeline.after(init_prepass_pipeline),
+                )
+                    .chain(),
             )
             .add_systems(
                 Render,
                 (
-                    render::prepare_chunks.in_set(RenderSystems::PrepareResources),
-                    render::queue_chunks.in_set(RenderSystems::QueueMeshes),
+                    (render::prepare_frame, render::prepare_chunks)
+                        .in_set(RenderSystems::PrepareResources),
+                    (
+                        render::queue_main,
+                        render::queue_prepass,
+                        render::queue_shadows,
+                    )
+                        .in_set(RenderSystems::QueueMeshes),
                 ),
             );
     }

@@ -1,6 +1,33 @@
 //! The instanced look: one mesh for every instance, shaded by the instanced pipeline.
 
 use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Whether an instanced class casts shadows, into every shadow map (directional cascades,
+/// point and spot lights) of the lights that cast them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum InstancedShadows {
+    /// No shadow: the class costs nothing in shadow passes.
+    Off,
+    /// Every drawn chunk casts (like a Bevy mesh).
+    #[default]
+    On,
+    /// Chunks whose bounds come within this distance (world units) of a camera cast; far
+    /// chunks cost nothing in shadow passes. Grass under the player's feet shades itself and
+    /// the ground; grass a hundred metres away does not need to.
+    Within(f32),
+}
+
+impl InstancedShadows {
+    /// Whether a chunk `distance` from the nearest camera casts.
+    pub fn casts_at(self, distance: f32) -> bool {
+        match self {
+            Self::Off => false,
+            Self::On => true,
+            Self::Within(reach) => distance <= reach,
+        }
+    }
+}
 
 /// How an instanced class is shaded: a blade-like gradient from root to tip, lit by the
 /// scene's lights, with a hashed colour variation per instance.
@@ -25,6 +52,12 @@ pub struct InstancedMaterial {
     /// blends in above it. 0 for grass (a gradient from root to tip); near 1 for flowers (a
     /// green stem under a coloured head).
     pub tip_from: f32,
+    /// Whether the class casts shadows.
+    pub shadows: InstancedShadows,
+    /// How far instances lean where a [`Bender`](crate::instancing::Bender) passed, as a
+    /// fraction of the field's lean (1 lays a blade flat where the field says so); 0 for
+    /// instances that do not bend (pebbles).
+    pub bend_response: f32,
 }
 
 impl Default for InstancedMaterial {
@@ -37,6 +70,8 @@ impl Default for InstancedMaterial {
             wind_response: 0.25,
             fade_band: 0.1,
             tip_from: 0.0,
+            shadows: InstancedShadows::default(),
+            bend_response: 1.0,
         }
     }
 }

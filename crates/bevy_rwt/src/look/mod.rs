@@ -11,7 +11,7 @@ mod instanced;
 pub use blade::blade_mesh;
 pub(crate) use check::check_topology;
 pub use check::{InstancedClassError, check_instanced_mesh};
-pub use instanced::{InstancedLook, InstancedMaterial};
+pub use instanced::{InstancedLook, InstancedMaterial, InstancedShadows};
 
 use bevy::camera::visibility::VisibilityRange;
 use bevy::prelude::*;

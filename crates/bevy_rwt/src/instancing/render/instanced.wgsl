@@ -1,11 +1,21 @@
-// Instanced foliage: one chunk's instances of one mesh, lit by Bevy's PBR lighting (scene
-// lights, ambient light, received shadows, distance fog), swayed by a world-space wind
-// field and grown in or out by level of detail.
+// Instanced foliage: one chunk's instances of one mesh, swayed by a world-space wind field
+// and grown in or out by level of detail. The main pass lights it with Bevy's PBR lighting
+// (scene lights, ambient light, received shadows, distance fog); the prepass pipeline
+// (`PREPASS_PIPELINE`) writes its depth, normals and motion vectors (the previous frame's
+// sway included) and its depth into shadow maps.
 
+#ifdef PREPASS_PIPELINE
+#import bevy_pbr::mesh_view_bindings::view
+#import bevy_pbr::prepass_bindings::previous_view_uniforms
+#import bevy_render::globals::Globals
+// The prepass view layout has the globals at binding 1.
+@group(0) @binding(1) var<uniform> globals: Globals;
+#else
 #import bevy_pbr::mesh_view_bindings::{view, globals}
-#import bevy_pbr::view_transformations::position_world_to_clip
 #import bevy_pbr::{pbr_types, pbr_functions}
 #import bevy_pbr::mesh_types::MESH_FLAGS_SHADOW_RECEIVER_BIT
+#endif
+#import bevy_pbr::view_transformations::position_world_to_clip
 
 struct Chunk {
     // Chunk corner (xyz), mesh top (w).
@@ -20,11 +30,24 @@ struct Chunk {
     wind: vec4<f32>,
     // Wind speed.
     wind_motion: vec4<f32>,
-    // Height fraction where the tip colour starts, unused.
+    // Height fraction where the tip colour starts, bend response, unused.
     shading: vec4<f32>,
 };
 
 @group(2) @binding(0) var<uniform> chunk: Chunk;
+
+struct Frame {
+    // Where the main camera is (xyz): shadow passes grow instances as that camera sees
+    // them, not as the light does.
+    viewer: vec4<f32>,
+    // The bend field's min corner (x, z), 1 / its side, 1 when any blade leans.
+    bend: vec4<f32>,
+};
+
+@group(2) @binding(1) var<uniform> frame: Frame;
+// How far blades lean (x, z) around the main camera, where benders passed.
+@group(2) @binding(2) var bend_field: texture_2d<f32>;
+@group(2) @binding(3) var bend_sampler: sampler;
 
 struct Vertex {
     @location(0) position: vec3<f32>,
@@ -42,6 +65,12 @@ struct VertexOutput {
     @location(0) world_position: vec4<f32>,
     @location(1) world_normal: vec3<f32>,
     @location(2) color: vec4<f32>,
+#ifdef MOTION_VECTOR_PREPASS
+    @location(3) previous_world_position: vec4<f32>,
+#endif
+#ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
+    @location(4) unclipped_depth: f32,
+#endif
 };
 
 fn hash2(p: vec2<f32>) -> f32 {
@@ -68,7 +97,12 @@ fn growth(root: vec3<f32>, appear: f32) -> f32 {
     if chunk.falloff.z == 0.0 {
         return 1.0;
     }
-    let distance = length(root.xz - view.world_position.xz);
+#ifdef RWT_SHADOW_PASS
+    let eye = frame.viewer.xz;
+#else
+    let eye = view.world_position.xz;
+#endif
+    let distance = length(root.xz - eye);
     let span = max(chunk.falloff.y - chunk.falloff.x, 1e-3);
     let factor = max(chunk.falloff.w, clamp(1.0 - (distance - chunk.falloff.x) / span, 0.0, 1.0));
     return clamp((factor - appear) / chunk.params.w, 0.0, 1.0);
@@ -76,9 +110,8 @@ fn growth(root: vec3<f32>, appear: f32) -> f32 {
 
 // Sideways displacement of a point at height fraction `t` (0 root, 1 tip) of an instance
 // rooted at `root`: gusts travelling with the wind plus a small per-instance flutter.
-fn sway(root: vec3<f32>, t: f32, tint: f32, height: f32) -> vec3<f32> {
+fn sway(root: vec3<f32>, t: f32, tint: f32, height: f32, time: f32) -> vec3<f32> {
     let dir = normalize(chunk.wind.xy + vec2<f32>(1e-5, 0.0));
-    let time = globals.time;
     let drift = dir * chunk.wind_motion.x * time;
     let gust = value_noise((root.xz - drift) * chunk.wind.w);
     let flutter = 0.15 * sin(time * 2.3 + tint * 6.2831) * (0.5 + gust);
@@ -87,8 +120,37 @@ fn sway(root: vec3<f32>, t: f32, tint: f32, height: f32) -> vec3<f32> {
     return vec3<f32>(dir.x * bend, -0.3 * abs(bend) * t, dir.y * bend);
 }
 
-@vertex
-fn vertex(in: Vertex) -> VertexOutput {
+// The lean of an instance rooted at `root` (x, z; length 0..1, 1 is flat).
+fn lean_at(root: vec3<f32>) -> vec2<f32> {
+    if frame.bend.w == 0.0 || chunk.shading.y == 0.0 {
+        return vec2<f32>(0.0);
+    }
+    let uv = (root.xz - frame.bend.xy) * frame.bend.z;
+    if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+        return vec2<f32>(0.0);
+    }
+    let lean = textureSampleLevel(bend_field, bend_sampler, uv, 0.0).xy * chunk.shading.y;
+    let amount = length(lean);
+    return select(lean, lean / amount, amount > 1.0);
+}
+
+// Turns `v` (relative to the root) about the horizontal axis across `dir` by the angle
+// whose sine and cosine are `s`, `c`: the blade falls towards `dir`.
+fn fall(v: vec3<f32>, dir: vec2<f32>, s: f32, c: f32) -> vec3<f32> {
+    let along = dot(v.xz, dir);
+    let turned = along * c + v.y * s;
+    let up = v.y * c - along * s;
+    return vec3<f32>(v.x + dir.x * (turned - along), up, v.z + dir.y * (turned - along));
+}
+
+// An instance's vertex: where it is at `time`, its normal and its height fraction.
+struct Placed {
+    world: vec3<f32>,
+    normal: vec3<f32>,
+    t: f32,
+};
+
+fn place(in: Vertex, time: f32) -> Placed {
     let root = chunk.origin.xyz + in.offset_scale.xyz;
     let yaw = in.yaw_appear_tint.x * 6.2831853;
     let tint = in.yaw_appear_tint.z;
@@ -96,35 +158,88 @@ fn vertex(in: Vertex) -> VertexOutput {
     let c = cos(yaw);
     let s = sin(yaw);
     let local = in.position * scale;
-    let turned = vec3<f32>(c * local.x + s * local.z, local.y, -s * local.x + c * local.z);
-    let t = clamp(in.position.y / chunk.origin.w, 0.0, 1.0);
-    let world = root + turned + sway(root, t, tint, chunk.origin.w * scale);
-
+    var turned = vec3<f32>(c * local.x + s * local.z, local.y, -s * local.x + c * local.z);
 #ifdef RWT_NORMALS
     let n = in.normal;
-    let normal = vec3<f32>(c * n.x + s * n.z, n.y, -s * n.x + c * n.z);
+    var normal = vec3<f32>(c * n.x + s * n.z, n.y, -s * n.x + c * n.z);
 #else
-    let normal = vec3<f32>(0.0, 1.0, 0.0);
+    var normal = vec3<f32>(0.0, 1.0, 0.0);
 #endif
-
-    let variation = (tint - 0.5) * chunk.params.x;
-    let tip_start = chunk.shading.x;
-    let shade = mix(chunk.base_color, chunk.tip_color, clamp((t - tip_start) / (1.0 - tip_start), 0.0, 1.0));
-    var out: VertexOutput;
-    out.world_position = vec4<f32>(world, 1.0);
-    out.clip_position = position_world_to_clip(world);
+    // Where a bender passed, the blade falls away from it, up to 80 degrees.
+    let lean = lean_at(root);
+    let amount = length(lean);
+    if amount > 1e-3 {
+        let dir = lean / amount;
+        let angle = amount * 1.4;
+        turned = fall(turned, dir, sin(angle), cos(angle));
+        normal = fall(normal, dir, sin(angle), cos(angle));
+    }
+    var out: Placed;
+    out.t = clamp(in.position.y / chunk.origin.w, 0.0, 1.0);
+    let wind = sway(root, out.t, tint, chunk.origin.w * scale, time) * (1.0 - amount);
+    out.world = root + turned + wind;
     // Blades read as blades when their normals lean towards the sky.
-    out.world_normal = normalize(mix(normal, vec3<f32>(0.0, 1.0, 0.0), 0.45));
-    out.color = vec4<f32>(shade.rgb * (1.0 + variation) + vec3<f32>(variation * 0.15, variation * 0.05, 0.0), 1.0);
+    out.normal = normalize(mix(normal, vec3<f32>(0.0, 1.0, 0.0), 0.45));
     return out;
 }
 
+@vertex
+fn vertex(in: Vertex) -> VertexOutput {
+    let placed = place(in, globals.time);
+    let tint = in.yaw_appear_tint.z;
+    let variation = (tint - 0.5) * chunk.params.x;
+    let tip_start = chunk.shading.x;
+    let shade = mix(chunk.base_color, chunk.tip_color, clamp((placed.t - tip_start) / (1.0 - tip_start), 0.0, 1.0));
+    var out: VertexOutput;
+    out.world_position = vec4<f32>(placed.world, 1.0);
+    out.clip_position = position_world_to_clip(placed.world);
+    out.world_normal = placed.normal;
+    out.color = vec4<f32>(shade.rgb * (1.0 + variation) + vec3<f32>(variation * 0.15, variation * 0.05, 0.0), 1.0);
+#ifdef MOTION_VECTOR_PREPASS
+    out.previous_world_position = vec4<f32>(place(in, globals.time - globals.delta_time).world, 1.0);
+#endif
+#ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
+    out.unclipped_depth = out.clip_position.z;
+    out.clip_position.z = min(out.clip_position.z, 1.0);
+#endif
+    return out;
+}
+
+#ifdef PREPASS_PIPELINE
+#ifdef PREPASS_FRAGMENT
+struct FragmentOutput {
+#ifdef NORMAL_PREPASS
+    @location(0) normal: vec4<f32>,
+#endif
+#ifdef MOTION_VECTOR_PREPASS
+    @location(1) motion_vector: vec2<f32>,
+#endif
+#ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
+    @builtin(frag_depth) frag_depth: f32,
+#endif
+};
+
+@fragment
+fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> FragmentOutput {
+    var out: FragmentOutput;
+#ifdef NORMAL_PREPASS
+    out.normal = vec4<f32>(facing_normal(in.world_normal, is_front) * 0.5 + vec3<f32>(0.5), 1.0);
+#endif
+#ifdef MOTION_VECTOR_PREPASS
+    let now_t = view.unjittered_clip_from_world * in.world_position;
+    let then_t = previous_view_uniforms.clip_from_world * in.previous_world_position;
+    out.motion_vector = (now_t.xy / now_t.w - then_t.xy / then_t.w) * vec2<f32>(0.5, -0.5);
+#endif
+#ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
+    out.frag_depth = in.unclipped_depth;
+#endif
+    return out;
+}
+#endif
+#else
 @fragment
 fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
-    var n = normalize(in.world_normal);
-    if !is_front {
-        n = vec3<f32>(-n.x, n.y, -n.z);
-    }
+    let n = facing_normal(in.world_normal, is_front);
     var pbr_input = pbr_types::pbr_input_new();
     pbr_input.material.base_color = in.color;
     pbr_input.material.perceptual_roughness = chunk.params.y;
@@ -139,4 +254,14 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @locatio
     var color = pbr_functions::apply_pbr_lighting(pbr_input);
     color = pbr_functions::main_pass_post_lighting_processing(pbr_input, color);
     return color;
+}
+#endif
+
+// The normal of the side seen: blades are seen from both sides.
+fn facing_normal(world_normal: vec3<f32>, is_front: bool) -> vec3<f32> {
+    let n = normalize(world_normal);
+    if is_front {
+        return n;
+    }
+    return vec3<f32>(-n.x, n.y, -n.z);
 }

@@ -1,40 +1,54 @@
-//! Render world: each visible [`InstancedChunk`] is drawn with one instanced draw of its
-//! class's mesh, from a vertex buffer made once per instance buffer (kept while the main
-//! world's buffer is the same one) and a small uniform with the chunk's corner, shading,
-//! fall-off and wind.
+//! Render world: each [`InstancedChunk`] is drawn with one instanced draw of its class's
+//! mesh, from a vertex buffer made once per instance buffer (kept while the main world's
+//! buffer is the same one) and a small uniform with the chunk's corner, shading, fall-off
+//! and wind.
+//!
+//! A chunk takes part in Bevy's passes as a mesh does: the opaque 3-D phase
+//! ([`main_pass`]), the depth, normal and motion-vector prepasses of views that have them,
+//! and the shadow maps of shadow-casting lights ([`depth`]), each culled by the chunk's
+//! bounds per view. The phases are binned and retained; [`retained`] keeps our items in
+//! them true frame by frame.
 
-use super::{GpuInstance, InstanceBuffer, InstancedChunk, RwtFadeIn, RwtWind};
-use crate::look::check_topology;
-use bevy::core_pipeline::core_3d::{Transparent3d, TransparentSortingInfo3d};
-use bevy::ecs::query::QueryItem;
-use bevy::ecs::system::{SystemParamItem, lifetimeless::*};
-use bevy::mesh::{MeshVertexBufferLayoutRef, VertexBufferLayout};
-use bevy::pbr::{
-    MeshPipeline, MeshPipelineKey, SetMeshViewBindGroup, SetMeshViewBindingArrayBindGroup,
-    ViewKeyCache,
+mod depth;
+mod draw;
+mod main_pass;
+mod retained;
+
+pub(super) use depth::{
+    DrawInstancedDepth, InstancedDepthPipeline, init_depth_pipeline, queue_prepass, queue_shadows,
 };
+pub(super) use draw::DrawInstancedChunk;
+pub(super) use main_pass::{InstancedPipeline, init_main_pipeline, queue_main};
+pub(super) use retained::Queued;
+
+use super::bend::{BEND_FIELD_TEXELS, BendField};
+use super::{GpuInstance, InstanceBuffer, InstancedChunk, RwtFadeIn, RwtWind};
+use crate::look::{InstancedShadows, check_topology};
+use bevy::camera::primitives::Aabb;
+use bevy::ecs::query::QueryItem;
+use bevy::mesh::VertexBufferLayout;
+use bevy::pbr::MeshPipelineKey;
 use bevy::platform::collections::HashSet;
 use bevy::prelude::*;
+use bevy::render::camera::ExtractedCamera;
 use bevy::render::extract_component::ExtractComponent;
 use bevy::render::extract_resource::ExtractResource;
-use bevy::render::mesh::allocator::MeshAllocator;
-use bevy::render::mesh::{RenderMesh, RenderMeshBufferInfo};
-use bevy::render::render_asset::RenderAssets;
-use bevy::render::render_phase::{
-    DrawFunctions, PhaseItem, PhaseItemExtraIndex, RenderCommand, RenderCommandResult,
-    SetItemPipeline, TrackedRenderPass, ViewSortedRenderPhases,
-};
-use bevy::render::render_resource::binding_types::uniform_buffer_sized;
+use bevy::render::mesh::RenderMesh;
+use bevy::render::render_resource::binding_types::{sampler, texture_2d, uniform_buffer_sized};
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::sync_component::SyncComponent;
-use bevy::render::view::{ExtractedView, RenderVisibleEntities};
-use bevy::shader::ShaderDefVal;
+use bevy::render::view::ExtractedView;
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
 /// Shader locations of the instance attributes (after every mesh attribute).
 const INSTANCE_LOCATIONS: [u32; 2] = [8, 9];
+
+/// Adds the instanced shader to the app's embedded assets.
+pub(super) fn embed_shader(app: &mut App) {
+    bevy::asset::embedded_asset!(app, "instanced.wgsl");
+}
 
 /// The per-chunk uniform, as the shader reads it.
 #[repr(C)]
@@ -52,8 +66,18 @@ struct ChunkUniform {
     wind: [f32; 4],
     /// Wind speed.
     wind_motion: [f32; 4],
-    /// Height fraction where the tip colour starts, unused.
+    /// Height fraction where the tip colour starts, bend response, unused.
     shading: [f32; 4],
+}
+
+/// The per-frame uniform every chunk shares: where the main camera is (shadow passes grow
+/// instances as it sees them, not as the light does), and where the bend field lies.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+struct FrameUniform {
+    viewer: [f32; 4],
+    /// The bend field's min corner (x, z), 1 / its side, 1 when any blade leans.
+    bend: [f32; 4],
 }
 
 /// A chunk as the render world sees it (its extraction is part of [`InstancedChunk`]'s
@@ -63,8 +87,9 @@ pub struct ExtractedChunk {
     buffer: Arc<InstanceBuffer>,
     mesh: AssetId<Mesh>,
     uniform: ChunkUniform,
-    /// World-space centre of the instances, for sorting.
-    centre: Vec3,
+    /// World-space bounds of the drawn instances, for culling shadow views.
+    bounds: Aabb,
+    shadows: InstancedShadows,
 }
 
 impl SyncComponent for InstancedChunk {
@@ -72,19 +97,26 @@ impl SyncComponent for InstancedChunk {
 }
 
 impl ExtractComponent for InstancedChunk {
-    type QueryData = (&'static InstancedChunk, &'static GlobalTransform);
+    type QueryData = (
+        &'static InstancedChunk,
+        &'static GlobalTransform,
+        Option<&'static Aabb>,
+    );
     type QueryFilter = ();
     type Out = ExtractedChunk;
 
     fn extract_component(
-        (chunk, transform): QueryItem<'_, '_, Self::QueryData>,
+        (chunk, transform, aabb): QueryItem<'_, '_, Self::QueryData>,
     ) -> Option<Self::Out> {
         let origin = transform.translation();
         let m = &chunk.material;
-        let (lo, hi) = chunk.buffer.bounds;
         let (near, far, on, floor) = chunk
             .falloff
             .map_or((0.0, 1.0, 0.0, 0.0), |(n, f, floor)| (n, f, 1.0, floor));
+        let local = aabb.copied().unwrap_or_else(|| {
+            let (lo, hi) = chunk.buffer.bounds;
+            Aabb::from_min_max(lo, hi)
+        });
         Some(ExtractedChunk {
             buffer: chunk.buffer.clone(),
             mesh: chunk.mesh.id(),
@@ -99,10 +131,14 @@ impl ExtractComponent for InstancedChunk {
                     m.fade_band.max(1e-3),
                 ],
                 falloff: [near, far, on, floor],
-                shading: [m.tip_from.clamp(0.0, 0.99), 0.0, 0.0, 0.0],
+                shading: [m.tip_from.clamp(0.0, 0.99), m.bend_response, 0.0, 0.0],
                 ..default()
             },
-            centre: origin + (lo + hi) * 0.5,
+            bounds: Aabb {
+                center: local.center + origin.to_vec3a(),
+                half_extents: local.half_extents,
+            },
+            shadows: m.shadows,
         })
     }
 }
@@ -112,6 +148,14 @@ impl ExtractResource for RwtWind {
 
     fn extract_resource(source: &Self::Source) -> Self {
         *source
+    }
+}
+
+impl ExtractResource for BendField {
+    type Source = BendField;
+
+    fn extract_resource(source: &Self::Source) -> Self {
+        source.clone()
     }
 }
 
@@ -135,14 +179,21 @@ pub(super) struct GpuChunk {
     bind_group: BindGroup,
 }
 
-/// The instanced pipeline: Bevy's mesh pipeline (view bindings, lights, shadows, fog) with
-/// our shader, the instance buffer and the chunk uniform.
-#[derive(Resource)]
-pub(super) struct InstancedPipeline {
-    mesh_pipeline: MeshPipeline,
+/// What every instanced pipeline shares: the shader and the layout of group 2 (the chunk's
+/// uniform, the frame's, the bend field and its sampler), and the shared resources.
+#[derive(Resource, Clone)]
+pub(super) struct ChunkBindings {
     shader: Handle<Shader>,
-    chunk_layout: BindGroupLayoutDescriptor,
+    layout: BindGroupLayoutDescriptor,
+    frame: Buffer,
+    bend: Texture,
+    bend_view: TextureView,
+    bend_sampler: Sampler,
 }
+
+/// The main camera's position as the shadow passes see it, and the shared frame uniform.
+#[derive(Resource, Default)]
+pub(super) struct MainViewer(Option<Vec3>);
 
 /// Meshes that cannot be drawn, reported once each.
 #[derive(Resource, Default)]
@@ -157,19 +208,48 @@ impl ReportedMeshes {
     }
 }
 
-pub(super) fn init_pipeline(
+pub(super) fn init_bindings(
     mut commands: Commands,
-    mesh_pipeline: Res<MeshPipeline>,
+    device: Res<RenderDevice>,
     asset_server: Res<AssetServer>,
 ) {
-    let entries = BindGroupLayoutEntries::single(
+    let entries = BindGroupLayoutEntries::sequential(
         ShaderStages::VERTEX_FRAGMENT,
-        uniform_buffer_sized(false, None),
+        (
+            uniform_buffer_sized(false, None),
+            uniform_buffer_sized(false, None),
+            texture_2d(TextureSampleType::Float { filterable: true }),
+            sampler(SamplerBindingType::Filtering),
+        ),
     );
-    commands.insert_resource(InstancedPipeline {
-        mesh_pipeline: mesh_pipeline.clone(),
+    let frame = device.create_buffer_with_data(&BufferInitDescriptor {
+        label: Some("rwt_instanced_frame"),
+        contents: bytemuck::bytes_of(&FrameUniform::default()),
+        usage: BufferUsages::UNIFORM | BufferUsages::COPY_DST,
+    });
+    let bend = device.create_texture(&TextureDescriptor {
+        label: Some("rwt_bend_field"),
+        size: bend_extent(),
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: TextureDimension::D2,
+        format: TextureFormat::Rg8Snorm,
+        usage: TextureUsages::TEXTURE_BINDING | TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let bend_sampler = device.create_sampler(&SamplerDescriptor {
+        label: Some("rwt_bend_field"),
+        mag_filter: FilterMode::Linear,
+        min_filter: FilterMode::Linear,
+        ..default()
+    });
+    commands.insert_resource(ChunkBindings {
         shader: bevy::asset::load_embedded_asset!(asset_server.as_ref(), "instanced.wgsl"),
-        chunk_layout: BindGroupLayoutDescriptor::new("rwt_instanced_chunk", &entries),
+        layout: BindGroupLayoutDescriptor::new("rwt_instanced_chunk", &entries),
+        frame,
+        bend_view: bend.create_view(&TextureViewDescriptor::default()),
+        bend,
+        bend_sampler,
     });
 }
 
@@ -193,35 +273,70 @@ fn instance_layout() -> VertexBufferLayout {
     }
 }
 
-impl SpecializedMeshPipeline for InstancedPipeline {
-    type Key = MeshPipelineKey;
-
-    fn specialize(
-        &self,
-        key: Self::Key,
-        layout: &MeshVertexBufferLayoutRef,
-    ) -> Result<RenderPipelineDescriptor, SpecializedMeshPipelineError> {
-        let mut descriptor = self.mesh_pipeline.specialize(key, layout)?;
-        let mut attributes = vec![Mesh::ATTRIBUTE_POSITION.at_shader_location(0)];
-        let mut defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 3)];
-        if layout.0.contains(Mesh::ATTRIBUTE_NORMAL) {
-            attributes.push(Mesh::ATTRIBUTE_NORMAL.at_shader_location(1));
-            defs.push("RWT_NORMALS".into());
-        }
-        descriptor.vertex.buffers = vec![layout.0.get_layout(&attributes)?, instance_layout()];
-        descriptor.vertex.shader = self.shader.clone();
-        descriptor.vertex.shader_defs.extend(defs.iter().cloned());
-        if let Some(fragment) = descriptor.fragment.as_mut() {
-            fragment.shader = self.shader.clone();
-            fragment.shader_defs.extend(defs);
-        }
-        descriptor.layout.truncate(2);
-        descriptor.layout.push(self.chunk_layout.clone());
-        // Blades are seen from both sides.
-        descriptor.primitive.cull_mode = None;
-        descriptor.label = Some("rwt_instanced_pipeline".into());
-        Ok(descriptor)
+fn bend_extent() -> Extent3d {
+    Extent3d {
+        width: BEND_FIELD_TEXELS,
+        height: BEND_FIELD_TEXELS,
+        depth_or_array_layers: 1,
     }
+}
+
+/// The main camera (the active 3-D camera of lowest order): the shadow passes grow
+/// instances and choose casting chunks as it sees them. Writes the frame uniform, and the
+/// bend field when it changed.
+pub(super) fn prepare_frame(
+    cameras: Query<(&ExtractedView, &ExtractedCamera), With<Camera3d>>,
+    bindings: Option<Res<ChunkBindings>>,
+    field: Option<Res<BendField>>,
+    queue: Res<RenderQueue>,
+    mut viewer: ResMut<MainViewer>,
+) {
+    viewer.0 = cameras
+        .iter()
+        .min_by_key(|(_, camera)| camera.order)
+        .map(|(view, _)| view.world_from_view.translation());
+    let Some(bindings) = bindings else { return };
+    let bend = field.as_ref().map_or([0.0; 4], |f| {
+        let min = f.min();
+        [
+            min.x,
+            min.y,
+            1.0 / f.extent(),
+            if f.active() { 1.0 } else { 0.0 },
+        ]
+    });
+    let uniform = FrameUniform {
+        viewer: viewer.0.unwrap_or_default().extend(1.0).to_array(),
+        bend,
+    };
+    queue.write_buffer(&bindings.frame, 0, bytemuck::bytes_of(&uniform));
+    if let Some(field) = field.filter(|f| f.is_changed()) {
+        let texels: Vec<[i8; 2]> = field
+            .texels()
+            .iter()
+            .map(|l| [snorm8(l.x), snorm8(l.y)])
+            .collect();
+        queue.write_texture(
+            TexelCopyTextureInfo {
+                texture: &bindings.bend,
+                mip_level: 0,
+                origin: Origin3d::ZERO,
+                aspect: TextureAspect::All,
+            },
+            bytemuck::cast_slice(&texels),
+            TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(2 * BEND_FIELD_TEXELS),
+                rows_per_image: None,
+            },
+            bend_extent(),
+        );
+    }
+}
+
+/// `v` in -1..1 as a signed normalized byte.
+fn snorm8(v: f32) -> i8 {
+    (v.clamp(-1.0, 1.0) * 127.0).round() as i8
 }
 
 /// Makes the GPU resources of new or changed chunks; updates the uniform when the wind or
@@ -232,7 +347,7 @@ pub(super) fn prepare_chunks(
     mut chunks: Query<(Entity, &ExtractedChunk, Option<&mut GpuChunk>)>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
-    pipeline: Res<InstancedPipeline>,
+    bindings: Res<ChunkBindings>,
     cache: Res<PipelineCache>,
     wind: Option<Res<RwtWind>>,
     fade: Option<Res<RwtFadeIn>>,
@@ -259,7 +374,7 @@ pub(super) fn prepare_chunks(
                 }
             }
             _ => {
-                let gpu = upload(&device, &pipeline, &cache, chunk, uniform);
+                let gpu = upload(&device, &bindings, &cache, chunk, uniform);
                 commands.entity(entity).insert(gpu);
             }
         }
@@ -269,7 +384,7 @@ pub(super) fn prepare_chunks(
 /// The GPU resources of one chunk.
 fn upload(
     device: &RenderDevice,
-    pipeline: &InstancedPipeline,
+    bindings: &ChunkBindings,
     cache: &PipelineCache,
     chunk: &ExtractedChunk,
     uniform: ChunkUniform,
@@ -286,8 +401,13 @@ fn upload(
     });
     let bind_group = device.create_bind_group(
         "rwt_instanced_chunk",
-        &cache.get_bind_group_layout(&pipeline.chunk_layout),
-        &BindGroupEntries::single(uniform_buffer.as_entire_binding()),
+        &cache.get_bind_group_layout(&bindings.layout),
+        &BindGroupEntries::sequential((
+            uniform_buffer.as_entire_binding(),
+            bindings.frame.as_entire_binding(),
+            &bindings.bend_view,
+            &bindings.bend_sampler,
+        )),
     );
     GpuChunk {
         source: chunk.buffer.clone(),
@@ -299,153 +419,39 @@ fn upload(
     }
 }
 
-/// Queues every chunk visible from each view (culled by its `Aabb`), sorted with the
-/// transparent phase so that no batching state of Bevy's meshes is involved.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn queue_chunks(
-    draw_functions: Res<DrawFunctions<Transparent3d>>,
-    pipeline: Res<InstancedPipeline>,
-    mut pipelines: ResMut<SpecializedMeshPipelines<InstancedPipeline>>,
-    cache: Res<PipelineCache>,
-    meshes: Res<RenderAssets<RenderMesh>>,
-    chunks: Query<&ExtractedChunk>,
-    mut phases: ResMut<ViewSortedRenderPhases<Transparent3d>>,
-    views: Query<(&ExtractedView, &RenderVisibleEntities)>,
-    view_keys: Res<ViewKeyCache>,
-    mut reported: ResMut<ReportedMeshes>,
-) {
-    let draw = draw_functions.read().id::<DrawInstancedChunk>();
-    for (view, visible) in &views {
-        let Some(phase) = phases.get_mut(&view.retained_view_entity) else {
-            continue;
-        };
-        let (Some(&view_key), Some(visible)) = (
-            view_keys.get(&view.retained_view_entity),
-            visible.get::<InstancedChunk>(),
-        ) else {
-            continue;
-        };
-        for &(entity, main_entity) in &visible.entities_cpu_culling {
-            let Ok(chunk) = chunks.get(entity) else {
-                continue;
-            };
-            let Some(mesh) = meshes.get(chunk.mesh) else {
-                continue;
-            };
-            let key = view_key
-                | MeshPipelineKey::from_primitive_topology_and_strip_index(
-                    mesh.primitive_topology(),
-                    mesh.index_format(),
-                );
-            let id = check_topology(mesh.primitive_topology())
+/// The pipeline of `specializer` for `mesh` under `key` (with the mesh's topology), or
+/// `None` with the reason logged once when the mesh cannot be drawn.
+fn specialize<S>(
+    pipelines: &mut SpecializedMeshPipelines<S>,
+    cache: &PipelineCache,
+    specializer: &S,
+    key: S::Key,
+    (id, mesh): (AssetId<Mesh>, &RenderMesh),
+    reported: &mut ReportedMeshes,
+) -> Option<CachedRenderPipelineId>
+where
+    S: SpecializedMeshPipeline,
+{
+    let specialized = check_topology(mesh.primitive_topology())
+        .map_err(|e| e.to_string())
+        .and_then(|()| {
+            pipelines
+                .specialize(cache, specializer, key, &mesh.layout)
                 .map_err(|e| e.to_string())
-                .and_then(|()| {
-                    pipelines
-                        .specialize(&cache, &pipeline, key, &mesh.layout)
-                        .map_err(|e| e.to_string())
-                });
-            let id = match id {
-                Ok(id) => id,
-                Err(e) => {
-                    reported.once(chunk.mesh, &e);
-                    continue;
-                }
-            };
-            phase.add_retained(Transparent3d {
-                sorting_info: TransparentSortingInfo3d::Sorted {
-                    mesh_center: chunk.centre,
-                    depth_bias: 0.0,
-                },
-                entity: (entity, main_entity),
-                pipeline: id,
-                draw_function: draw,
-                distance: 0.0,
-                batch_range: 0..1,
-                extra_index: PhaseItemExtraIndex::None,
-                indexed: mesh.indexed(),
-            });
+        });
+    match specialized {
+        Ok(pipeline) => Some(pipeline),
+        Err(e) => {
+            reported.once(id, &e);
+            None
         }
     }
 }
 
-/// The draw of one chunk.
-pub(super) type DrawInstancedChunk = (
-    SetItemPipeline,
-    SetMeshViewBindGroup<0>,
-    SetMeshViewBindingArrayBindGroup<1>,
-    SetChunkBindGroup<2>,
-    DrawChunkInstances,
-);
-
-/// Binds a chunk's uniform.
-pub(super) struct SetChunkBindGroup<const I: usize>;
-
-impl<P: PhaseItem, const I: usize> RenderCommand<P> for SetChunkBindGroup<I> {
-    type Param = ();
-    type ViewQuery = ();
-    type ItemQuery = Read<GpuChunk>;
-
-    fn render<'w>(
-        _: &P,
-        _: (),
-        gpu: Option<&'w GpuChunk>,
-        _: SystemParamItem<'w, '_, Self::Param>,
-        pass: &mut TrackedRenderPass<'w>,
-    ) -> RenderCommandResult {
-        let Some(gpu) = gpu else {
-            return RenderCommandResult::Skip;
-        };
-        pass.set_bind_group(I, &gpu.bind_group, &[]);
-        RenderCommandResult::Success
-    }
-}
-
-/// Draws a chunk's mesh once per instance.
-pub(super) struct DrawChunkInstances;
-
-impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
-    type Param = (SRes<RenderAssets<RenderMesh>>, SRes<MeshAllocator>);
-    type ViewQuery = ();
-    type ItemQuery = (Read<ExtractedChunk>, Read<GpuChunk>);
-
-    fn render<'w>(
-        _: &P,
-        _: (),
-        item: Option<(&'w ExtractedChunk, &'w GpuChunk)>,
-        (meshes, allocator): SystemParamItem<'w, '_, Self::Param>,
-        pass: &mut TrackedRenderPass<'w>,
-    ) -> RenderCommandResult {
-        let (meshes, allocator) = (meshes.into_inner(), allocator.into_inner());
-        let Some((chunk, gpu)) = item else {
-            return RenderCommandResult::Skip;
-        };
-        let (Some(mesh), Some(vertices)) = (
-            meshes.get(chunk.mesh),
-            allocator.mesh_vertex_slice(&chunk.mesh),
-        ) else {
-            return RenderCommandResult::Skip;
-        };
-        pass.set_vertex_buffer(0, vertices.buffer.slice(..));
-        pass.set_vertex_buffer(1, gpu.instances.slice(..));
-        match &mesh.buffer_info {
-            RenderMeshBufferInfo::Indexed {
-                index_format,
-                count,
-            } => {
-                let Some(indices) = allocator.mesh_index_slice(&chunk.mesh) else {
-                    return RenderCommandResult::Skip;
-                };
-                pass.set_index_buffer(indices.buffer.slice(..), *index_format);
-                pass.draw_indexed(
-                    indices.range.start..indices.range.start + count,
-                    vertices.range.start as i32,
-                    0..gpu.count,
-                );
-            }
-            RenderMeshBufferInfo::NonIndexed => {
-                pass.draw(vertices.range, 0..gpu.count);
-            }
-        }
-        RenderCommandResult::Success
-    }
+/// The mesh-dependent bits of a pipeline key.
+fn topology_key(mesh: &RenderMesh) -> MeshPipelineKey {
+    MeshPipelineKey::from_primitive_topology_and_strip_index(
+        mesh.primitive_topology(),
+        mesh.index_format(),
+    )
 }

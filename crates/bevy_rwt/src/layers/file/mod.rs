@@ -69,7 +69,7 @@ pub use loader::ScatterLayerLoader;
 pub use names::NamedAssets;
 
 use super::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
-use crate::look::{GroundPlane, InstancedMaterial, MeshLod, blade_mesh};
+use crate::look::{GroundPlane, InstancedMaterial, InstancedShadows, MeshLod, blade_mesh};
 use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::Falloff;
@@ -196,6 +196,10 @@ pub struct InstancedMaterialDescription {
     pub fade_band: f32,
     /// See [`InstancedMaterial::tip_from`].
     pub tip_from: f32,
+    /// See [`InstancedMaterial::shadows`]: `Off`, `On` or `Within(30.0)`.
+    pub shadows: InstancedShadows,
+    /// See [`InstancedMaterial::bend_response`].
+    pub bend_response: f32,
 }
 
 impl Default for InstancedMaterialDescription {
@@ -218,6 +222,8 @@ impl From<&InstancedMaterial> for InstancedMaterialDescription {
             wind_response: m.wind_response,
             fade_band: m.fade_band,
             tip_from: m.tip_from,
+            shadows: m.shadows,
+            bend_response: m.bend_response,
         }
     }
 }
@@ -234,6 +240,8 @@ impl InstancedMaterialDescription {
             wind_response: self.wind_response,
             fade_band: self.fade_band,
             tip_from: self.tip_from,
+            shadows: self.shadows,
+            bend_response: self.bend_response,
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Layer files: parsing, checking, writing and describing layers.
 
 use super::*;
-use crate::look::ClassLook;
+use crate::look::{ClassLook, InstancedShadows};
 
 /// The layer of `d` with default handles and no names.
 fn plain(d: &LayerDescription) -> ScatterLayer {
@@ -38,11 +38,15 @@ fn a_layer_file_writes_and_reads_back_the_same() {
         "classes: [",
         r#"classes: [
         (density: Image(path: "m.png", min: (0.0, 0.0), size: (8.0, 8.0), scale: 2.0),
-         mesh: Blade(width: 0.1, height: 0.6), material: Instanced(tip: (0.3, 0.5, 0.1), tip_from: 0.8)),
+         mesh: Blade(width: 0.1, height: 0.6), material: Instanced(tip: (0.3, 0.5, 0.1), tip_from: 0.8, shadows: Within(30.0))),
         (density: Constant(1.0), mesh: Path("a.glb#Mesh0/Primitive0"), material: Path("a.glb#Material0")),"#,
     );
     let d = LayerDescription::from_ron(&with_all).unwrap();
     assert_eq!(d.classes.len(), 4);
+    let MaterialDescription::Instanced(m) = &d.classes[0].material else {
+        panic!("the first class is instanced");
+    };
+    assert_eq!(m.to_material().shadows, InstancedShadows::Within(30.0));
     let text = d.to_ron().unwrap();
     assert!(!text.contains("Some("), "{text}");
     assert_eq!(LayerDescription::from_ron(&text).unwrap(), d);
@@ -178,6 +182,7 @@ fn code_layer(names: &NamedAssets, map: &Handle<Image>) -> ScatterLayer {
         bush.clone(),
         InstancedMaterial {
             tip_from: 0.8,
+            shadows: InstancedShadows::Off,
             ..default()
         },
     );

@@ -1,0 +1,405 @@
+//! Instanced grass inside Bevy's renderer, checked on screen (`scripts/smoke.sh` runs it
+//! under Xvfb and lavapipe): `cargo run --example instanced_passes`.
+//!
+//! A field of tall instanced grass, a box beside it and a low sun. Four screenshots of the
+//! same scene, each compared region by region:
+//! 1. shadows on: the reference;
+//! 2. the sun's shadows off: the grass the box shades must be brighter there, so the
+//!    grass receives shadows;
+//! 3. the grass class's shadows off ([`InstancedShadows::Off`]): the bare ground just
+//!    behind the field (away from the sun) must be brighter there, so the grass casts;
+//! 4. depth, normal and motion-vector prepasses with SSAO (and MSAA off, as they need): the
+//!    grass must still be drawn (its region unlike the bare ground) and the image not blank;
+//! 5. a [`Bender`] standing in the grass: the blades around it must lie down (the pixels
+//!    around it change much more than pixels of grass far from it).
+//!
+//! It prints `rwt-passes: receive lit L shadowed S, cast off L on S, prepass grass G ground
+//! B, bent near N far F` (mean luminances, 0..255; mean pixel changes for the bender) and
+//! exits with an error when a check fails. Screenshots go to `RWT_PASSES_DIR` (default
+//! `target/passes`).
+
+use bevy::app::AppExit;
+use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass, NormalPrepass};
+use bevy::light::CascadeShadowConfigBuilder;
+use bevy::pbr::ScreenSpaceAmbientOcclusion;
+use bevy::prelude::*;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy_rwt::look::blade_mesh;
+use bevy_rwt::prelude::*;
+use bevy_rwt::rwt_core::density::Density;
+use glam::DVec2;
+use rwt_examples::prelude::*;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The grass field: x in 0..6, z in -6..6 (metres), under a sun from +x.
+const FIELD: (DVec2, DVec2) = (DVec2::new(0.0, -6.0), DVec2::new(6.0, 6.0));
+/// Ground points compared: grass the box shades, and bare ground the grass shades.
+const UNDER_BOX: Vec3 = Vec3::new(4.3, 0.35, 0.0);
+const BEHIND_GRASS: Vec3 = Vec3::new(-0.45, 0.0, 2.5);
+/// Where the bender stands, and grass far from it.
+const BENDER: Vec3 = Vec3::new(2.0, 0.0, 2.0);
+const FAR_GRASS: Vec3 = Vec3::new(3.5, 0.6, -3.5);
+/// Half-size of each compared region, pixels.
+const REGION: i32 = 5;
+/// Frames each step waits once streaming has settled (pipelines compile on the CPU).
+const WAIT: u32 = 12;
+
+fn main() {
+    App::new()
+        .add_plugins(example_plugins("rwt instanced_passes"))
+        .add_plugins(RwtPlugin::default())
+        .init_resource::<Check>()
+        .add_systems(Startup, setup)
+        .add_systems(Update, run_check)
+        .run();
+}
+
+/// A constant density over a rectangle, none outside.
+struct Rectangle {
+    min: DVec2,
+    max: DVec2,
+    density: f64,
+}
+
+impl Density for Rectangle {
+    fn density(&self, p: DVec2) -> f64 {
+        let inside = p.cmpge(self.min).all() && p.cmplt(self.max).all();
+        if inside { self.density } else { 0.0 }
+    }
+
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        let meets = max.cmpge(self.min).all() && min.cmplt(self.max).all();
+        if meets { self.density } else { 0.0 }
+    }
+}
+
+fn setup(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    commands.spawn((
+        Camera3d::default(),
+        RwtViewer::all_around(),
+        Transform::from_xyz(-5.0, 6.0, 9.0).looking_at(Vec3::new(2.0, 0.0, 0.5), Vec3::Y),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            shadow_maps_enabled: true,
+            illuminance: 12_000.0,
+            ..default()
+        },
+        Transform::from_xyz(10.0, 7.0, 1.0).looking_at(Vec3::ZERO, Vec3::Y),
+        // One cascade over the scene: a software driver draws every cascade on the CPU.
+        CascadeShadowConfigBuilder {
+            num_cascades: 1,
+            maximum_distance: 40.0,
+            ..default()
+        }
+        .build(),
+    ));
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(60.0, 60.0))),
+        MeshMaterial3d(materials.add(Color::srgb(0.75, 0.72, 0.65))),
+    ));
+    commands.spawn((
+        Mesh3d(meshes.add(Cuboid::new(1.5, 3.0, 1.5))),
+        MeshMaterial3d(materials.add(Color::srgb(0.6, 0.3, 0.2))),
+        Transform::from_xyz(7.2, 1.5, 0.0),
+    ));
+    let field = Rectangle {
+        min: FIELD.0,
+        max: FIELD.1,
+        density: 300.0,
+    };
+    let mut grass = ScatterClass::instanced(
+        LayerDensity::Custom(Arc::new(field)),
+        meshes.add(blade_mesh(0.1, 0.72, 0.1)),
+        InstancedMaterial {
+            base_color: Color::srgb(0.12, 0.3, 0.05),
+            tip_color: Color::srgb(0.5, 0.75, 0.2),
+            ..default()
+        },
+    );
+    grass.scale = 1.6;
+    commands.insert_resource(RwtWind {
+        strength: 0.0,
+        ..default()
+    });
+    commands.spawn((
+        Name::new("grass"),
+        ScatterLayer::new(vec![grass]).with_seed(7),
+    ));
+}
+
+/// Where the check stands.
+#[derive(Resource, Default)]
+struct Check {
+    step: Step,
+    /// Frames since the step began.
+    waited: u32,
+    /// Mean luminances of the regions (under the box, behind the grass, grass) per
+    /// screenshot.
+    shots: Vec<[f32; 3]>,
+    /// The screenshots before and with the bender, and where their regions are seen.
+    bent: Vec<Image>,
+    bent_regions: Vec<Vec2>,
+    pending: Option<Arc<std::sync::Mutex<Option<Image>>>>,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum Step {
+    #[default]
+    Reference,
+    SunShadowsOff,
+    GrassShadowsOff,
+    Prepasses,
+    Bent,
+    Done,
+}
+
+/// What the check changes and reads.
+#[derive(bevy::ecs::system::SystemParam)]
+struct Scene<'w, 's> {
+    stats: Res<'w, RwtStats>,
+    camera: Query<'w, 's, (Entity, &'static Camera, &'static GlobalTransform)>,
+    suns: Query<'w, 's, &'static mut DirectionalLight>,
+    layers: Query<'w, 's, (Entity, &'static ScatterLayer)>,
+    exit: MessageWriter<'w, AppExit>,
+}
+
+fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands) {
+    let settled = scene.stats.pending_tasks == 0 && scene.stats.queued_spawns == 0;
+    check.waited += 1;
+    if let Some(pending) = check.pending.clone() {
+        let Some(image) = pending.lock().unwrap().take() else {
+            return;
+        };
+        let Ok((_, camera, at)) = scene.camera.single() else {
+            return;
+        };
+        let luminance = |p: Vec3| region_luminance(&image, camera, at, p);
+        let grass = Vec3::new(3.0, 0.6, 3.0);
+        check.shots.push([
+            luminance(UNDER_BOX),
+            luminance(BEHIND_GRASS),
+            luminance(grass),
+        ]);
+        if matches!(check.step, Step::Prepasses | Step::Bent) {
+            check.bent.push(image.clone());
+            check.bent_regions = [BENDER + Vec3::Y * 0.3, FAR_GRASS]
+                .iter()
+                .filter_map(|p| camera.world_to_viewport(at, *p).ok())
+                .collect();
+        }
+        save(&image, check.step);
+        check.pending = None;
+        check.step = next(check.step, &mut scene, &mut commands);
+        check.waited = 0;
+        if check.step == Step::Done {
+            let ok = report(&check);
+            scene.exit.write(if ok {
+                AppExit::Success
+            } else {
+                AppExit::error()
+            });
+        }
+        return;
+    }
+    if settled && check.waited >= WAIT && check.step != Step::Done {
+        let slot = Arc::new(std::sync::Mutex::new(None));
+        let target = slot.clone();
+        commands.spawn(Screenshot::primary_window()).observe(
+            move |captured: On<ScreenshotCaptured>| {
+                *target.lock().unwrap() = Some(captured.image.clone());
+            },
+        );
+        check.pending = Some(slot);
+    }
+}
+
+/// Makes the change of the step after `step`, and returns it.
+fn next(step: Step, scene: &mut Scene, commands: &mut Commands) -> Step {
+    match step {
+        Step::Reference => {
+            for mut sun in &mut scene.suns {
+                sun.shadow_maps_enabled = false;
+            }
+            Step::SunShadowsOff
+        }
+        Step::SunShadowsOff => {
+            for mut sun in &mut scene.suns {
+                sun.shadow_maps_enabled = true;
+            }
+            set_grass_shadows(scene, commands, InstancedShadows::Off);
+            Step::GrassShadowsOff
+        }
+        Step::GrassShadowsOff => {
+            set_grass_shadows(scene, commands, InstancedShadows::On);
+            if let Ok((camera, ..)) = scene.camera.single() {
+                commands.entity(camera).insert((
+                    Msaa::Off,
+                    DepthPrepass,
+                    NormalPrepass,
+                    MotionVectorPrepass,
+                    ScreenSpaceAmbientOcclusion::default(),
+                ));
+            }
+            Step::Prepasses
+        }
+        Step::Prepasses => {
+            commands.spawn((
+                Transform::from_translation(BENDER),
+                Bender {
+                    radius: 1.5,
+                    strength: 1.0,
+                },
+            ));
+            Step::Bent
+        }
+        Step::Bent | Step::Done => Step::Done,
+    }
+}
+
+/// Replaces the grass layer by one whose class casts as `shadows` says (a replaced layer
+/// streams anew).
+fn set_grass_shadows(scene: &mut Scene, commands: &mut Commands, shadows: InstancedShadows) {
+    for (entity, layer) in &scene.layers {
+        let mut layer = layer.clone();
+        for class in &mut layer.classes {
+            if let ClassLook::Instanced(look) = &mut class.look {
+                look.material.shadows = shadows;
+            }
+        }
+        commands.entity(entity).insert(layer);
+    }
+}
+
+/// Mean luminance (0..255) of the pixels around where `p` is seen.
+fn region_luminance(image: &Image, camera: &Camera, at: &GlobalTransform, p: Vec3) -> f32 {
+    let Ok(centre) = camera.world_to_viewport(at, p) else {
+        return f32::NAN;
+    };
+    let (w, h) = (image.width() as i32, image.height() as i32);
+    let (cx, cy) = (centre.x as i32, centre.y as i32);
+    let mut sum = 0.0;
+    let mut n = 0.0;
+    for y in (cy - REGION).max(0)..(cy + REGION).min(h) {
+        for x in (cx - REGION).max(0)..(cx + REGION).min(w) {
+            if let Ok(c) = image.get_color_at(x as u32, y as u32) {
+                let c = c.to_srgba();
+                sum += 255.0 * (0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue);
+                n += 1.0;
+            }
+        }
+    }
+    if n > 0.0 { sum / n } else { f32::NAN }
+}
+
+fn save(image: &Image, step: Step) {
+    let dir = std::env::var_os("RWT_PASSES_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("target/passes"));
+    let _ = std::fs::create_dir_all(&dir);
+    let name = format!("{step:?}").to_lowercase();
+    if let Ok(rgba) = image.clone().try_into_dynamic() {
+        let _ = rgba.to_rgb8().save(dir.join(format!("{name}.png")));
+    }
+}
+
+/// Prints the line; whether every check holds.
+fn report(check: &Check) -> bool {
+    let ([reference, sun_off, grass_off, prepass, _], [straight, bent], [near, far]) = (
+        check.shots.as_slice(),
+        check.bent.as_slice(),
+        check.bent_regions.as_slice(),
+    ) else {
+        eprintln!(
+            "rwt-passes: FAIL expected five screenshots, got {}",
+            check.shots.len()
+        );
+        return false;
+    };
+    let change = |at: Vec2| region_change(straight, bent, at);
+    let (bent_near, bent_far) = (change(*near), change(*far));
+    println!(
+        "rwt-passes: receive lit {:.1} shadowed {:.1}, cast off {:.1} on {:.1}, prepass grass {:.1} ground {:.1}, bent near {bent_near:.1} far {bent_far:.1}",
+        sun_off[0], reference[0], grass_off[1], reference[1], prepass[2], prepass[1]
+    );
+    // Each check holds only when its comparison does (a NaN region fails it).
+    let checks = [
+        (
+            reference[0] < 0.85 * sun_off[0],
+            "the grass the box shades is not darker with the sun's shadows on",
+        ),
+        (
+            reference[1] < 0.85 * grass_off[1],
+            "the ground behind the grass is not darker when the grass casts shadows",
+        ),
+        (
+            (prepass[2] - prepass[1]).abs() > 10.0,
+            "with the prepasses and SSAO the grass is not drawn",
+        ),
+        (
+            luminance_variance(straight) >= 20.0,
+            "the screenshot with the prepasses and SSAO is blank",
+        ),
+        (
+            bent_near > 12.0 && bent_near > 3.0 * bent_far,
+            "the blades around the bender did not lie down",
+        ),
+    ];
+    let mut ok = true;
+    for (holds, what) in checks {
+        if !holds {
+            eprintln!("rwt-passes: FAIL {what}");
+            ok = false;
+        }
+    }
+    ok
+}
+
+/// Mean absolute change (0..255, over the channels) of the pixels around `at` from `a` to
+/// `b`.
+fn region_change(a: &Image, b: &Image, at: Vec2) -> f32 {
+    let (cx, cy) = (at.x as i32, at.y as i32);
+    let r = 3 * REGION;
+    let mut sum = 0.0;
+    let mut n = 0.0;
+    for y in (cy - r).max(0)..(cy + r).min(a.height() as i32) {
+        for x in (cx - r).max(0)..(cx + r).min(a.width() as i32) {
+            if let (Ok(p), Ok(q)) = (
+                a.get_color_at(x as u32, y as u32),
+                b.get_color_at(x as u32, y as u32),
+            ) {
+                let (p, q) = (p.to_srgba(), q.to_srgba());
+                sum += 255.0
+                    * ((p.red - q.red).abs() + (p.green - q.green).abs() + (p.blue - q.blue).abs())
+                    / 3.0;
+                n += 1.0;
+            }
+        }
+    }
+    if n > 0.0 { sum / n } else { f32::NAN }
+}
+
+fn luminance_variance(image: &Image) -> f32 {
+    let (mut sum, mut sq, mut n) = (0.0f64, 0.0f64, 0.0f64);
+    for y in (0..image.height()).step_by(4) {
+        for x in (0..image.width()).step_by(4) {
+            if let Ok(c) = image.get_color_at(x, y) {
+                let c = c.to_srgba();
+                let l = 255.0 * (0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue) as f64;
+                sum += l;
+                sq += l * l;
+                n += 1.0;
+            }
+        }
+    }
+    if n == 0.0 {
+        return 0.0;
+    }
+    let mean = sum / n;
+    (sq / n - mean * mean) as f32
+}
