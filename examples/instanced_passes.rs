@@ -1,9 +1,10 @@
 //! Instanced grass inside Bevy's renderer, checked on screen (`scripts/smoke.sh` runs it
 //! under Xvfb and lavapipe): `cargo run --example instanced_passes`.
 //!
-//! A field of tall instanced grass, a box beside it and a low sun. Four screenshots of the
-//! same scene, each compared region by region:
-//! 1. shadows on: the reference;
+//! A field of tall instanced grass, a box beside it, a few textured cards lying on the
+//! ground and a low sun. Five screenshots of the same scene, each compared region by region:
+//! 1. shadows on: the reference; each card (found by picking) shows its texture's red disc
+//!    at its centre and the ground at its corners, where the texture's alpha cuts it out;
 //! 2. the sun's shadows off: the grass the box shades must be brighter there, so the
 //!    grass receives shadows;
 //! 3. the grass class's shadows off ([`InstancedShadows::Off`]): the bare ground just
@@ -13,9 +14,10 @@
 //! 5. a [`Bender`] standing in the grass: the blades around it must lie down (the pixels
 //!    around it change much more than pixels of grass far from it).
 //!
-//! It prints `rwt-passes: receive lit L shadowed S, cast off L on S, prepass grass G ground
-//! B, bent near N far F` (mean luminances, 0..255; mean pixel changes for the bender) and
-//! exits with an error when a check fails. Screenshots go to `RWT_PASSES_DIR` (default
+//! It prints `rwt-passes: cards C cut out K, receive lit L shadowed S, cast off L on S,
+//! prepass grass G ground B, bent near N far F` (cards drawn and cut out as their texture
+//! says; mean luminances, 0..255; mean pixel changes for the bender) and exits with an error
+//! when a check fails. Screenshots go to `RWT_PASSES_DIR` (default
 //! `target/passes`).
 
 use bevy::app::AppExit;
@@ -37,6 +39,10 @@ const FIELD: (DVec2, DVec2) = (DVec2::new(0.0, -6.0), DVec2::new(6.0, 6.0));
 /// Ground points compared: grass the box shades, and bare ground the grass shades.
 const UNDER_BOX: Vec3 = Vec3::new(4.3, 0.35, 0.0);
 const BEHIND_GRASS: Vec3 = Vec3::new(-0.45, 0.0, 2.5);
+/// Where the textured cards lie (a few in a small square), their side and height.
+const CARDS: (DVec2, DVec2) = (DVec2::new(-3.6, -1.6), DVec2::new(-2.4, -0.4));
+const CARD: f32 = 0.8;
+const CARD_HEIGHT: f32 = 0.05;
 /// Where the bender stands, and grass far from it.
 const BENDER: Vec3 = Vec3::new(2.0, 0.0, 2.0);
 const FAR_GRASS: Vec3 = Vec3::new(3.5, 0.6, -3.5);
@@ -45,14 +51,14 @@ const REGION: i32 = 5;
 /// Frames each step waits once streaming has settled (pipelines compile on the CPU).
 const WAIT: u32 = 12;
 
-fn main() {
+fn main() -> AppExit {
     App::new()
         .add_plugins(example_plugins("rwt instanced_passes"))
         .add_plugins(RwtPlugin::default())
         .init_resource::<Check>()
         .add_systems(Startup, setup)
         .add_systems(Update, run_check)
-        .run();
+        .run()
 }
 
 /// A constant density over a rectangle, none outside.
@@ -78,6 +84,7 @@ fn setup(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    mut images: ResMut<Assets<Image>>,
 ) {
     commands.spawn((
         Camera3d::default(),
@@ -131,6 +138,73 @@ fn setup(
         Name::new("grass"),
         ScatterLayer::new(vec![grass]).with_seed(7),
     ));
+    let cards = ScatterClass::instanced(
+        LayerDensity::Custom(Arc::new(Rectangle {
+            min: CARDS.0,
+            max: CARDS.1,
+            density: 3.0,
+        })),
+        meshes.add(card_mesh()),
+        InstancedMaterial {
+            base_color: Color::WHITE,
+            tip_color: Color::WHITE,
+            color_variation: 0.0,
+            texture: Some(images.add(disc_texture())),
+            ..default()
+        },
+    );
+    commands.spawn((
+        Name::new("cards"),
+        ScatterLayer::new(vec![cards]).with_seed(2),
+    ));
+}
+
+/// A square card lying flat just above the ground, with UVs.
+fn card_mesh() -> Mesh {
+    let h = CARD / 2.0;
+    Mesh::new(
+        bevy::mesh::PrimitiveTopology::TriangleList,
+        bevy::asset::RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(
+        Mesh::ATTRIBUTE_POSITION,
+        vec![
+            [-h, CARD_HEIGHT, -h],
+            [h, CARD_HEIGHT, -h],
+            [h, CARD_HEIGHT, h],
+            [-h, CARD_HEIGHT, h],
+        ],
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0, 1.0, 0.0]; 4])
+    .with_inserted_attribute(
+        Mesh::ATTRIBUTE_UV_0,
+        vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+    )
+    .with_inserted_indices(bevy::mesh::Indices::U16(vec![0, 2, 1, 0, 3, 2]))
+}
+
+/// A red disc on a transparent square.
+fn disc_texture() -> Image {
+    let n = 64u32;
+    let mut data = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let d = Vec2::new(x as f32 + 0.5, y as f32 + 0.5).distance(Vec2::splat(n as f32 / 2.0));
+            let inside = d < 0.35 * n as f32;
+            data.extend_from_slice(&[220, 30, 30, if inside { 255 } else { 0 }]);
+        }
+    }
+    Image::new(
+        bevy::render::render_resource::Extent3d {
+            width: n,
+            height: n,
+            depth_or_array_layers: 1,
+        },
+        bevy::render::render_resource::TextureDimension::D2,
+        data,
+        bevy::render::render_resource::TextureFormat::Rgba8UnormSrgb,
+        bevy::asset::RenderAssetUsages::default(),
+    )
 }
 
 /// Where the check stands.
@@ -145,6 +219,8 @@ struct Check {
     /// The screenshots before and with the bender, and where their regions are seen.
     bent: Vec<Image>,
     bent_regions: Vec<Vec2>,
+    /// Cards seen, and those whose centre showed the texture and corners the ground.
+    cards: (usize, usize),
     pending: Option<Arc<std::sync::Mutex<Option<Image>>>>,
 }
 
@@ -167,6 +243,7 @@ struct Scene<'w, 's> {
     suns: Query<'w, 's, &'static mut DirectionalLight>,
     layers: Query<'w, 's, (Entity, &'static ScatterLayer)>,
     exit: MessageWriter<'w, AppExit>,
+    picking: ScatterPicking<'w, 's>,
 }
 
 fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands) {
@@ -193,6 +270,9 @@ fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands)
                 .filter_map(|p| camera.world_to_viewport(at, *p).ok())
                 .collect();
         }
+        if check.step == Step::Reference {
+            check.cards = cards_cut_out(&image, camera, at, &scene.picking);
+        }
         save(&image, check.step);
         check.pending = None;
         check.step = next(check.step, &mut scene, &mut commands);
@@ -217,6 +297,54 @@ fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands)
         );
         check.pending = Some(slot);
     }
+}
+
+/// Every card (found by picking), and how many show the texture's red disc at their centre
+/// and the ground at their four corners (cut out).
+fn cards_cut_out(
+    image: &Image,
+    camera: &Camera,
+    at: &GlobalTransform,
+    picking: &ScatterPicking,
+) -> (usize, usize) {
+    let centre = ((CARDS.0 + CARDS.1) / 2.0).as_vec2();
+    let cards = picking.near(centre, 2.0, &PickFilter::default().classes([0]));
+    let red = |p: Vec3| {
+        let Ok(c) = camera.world_to_viewport(at, p) else {
+            return None;
+        };
+        let c = image.get_color_at(c.x as u32, c.y as u32).ok()?.to_srgba();
+        Some(c.red > c.green + 0.2 && c.red > c.blue + 0.2)
+    };
+    // A corner over another card's disc shows red rightly: such corners are not judged.
+    let disc = 0.35 * CARD;
+    let over_a_disc = |p: Vec3, own: usize| {
+        cards.iter().enumerate().any(|(i, other)| {
+            let local = other
+                .transform
+                .compute_affine()
+                .inverse()
+                .transform_point3(p);
+            i != own && local.xz().length() < disc * 1.2
+        })
+    };
+    let cut = cards
+        .iter()
+        .enumerate()
+        .filter(|(own, hit)| {
+            let t = hit.transform;
+            let on_card = |u: f32, v: f32| t.transform_point(Vec3::new(u, CARD_HEIGHT, v));
+            let corner = 0.45 * CARD;
+            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .map(|(u, v)| on_card(u * corner, v * corner))
+                .map(|p| (over_a_disc(p, *own), red(p)));
+            red(on_card(0.0, 0.0)) == Some(true)
+                && corners
+                    .iter()
+                    .all(|(over, red)| *over || *red == Some(false))
+        })
+        .count();
+    (cards.len(), cut)
 }
 
 /// Makes the change of the step after `step`, and returns it.
@@ -323,12 +451,17 @@ fn report(check: &Check) -> bool {
     };
     let change = |at: Vec2| region_change(straight, bent, at);
     let (bent_near, bent_far) = (change(*near), change(*far));
+    let (cards, cut) = check.cards;
     println!(
-        "rwt-passes: receive lit {:.1} shadowed {:.1}, cast off {:.1} on {:.1}, prepass grass {:.1} ground {:.1}, bent near {bent_near:.1} far {bent_far:.1}",
+        "rwt-passes: cards {cards} cut out {cut}, receive lit {:.1} shadowed {:.1}, cast off {:.1} on {:.1}, prepass grass {:.1} ground {:.1}, bent near {bent_near:.1} far {bent_far:.1}",
         sun_off[0], reference[0], grass_off[1], reference[1], prepass[2], prepass[1]
     );
     // Each check holds only when its comparison does (a NaN region fails it).
     let checks = [
+        (
+            cards > 0 && cut == cards,
+            "a textured card does not show its texture, or is not cut out by its alpha",
+        ),
         (
             reference[0] < 0.85 * sun_off[0],
             "the grass the box shades is not darker with the sun's shadows on",

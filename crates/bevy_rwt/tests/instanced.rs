@@ -7,6 +7,7 @@ mod common;
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::PrimitiveTopology;
 use bevy::prelude::*;
+use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy_rwt::instancing::InstancedChunk;
 use bevy_rwt::look::InstancedClassError;
 use bevy_rwt::prelude::*;
@@ -309,4 +310,124 @@ fn chunk_bounds_follow_a_mesh_that_loads_late() {
         after.iter().all(|&(top, y)| top == 5.0 && y > 4.9),
         "{after:?}"
     );
+}
+
+/// An image of `layers` layers of 4×4 texels in `format`, filled with zeros.
+fn texture(dimension: TextureDimension, layers: u32, format: TextureFormat) -> Image {
+    let size = Extent3d {
+        width: 4,
+        height: 4,
+        depth_or_array_layers: layers,
+    };
+    let texel = vec![0; format.block_copy_size(None).unwrap() as usize];
+    Image::new_fill(size, dimension, &texel, format, RenderAssetUsages::all())
+}
+
+#[test]
+fn textures_that_cannot_be_drawn_are_reported_per_class() {
+    use InstancedClassError::*;
+    let mut app = create_app_with(|app| {
+        app.init_asset::<Mesh>();
+    });
+    let list = PrimitiveTopology::TriangleList;
+    let with_uvs =
+        mesh(list, 3, 3).with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, vec![[0.0f32; 2]; 3]);
+    let mut meshes = app.world_mut().resource_mut::<Assets<Mesh>>();
+    let (uvs, no_uvs) = (meshes.add(with_uvs), meshes.add(mesh(list, 3, 3)));
+    let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+    let d2 = TextureDimension::D2;
+    let good = images.add(texture(d2, 1, TextureFormat::Rgba8UnormSrgb));
+    let integer = images.add(texture(d2, 1, TextureFormat::R32Uint));
+    let volume = images.add(texture(TextureDimension::D3, 4, TextureFormat::Rgba8Unorm));
+    let class = |mesh: &Handle<Mesh>, image: Option<&Handle<Image>>| {
+        let material = InstancedMaterial {
+            texture: image.cloned(),
+            ..default()
+        };
+        ScatterClass::instanced(LayerDensity::Constant(0.1), mesh.clone(), material)
+    };
+    let mut l = layer(LayerDensity::Constant(0.0));
+    l.classes = vec![
+        class(&uvs, Some(&good)),
+        class(&no_uvs, Some(&good)),
+        class(&uvs, Some(&integer)),
+        class(&uvs, Some(&volume)),
+        class(&no_uvs, None),
+    ];
+    app.world_mut().spawn(l);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    tick_app(&mut app, 4_000);
+    let integer_error = Texture {
+        dimension: d2,
+        layers: 1,
+        format: TextureFormat::R32Uint,
+    };
+    assert_eq!(
+        class_errors(&mut app),
+        [
+            (1, MissingUvs),
+            (2, integer_error),
+            (
+                3,
+                Texture {
+                    dimension: TextureDimension::D3,
+                    layers: 4,
+                    format: TextureFormat::Rgba8Unorm,
+                }
+            )
+        ]
+    );
+    // The classes stream all the same; a fixed texture is checked again.
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    let classes: HashSet<u16> = chunks.iter(app.world()).map(|c| c.class).collect();
+    assert_eq!(classes.len(), 5);
+    let mut images = app.world_mut().resource_mut::<Assets<Image>>();
+    *images.get_mut(&volume).unwrap() = texture(d2, 1, TextureFormat::Rgba8Unorm);
+    app.update();
+    assert_eq!(class_errors(&mut app).len(), 2);
+}
+
+#[test]
+fn far_chunks_draw_the_far_mesh_and_near_ones_the_class_mesh() {
+    let mut app = create_app_with(|app| {
+        app.init_asset::<Mesh>();
+    });
+    let list = PrimitiveTopology::TriangleList;
+    let mut meshes = app.world_mut().resource_mut::<Assets<Mesh>>();
+    // Small meshes: a chunk's bounds grow by its mesh's reach.
+    let small = |n| mesh(list, n, 0).scaled_by(Vec3::splat(0.1));
+    let (near, far) = (meshes.add(small(6)), meshes.add(small(3)));
+    let class = ScatterClass::instanced(LayerDensity::Constant(0.5), near.clone(), default())
+        .with_instanced_far(far.clone(), 12.0);
+    let mut l = layer(LayerDensity::Constant(0.0));
+    l.classes = vec![class];
+    app.world_mut().spawn(l);
+    let viewer = spawn_viewer(&mut app, Vec3::ZERO);
+    tick_app(&mut app, 4_000);
+    // Each chunk's mesh follows the distance from the viewer to its bounds, with the
+    // hysteresis around the boundary; its bounds hold both meshes' bounds.
+    let check = |app: &mut App, eye: Vec3| {
+        let mut q = app
+            .world_mut()
+            .query::<(&InstancedChunk, &Transform, &bevy::camera::primitives::Aabb)>();
+        let (mut n, mut f) = (0, 0);
+        for (chunk, at, aabb) in q.iter(app.world()) {
+            let centre = Vec3::from(aabb.center) + at.translation;
+            let gap = ((centre - eye).abs() - Vec3::from(aabb.half_extents)).max(Vec3::ZERO);
+            let d = gap.length();
+            if d < 12.0 / 1.05 {
+                assert_eq!(chunk.mesh, near, "a chunk {d} m away");
+                n += 1;
+            } else if d > 12.0 * 1.05 {
+                assert_eq!(chunk.mesh, far, "a chunk {d} m away");
+                f += 1;
+            }
+        }
+        assert!(n > 0 && f > 0, "near {n} far {f}");
+    };
+    check(&mut app, Vec3::ZERO);
+    let eye = Vec3::new(40.0, 0.0, 8.0);
+    move_viewer(&mut app, viewer, eye);
+    tick_app(&mut app, 4_000);
+    check(&mut app, eye);
 }

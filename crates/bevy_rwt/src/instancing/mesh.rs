@@ -3,7 +3,10 @@
 
 use super::InstancedChunk;
 use crate::layers::{ScatterLayer, ScatterLayerStatus};
-use crate::look::{ClassLook, GroundPlane, InstancedClassError, check_instanced_mesh};
+use crate::look::{
+    ClassLook, GroundPlane, InstancedClassError, InstancedFar, InstancedLook, check_instanced_mesh,
+    check_texture,
+};
 use bevy::camera::primitives::Aabb;
 use bevy::ecs::message::MessageCursor;
 use bevy::platform::collections::{HashMap, HashSet};
@@ -30,6 +33,22 @@ impl InstancedMeshes {
             self.0.insert(id, checked);
         }
         self.0.get(&id)
+    }
+
+    /// Bounds holding a class's near and far meshes (a chunk's `Aabb` holds either).
+    pub fn class_bounds(
+        &mut self,
+        (near, far): &(Handle<Mesh>, Option<InstancedFar>),
+        meshes: Option<&Assets<Mesh>>,
+    ) -> (Vec3, Vec3) {
+        let (lo, hi) = self.bounds(near, meshes);
+        match far {
+            Some(far) => {
+                let (far_lo, far_hi) = self.bounds(&far.mesh, meshes);
+                (lo.min(far_lo), hi.max(far_hi))
+            }
+            None => (lo, hi),
+        }
     }
 
     /// Bounds of `mesh` (a unit box standing on the ground while it is not loaded or cannot
@@ -73,11 +92,46 @@ pub(super) fn refit_changed_meshes(
         return;
     }
     for (mut chunk, mut aabb) in &mut chunks {
-        if changed.contains(&chunk.mesh.id()) {
-            let bounds = checked.bounds(&chunk.mesh, meshes.as_deref());
-            chunk.mesh_top = bounds.1.y.max(1e-3);
+        let (near, far) = &chunk.meshes;
+        let drawn = far.as_ref().map(|f| &f.mesh).into_iter().chain([near]);
+        if drawn.into_iter().any(|m| changed.contains(&m.id())) {
+            let top = checked.bounds(&chunk.mesh, meshes.as_deref()).1.y;
+            chunk.mesh_top = top.max(1e-3);
+            let bounds = checked.class_bounds(&chunk.meshes, meshes.as_deref());
             *aabb = chunk.aabb(bounds);
         }
+    }
+}
+
+/// The assets a class check reads (absent in apps without them).
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct ClassAssets<'w> {
+    meshes: Option<Res<'w, Assets<Mesh>>>,
+    images: Option<Res<'w, Assets<Image>>>,
+    server: Option<Res<'w, AssetServer>>,
+}
+
+impl ClassAssets<'_> {
+    /// Why `look`'s texture cannot be drawn with its mesh, if it cannot.
+    fn texture_error(&self, look: &InstancedLook) -> Option<InstancedClassError> {
+        let texture = look.material.texture.as_ref()?;
+        let mesh = self.meshes.as_deref().and_then(|m| m.get(&look.mesh));
+        // Render-world-only meshes keep no attributes here; the renderer skips them instead.
+        if let Some(mesh) = mesh.filter(|m| m.try_attributes().is_ok())
+            && !mesh.contains_attribute(Mesh::ATTRIBUTE_UV_0)
+        {
+            return Some(InstancedClassError::MissingUvs);
+        }
+        if let Some(image) = self.images.as_deref().and_then(|i| i.get(texture)) {
+            let d = &image.texture_descriptor;
+            return check_texture(d.dimension, d.size.depth_or_array_layers, d.format).err();
+        }
+        let failed = self
+            .server
+            .as_deref()
+            .and_then(|s| s.get_load_state(texture))
+            .is_some_and(|state| state.is_failed());
+        failed.then_some(InstancedClassError::TextureNotLoaded)
     }
 }
 
@@ -85,7 +139,7 @@ pub(super) fn refit_changed_meshes(
 pub(super) fn report_class_errors(
     mut layers: Query<(&ScatterLayer, &mut ScatterLayerStatus)>,
     mut checked: ResMut<InstancedMeshes>,
-    meshes: Option<Res<Assets<Mesh>>>,
+    assets: ClassAssets,
 ) {
     for (layer, mut status) in &mut layers {
         let errors: Vec<(u16, InstancedClassError)> = layer
@@ -99,10 +153,13 @@ pub(super) fn report_class_errors(
                 if layer.plane != GroundPlane::Xz {
                     return Some((i as u16, InstancedClassError::Plane(layer.plane)));
                 }
-                match checked.check(&look.mesh, meshes.as_deref()) {
-                    Some(Err(e)) => Some((i as u16, e.clone())),
-                    _ => None,
+                let far = look.far.as_ref().map(|f| &f.mesh);
+                for mesh in std::iter::once(&look.mesh).chain(far) {
+                    if let Some(Err(e)) = checked.check(mesh, assets.meshes.as_deref()) {
+                        return Some((i as u16, e.clone()));
+                    }
                 }
+                assets.texture_error(look).map(|e| (i as u16, e))
             })
             .collect();
         if status.class_errors != errors {

@@ -14,6 +14,7 @@
 //! band nor at the streaming edge.
 
 mod bend;
+mod far;
 mod mesh;
 mod pack;
 mod plugin;
@@ -131,8 +132,11 @@ pub struct InstancedChunk {
     pub chunk: ChunkCoord,
     /// The class index in the layer.
     pub class: u16,
-    /// The mesh every instance draws.
+    /// The mesh every instance draws now: the class's, or its far mesh while the chunk is
+    /// far from every camera (see [`InstancedFar`](crate::look::InstancedFar)).
     pub mesh: Handle<Mesh>,
+    /// The class's meshes: near, and far with its distance.
+    pub meshes: (Handle<Mesh>, Option<crate::look::InstancedFar>),
     /// The shading.
     pub material: InstancedMaterial,
     /// Height of the mesh's top above its origin (the tip, which sways most).
@@ -169,4 +173,10 @@ impl InstancedChunk {
         let max = hi + Vec3::new(horizontal, mesh_hi.y.max(0.0) * s, horizontal);
         Aabb::from_min_max(min, max)
     }
+}
+
+/// Distance from `point` to the box `aabb` (0 inside).
+pub(crate) fn distance_to_box(aabb: &Aabb, point: Vec3) -> f32 {
+    let d = (Vec3::from(aabb.center) - point).abs() - Vec3::from(aabb.half_extents);
+    d.max(Vec3::ZERO).length()
 }

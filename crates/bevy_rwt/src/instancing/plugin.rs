@@ -2,7 +2,7 @@
 //! every [`InstancedChunk`] with one instanced draw.
 
 use super::{BendField, Bender, InstancedChunk, InstancedMeshes, RwtFadeIn, RwtWind};
-use super::{bend, mesh, render};
+use super::{bend, far, mesh, render};
 use crate::settings::RwtSystems;
 use bevy::core_pipeline::core_3d::Opaque3d;
 use bevy::core_pipeline::prepass::Opaque3dPrepass;
@@ -35,7 +35,8 @@ impl Plugin for RwtInstancingPlugin {
                 (
                     mesh::refit_changed_meshes.before(RwtSystems::Apply),
                     bend::update_bend_field,
-                    mesh::report_class_errors
+                    (far::choose_chunk_meshes, mesh::report_class_errors)
+                        .chain()
                         .after(RwtSystems::Apply)
                         .before(RwtSystems::Stats),
                 ),

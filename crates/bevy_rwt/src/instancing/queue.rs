@@ -308,6 +308,7 @@ impl<'a> Upload<'a> {
             chunk: target.chunk,
             class,
             mesh: look.mesh.clone(),
+            meshes: (look.mesh.clone(), look.far.clone()),
             material: look.material.clone(),
             mesh_top: mesh_bounds.1.y.max(1e-3),
             max_scale: c.scale * (1.0 + c.scale_variation.abs()),
@@ -316,7 +317,7 @@ impl<'a> Upload<'a> {
                 .map(|f| (f.near as f32, f.far as f32, f.floor as f32)),
             buffer,
         };
-        let aabb = component.aabb(mesh_bounds);
+        let aabb = component.aabb(self.checked.class_bounds(&component.meshes, self.meshes));
         Some((component, aabb))
     }
 }

@@ -16,7 +16,8 @@ pub use status::{AssetStatus, ScatterLayerStatus};
 
 use crate::edits::ScatterEdits;
 use crate::look::{
-    ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, MeshLod,
+    ClassLook, GroundPlane, InstanceInserter, InstancedFar, InstancedLook, InstancedMaterial,
+    MeshLod,
 };
 use bevy::prelude::*;
 use rwt_core::density::{Constant, Density, NoiseDensity};
@@ -182,8 +183,21 @@ impl ScatterClass {
     ) -> Self {
         Self::with_look(
             density,
-            ClassLook::Instanced(InstancedLook { mesh, material }),
+            ClassLook::Instanced(InstancedLook {
+                mesh,
+                material,
+                far: None,
+            }),
         )
+    }
+
+    /// An instanced class draws `mesh` instead in chunks farther than `distance` from every
+    /// camera (see [`InstancedFar`]); other classes are returned unchanged.
+    pub fn with_instanced_far(mut self, mesh: Handle<Mesh>, distance: f32) -> Self {
+        if let ClassLook::Instanced(look) = &mut self.look {
+            look.far = Some(InstancedFar { mesh, distance });
+        }
+        self
     }
 
     /// Shows `mesh` and `material` instead from `distance` on, crossfading over a tenth of

@@ -4,6 +4,7 @@ use super::GroundPlane;
 use bevy::camera::primitives::MeshAabb;
 use bevy::mesh::{MeshAccessError, PrimitiveTopology};
 use bevy::prelude::*;
+use bevy::render::render_resource::{TextureDimension, TextureFormat, TextureSampleType};
 
 /// Why an instanced class cannot be drawn. Its chunks still stream and are counted; the
 /// renderer skips them until the mesh is fixed (a reloaded or edited mesh is checked again).
@@ -31,6 +32,46 @@ pub enum InstancedClassError {
     /// The layer lies on a plane the instanced path does not draw.
     #[error("instanced classes are drawn on GroundPlane::Xz only, not {0:?}")]
     Plane(GroundPlane),
+    /// The class has a texture but its mesh has no `Mesh::ATTRIBUTE_UV_0` to read it by.
+    #[error("the class has a texture but its mesh has no UV_0 coordinates")]
+    MissingUvs,
+    /// The texture is not one 2-D image of filterable colour.
+    #[error(
+        "the class's texture is a {dimension:?} image of {layers} layers in {format:?}; \
+         textures must be one 2-D layer of a filterable colour format"
+    )]
+    Texture {
+        /// Its dimension.
+        dimension: TextureDimension,
+        /// Its layers.
+        layers: u32,
+        /// Its format.
+        format: TextureFormat,
+    },
+    /// The texture did not load.
+    #[error("the class's texture did not load")]
+    TextureNotLoaded,
+}
+
+/// Whether an image of this shape and format can be a class's texture.
+pub(crate) fn check_texture(
+    dimension: TextureDimension,
+    layers: u32,
+    format: TextureFormat,
+) -> Result<(), InstancedClassError> {
+    let filterable = matches!(
+        format.sample_type(None, None),
+        Some(TextureSampleType::Float { filterable: true })
+    );
+    if dimension == TextureDimension::D2 && layers == 1 && filterable {
+        Ok(())
+    } else {
+        Err(InstancedClassError::Texture {
+            dimension,
+            layers,
+            format,
+        })
+    }
 }
 
 /// Bounds of a mesh that the instanced path can draw (min, max), or why it cannot; `None`

@@ -29,6 +29,9 @@ impl InstancedShadows {
     }
 }
 
+/// [`InstancedMaterial::alpha_cutoff`]'s default.
+pub const DEFAULT_ALPHA_CUTOFF: f32 = 0.5;
+
 /// How an instanced class is shaded: a blade-like gradient from root to tip, lit by the
 /// scene's lights, with a hashed colour variation per instance.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,6 +57,15 @@ pub struct InstancedMaterial {
     pub tip_from: f32,
     /// Whether the class casts shadows.
     pub shadows: InstancedShadows,
+    /// A base-colour texture (with alpha), read at the mesh's first UV coordinates and
+    /// multiplied by the root-to-tip colour (white `base_color` and `tip_color` show it as
+    /// it is): flower heads, fern fronds, leaf cards. Where its alpha is below
+    /// `alpha_cutoff` the instance is cut out, in every pass (shadows and prepasses too).
+    /// The mesh needs `Mesh::ATTRIBUTE_UV_0`; the image one 2-D layer of a filterable colour
+    /// format (otherwise an [`InstancedClassError`](crate::look::InstancedClassError)).
+    pub texture: Option<Handle<Image>>,
+    /// Alpha below which a textured instance is cut out (0..1).
+    pub alpha_cutoff: f32,
     /// How far instances lean where a [`Bender`](crate::instancing::Bender) passed, as a
     /// fraction of the field's lean (1 lays a blade flat where the field says so); 0 for
     /// instances that do not bend (pebbles).
@@ -72,6 +84,8 @@ impl Default for InstancedMaterial {
             tip_from: 0.0,
             shadows: InstancedShadows::default(),
             bend_response: 1.0,
+            texture: None,
+            alpha_cutoff: DEFAULT_ALPHA_CUTOFF,
         }
     }
 }
@@ -84,4 +98,34 @@ pub struct InstancedLook {
     pub mesh: Handle<Mesh>,
     /// Its shading.
     pub material: InstancedMaterial,
+    /// A cheaper mesh for far chunks, if any.
+    pub far: Option<InstancedFar>,
+}
+
+/// The far level of detail of an instanced class: chunks whose bounds lie farther than
+/// `distance` from every camera draw `mesh` instead of the class's (chosen per chunk, with
+/// [`InstancedFar::HYSTERESIS`] against flicker at the boundary). The fade-in by rank keeps
+/// growing and shrinking instances across the change.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstancedFar {
+    /// The far mesh (same conventions as the class's: y up, root at its lowest point).
+    pub mesh: Handle<Mesh>,
+    /// Distance from the camera to a chunk's bounds from which it draws the far mesh.
+    pub distance: f32,
+}
+
+impl InstancedFar {
+    /// A chunk turns far beyond `distance * HYSTERESIS` and near again within
+    /// `distance / HYSTERESIS`.
+    pub const HYSTERESIS: f32 = 1.05;
+
+    /// Whether a chunk `distance` from the nearest camera draws the far mesh, given whether
+    /// it does now.
+    pub fn is_far(&self, distance: f32, far_now: bool) -> bool {
+        if far_now {
+            distance > self.distance / Self::HYSTERESIS
+        } else {
+            distance > self.distance * Self::HYSTERESIS
+        }
+    }
 }

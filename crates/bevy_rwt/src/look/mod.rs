@@ -9,9 +9,11 @@ mod check;
 mod instanced;
 
 pub use blade::blade_mesh;
-pub(crate) use check::check_topology;
 pub use check::{InstancedClassError, check_instanced_mesh};
-pub use instanced::{InstancedLook, InstancedMaterial, InstancedShadows};
+pub(crate) use check::{check_texture, check_topology};
+pub use instanced::{
+    DEFAULT_ALPHA_CUTOFF, InstancedFar, InstancedLook, InstancedMaterial, InstancedShadows,
+};
 
 use bevy::camera::visibility::VisibilityRange;
 use bevy::prelude::*;

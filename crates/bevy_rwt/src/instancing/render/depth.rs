@@ -5,11 +5,12 @@
 //! written: under a deferred camera chunks are drawn forward.
 
 use super::draw::{DrawChunkInstances, SetChunkBindGroup};
-use super::main_pass::mesh_bin;
+use super::main_pass::{mesh_attributes, mesh_bin};
 use super::{
-    ChunkBindings, ExtractedChunk, InstancedChunk, MainViewer, Queued, ReportedMeshes,
-    instance_layout, specialize, topology_key,
+    ChunkBindings, ChunkPipelines, ExtractedChunk, MainViewer, Queued, instance_layout,
+    visible_chunks,
 };
+use crate::instancing::distance_to_box;
 use crate::look::InstancedShadows;
 use bevy::camera::primitives::{Aabb, Frustum};
 use bevy::camera::visibility::RenderLayers;
@@ -24,9 +25,7 @@ use bevy::pbr::{
     SetPrepassViewEmptyBindGroup, Shadow, ShadowBatchSetKey, ShadowBinKey, ViewKeyPrepassCache,
 };
 use bevy::prelude::*;
-use bevy::render::mesh::RenderMesh;
 use bevy::render::mesh::allocator::MeshSlabs;
-use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_phase::{DrawFunctions, SetItemPipeline, ViewBinnedRenderPhases};
 use bevy::render::render_resource::*;
 use bevy::render::sync_world::MainEntity;
@@ -55,6 +54,8 @@ pub(in crate::instancing) struct InstancedDepthPipeline {
 pub(in crate::instancing) struct DepthKey {
     mesh: MeshPipelineKey,
     shadow: bool,
+    /// Whether the class is textured (its cut-out discards fragments here too).
+    textured: bool,
 }
 
 pub(in crate::instancing) fn init_depth_pipeline(
@@ -84,11 +85,7 @@ impl SpecializedMeshPipeline for InstancedDepthPipeline {
         let emulate_unclipped = k.contains(MeshPipelineKey::UNCLIPPED_DEPTH_ORTHO)
             && !self.prepass.depth_clip_control_supported;
         let mut defs: Vec<ShaderDefVal> = vec!["PREPASS_PIPELINE".into()];
-        let mut attributes = vec![Mesh::ATTRIBUTE_POSITION.at_shader_location(0)];
-        if layout.0.contains(Mesh::ATTRIBUTE_NORMAL) {
-            attributes.push(Mesh::ATTRIBUTE_NORMAL.at_shader_location(1));
-            defs.push("RWT_NORMALS".into());
-        }
+        let attributes = mesh_attributes(layout, key.textured, &mut defs);
         for (on, def) in [
             (normals, "NORMAL_PREPASS"),
             (motion, "MOTION_VECTOR_PREPASS"),
@@ -101,14 +98,16 @@ impl SpecializedMeshPipeline for InstancedDepthPipeline {
         }
         // Every prepass attachment, in the pass's order (None where unused).
         let targets = prepass_target_descriptors(normals, motion, false);
-        let fragment = (normals || motion || emulate_unclipped).then(|| {
+        let writes = normals || motion || emulate_unclipped;
+        if writes {
             defs.push("PREPASS_FRAGMENT".into());
-            FragmentState {
-                shader: self.bindings.shader.clone(),
-                shader_defs: defs.clone(),
-                targets: if normals || motion { targets } else { vec![] },
-                ..default()
-            }
+        }
+        // A textured class needs the fragment stage to cut out, even for depth alone.
+        let fragment = (writes || key.textured).then(|| FragmentState {
+            shader: self.bindings.shader.clone(),
+            shader_defs: defs.clone(),
+            targets: if normals || motion { targets } else { vec![] },
+            ..default()
         });
         let view_layout = if motion {
             self.prepass.view_layout_motion_vectors.clone()
@@ -156,57 +155,41 @@ impl SpecializedMeshPipeline for InstancedDepthPipeline {
 
 /// Bins every chunk visible from each view with a depth, normal or motion-vector prepass
 /// into its opaque prepass phase.
-#[allow(clippy::too_many_arguments)]
 pub(in crate::instancing) fn queue_prepass(
     draw_functions: Res<DrawFunctions<Opaque3dPrepass>>,
-    pipeline: Option<Res<InstancedDepthPipeline>>,
-    mut pipelines: ResMut<SpecializedMeshPipelines<InstancedDepthPipeline>>,
-    cache: Res<PipelineCache>,
-    meshes: Res<RenderAssets<RenderMesh>>,
+    mut pipelines: ChunkPipelines<InstancedDepthPipeline>,
     chunks: Query<&ExtractedChunk>,
     mut phases: ResMut<ViewBinnedRenderPhases<Opaque3dPrepass>>,
     views: Query<(&ExtractedView, &RenderVisibleEntities)>,
     view_keys: Res<ViewKeyPrepassCache>,
-    mut reported: ResMut<ReportedMeshes>,
     mut queued: ResMut<Queued<Opaque3dPrepass>>,
 ) {
-    let Some(pipeline) = pipeline else { return };
     let draw = draw_functions.read().id::<DrawInstancedDepth>();
     for (view, visible) in &views {
         let Some(phase) = phases.get_mut(&view.retained_view_entity) else {
             continue;
         };
         let view_key = view_keys.get(&view.retained_view_entity).copied();
-        let visible = visible
-            .get::<InstancedChunk>()
-            .map(|v| v.entities_cpu_culling.as_slice())
-            .unwrap_or_default();
-        let items = visible.iter().filter_map(|&(entity, main_entity)| {
-            let chunk = chunks.get(entity).ok()?;
-            let mesh = meshes.get(chunk.mesh)?;
-            let key = DepthKey {
-                mesh: view_key? | topology_key(mesh),
-                shadow: false,
-            };
-            let id = specialize(
-                &mut pipelines,
-                &cache,
-                &pipeline,
-                key,
-                (chunk.mesh, mesh),
-                &mut reported,
-            )?;
-            let batch_set = OpaqueNoLightmap3dBatchSetKey {
-                draw_function: draw,
-                pipeline: id,
-                material_bind_group_index: None,
-                slabs: MeshSlabs::default(),
-            };
-            let bin = OpaqueNoLightmap3dBinKey {
-                asset_id: mesh_bin(chunk.mesh),
-            };
-            Some((batch_set, bin, (entity, main_entity)))
-        });
+        let items = visible_chunks(visible)
+            .iter()
+            .filter_map(|&(entity, main_entity)| {
+                let (chunk, view_key) = (chunks.get(entity).ok()?, view_key?);
+                let id = pipelines.of(chunk, |topology| DepthKey {
+                    mesh: view_key | topology,
+                    shadow: false,
+                    textured: chunk.texture.is_some(),
+                })?;
+                let batch_set = OpaqueNoLightmap3dBatchSetKey {
+                    draw_function: draw,
+                    pipeline: id,
+                    material_bind_group_index: None,
+                    slabs: MeshSlabs::default(),
+                };
+                let bin = OpaqueNoLightmap3dBinKey {
+                    asset_id: mesh_bin(chunk.mesh),
+                };
+                Some((batch_set, bin, (entity, main_entity)))
+            });
         queued.rebin(view.retained_view_entity, phase, items.collect::<Vec<_>>());
     }
     queued.end_frame();
@@ -225,19 +208,14 @@ type ShadowView<'a> = (
 #[allow(clippy::too_many_arguments)]
 pub(in crate::instancing) fn queue_shadows(
     draw_functions: Res<DrawFunctions<Shadow>>,
-    pipeline: Option<Res<InstancedDepthPipeline>>,
-    mut pipelines: ResMut<SpecializedMeshPipelines<InstancedDepthPipeline>>,
-    cache: Res<PipelineCache>,
-    meshes: Res<RenderAssets<RenderMesh>>,
+    mut pipelines: ChunkPipelines<InstancedDepthPipeline>,
     chunks: Query<(Entity, &MainEntity, &ExtractedChunk)>,
     mut phases: ResMut<ViewBinnedRenderPhases<Shadow>>,
     views: Query<ShadowView, With<LightEntity>>,
     light_keys: Res<LightKeyCache>,
     viewer: Res<MainViewer>,
-    mut reported: ResMut<ReportedMeshes>,
     mut queued: ResMut<Queued<Shadow>>,
 ) {
-    let Some(pipeline) = pipeline else { return };
     let draw = draw_functions.read().id::<DrawInstancedDepth>();
     let casting: Vec<_> = chunks
         .iter()
@@ -256,19 +234,12 @@ pub(in crate::instancing) fn queue_shadows(
                 frustum.is_none_or(|f| f.intersects_obb_identity(&chunk.bounds))
             })
             .filter_map(|&(entity, main_entity, chunk)| {
-                let mesh = meshes.get(chunk.mesh)?;
-                let key = DepthKey {
-                    mesh: light_key? | topology_key(mesh),
+                let light_key = light_key?;
+                let id = pipelines.of(chunk, |topology| DepthKey {
+                    mesh: light_key | topology,
                     shadow: true,
-                };
-                let id = specialize(
-                    &mut pipelines,
-                    &cache,
-                    &pipeline,
-                    key,
-                    (chunk.mesh, mesh),
-                    &mut reported,
-                )?;
+                    textured: chunk.texture.is_some(),
+                })?;
                 let batch_set = ShadowBatchSetKey {
                     pipeline: id,
                     draw_function: draw,
@@ -293,14 +264,8 @@ fn casts(chunk: &ExtractedChunk, viewer: Option<Vec3>) -> bool {
 /// Whether `shadows` cast for bounds `aabb` seen from `viewer` (at any distance when there
 /// is no camera).
 fn shadows_at(aabb: &Aabb, shadows: InstancedShadows, viewer: Option<Vec3>) -> bool {
-    let distance = viewer.map_or(0.0, |eye| distance_to(aabb, eye));
+    let distance = viewer.map_or(0.0, |eye| distance_to_box(aabb, eye));
     shadows.casts_at(distance)
-}
-
-/// Distance from `point` to the box (0 inside).
-fn distance_to(aabb: &Aabb, point: Vec3) -> f32 {
-    let d = (Vec3::from(aabb.center) - point).abs() - Vec3::from(aabb.half_extents);
-    d.max(Vec3::ZERO).length()
 }
 
 #[cfg(test)]
@@ -310,9 +275,9 @@ mod tests {
     #[test]
     fn a_chunk_casts_by_its_class_setting_and_its_distance_to_the_camera() {
         let bounds = Aabb::from_min_max(Vec3::new(10.0, 0.0, 0.0), Vec3::new(26.0, 1.0, 16.0));
-        assert_eq!(distance_to(&bounds, Vec3::new(15.0, 0.5, 5.0)), 0.0);
-        assert_eq!(distance_to(&bounds, Vec3::new(0.0, 1.0, 8.0)), 10.0);
-        assert_eq!(distance_to(&bounds, Vec3::new(29.0, 5.0, 16.0)), 5.0);
+        assert_eq!(distance_to_box(&bounds, Vec3::new(15.0, 0.5, 5.0)), 0.0);
+        assert_eq!(distance_to_box(&bounds, Vec3::new(0.0, 1.0, 8.0)), 10.0);
+        assert_eq!(distance_to_box(&bounds, Vec3::new(29.0, 5.0, 16.0)), 5.0);
         let near = |shadows| {
             let eye = Some(Vec3::new(-20.0, 1.0, 8.0));
             shadows_at(&bounds, shadows, eye)

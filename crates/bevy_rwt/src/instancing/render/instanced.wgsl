@@ -30,7 +30,8 @@ struct Chunk {
     wind: vec4<f32>,
     // Wind speed.
     wind_motion: vec4<f32>,
-    // Height fraction where the tip colour starts, bend response, unused.
+    // Height fraction where the tip colour starts, bend response, alpha cut-off, 1 when
+    // textured.
     shading: vec4<f32>,
 };
 
@@ -48,11 +49,19 @@ struct Frame {
 // How far blades lean (x, z) around the main camera, where benders passed.
 @group(2) @binding(2) var bend_field: texture_2d<f32>;
 @group(2) @binding(3) var bend_sampler: sampler;
+#ifdef RWT_TEXTURE
+// The class's base-colour texture; alpha below the cut-off is cut out in every pass.
+@group(2) @binding(4) var base_texture: texture_2d<f32>;
+@group(2) @binding(5) var base_sampler: sampler;
+#endif
 
 struct Vertex {
     @location(0) position: vec3<f32>,
 #ifdef RWT_NORMALS
     @location(1) normal: vec3<f32>,
+#endif
+#ifdef RWT_TEXTURE
+    @location(2) uv: vec2<f32>,
 #endif
     // Offset from the chunk corner (xyz), scale (w).
     @location(8) offset_scale: vec4<f32>,
@@ -70,6 +79,9 @@ struct VertexOutput {
 #endif
 #ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
     @location(4) unclipped_depth: f32,
+#endif
+#ifdef RWT_TEXTURE
+    @location(5) uv: vec2<f32>,
 #endif
 };
 
@@ -198,12 +210,26 @@ fn vertex(in: Vertex) -> VertexOutput {
 #ifdef MOTION_VECTOR_PREPASS
     out.previous_world_position = vec4<f32>(place(in, globals.time - globals.delta_time).world, 1.0);
 #endif
+#ifdef RWT_TEXTURE
+    out.uv = in.uv;
+#endif
 #ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
     out.unclipped_depth = out.clip_position.z;
     out.clip_position.z = min(out.clip_position.z, 1.0);
 #endif
     return out;
 }
+
+#ifdef RWT_TEXTURE
+// The texture at the fragment, which is cut out where its alpha is below the cut-off.
+fn cut_out(uv: vec2<f32>) -> vec4<f32> {
+    let texel = textureSample(base_texture, base_sampler, uv);
+    if texel.a < chunk.shading.z {
+        discard;
+    }
+    return texel;
+}
+#endif
 
 #ifdef PREPASS_PIPELINE
 #ifdef PREPASS_FRAGMENT
@@ -221,6 +247,9 @@ struct FragmentOutput {
 
 @fragment
 fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> FragmentOutput {
+#ifdef RWT_TEXTURE
+    _ = cut_out(in.uv);
+#endif
     var out: FragmentOutput;
 #ifdef NORMAL_PREPASS
     out.normal = vec4<f32>(facing_normal(in.world_normal, is_front) * 0.5 + vec3<f32>(0.5), 1.0);
@@ -235,13 +264,25 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> Fragment
 #endif
     return out;
 }
+#else
+#ifdef RWT_TEXTURE
+// Depth alone (a shadow map, a depth prepass): only the cut-out.
+@fragment
+fn fragment(in: VertexOutput) {
+    _ = cut_out(in.uv);
+}
+#endif
 #endif
 #else
 @fragment
 fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
     let n = facing_normal(in.world_normal, is_front);
+    var color = in.color;
+#ifdef RWT_TEXTURE
+    color = vec4<f32>(color.rgb * cut_out(in.uv).rgb, 1.0);
+#endif
     var pbr_input = pbr_types::pbr_input_new();
-    pbr_input.material.base_color = in.color;
+    pbr_input.material.base_color = color;
     pbr_input.material.perceptual_roughness = chunk.params.y;
     pbr_input.material.reflectance = vec3<f32>(0.2);
     pbr_input.material.flags = pbr_types::STANDARD_MATERIAL_FLAGS_FOG_ENABLED_BIT;
@@ -251,9 +292,8 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @locatio
     pbr_input.N = n;
     pbr_input.V = pbr_functions::calculate_view(in.world_position, false);
     pbr_input.flags = MESH_FLAGS_SHADOW_RECEIVER_BIT;
-    var color = pbr_functions::apply_pbr_lighting(pbr_input);
-    color = pbr_functions::main_pass_post_lighting_processing(pbr_input, color);
-    return color;
+    let lit = pbr_functions::apply_pbr_lighting(pbr_input);
+    return pbr_functions::main_pass_post_lighting_processing(pbr_input, lit);
 }
 #endif
 

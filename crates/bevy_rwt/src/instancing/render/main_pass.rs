@@ -2,17 +2,14 @@
 
 use super::draw::DrawInstancedChunk;
 use super::{
-    ChunkBindings, ExtractedChunk, InstancedChunk, Queued, ReportedMeshes, instance_layout,
-    specialize, topology_key,
+    ChunkBindings, ChunkPipelines, ExtractedChunk, Queued, instance_layout, visible_chunks,
 };
 use bevy::asset::UntypedAssetId;
 use bevy::core_pipeline::core_3d::{Opaque3d, Opaque3dBatchSetKey, Opaque3dBinKey};
-use bevy::mesh::MeshVertexBufferLayoutRef;
+use bevy::mesh::{MeshVertexBufferLayoutRef, VertexAttributeDescriptor};
 use bevy::pbr::{MeshPipeline, MeshPipelineKey, ViewKeyCache};
 use bevy::prelude::*;
-use bevy::render::mesh::RenderMesh;
 use bevy::render::mesh::allocator::MeshSlabs;
-use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_phase::{DrawFunctions, ViewBinnedRenderPhases};
 use bevy::render::render_resource::*;
 use bevy::render::view::{ExtractedView, RenderVisibleEntities};
@@ -37,21 +34,25 @@ pub(in crate::instancing) fn init_main_pipeline(
     });
 }
 
+/// A main-pass pipeline's key: the view's and mesh's bits, and whether the class is
+/// textured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(in crate::instancing) struct InstancedKey {
+    mesh: MeshPipelineKey,
+    textured: bool,
+}
+
 impl SpecializedMeshPipeline for InstancedPipeline {
-    type Key = MeshPipelineKey;
+    type Key = InstancedKey;
 
     fn specialize(
         &self,
         key: Self::Key,
         layout: &MeshVertexBufferLayoutRef,
     ) -> Result<RenderPipelineDescriptor, SpecializedMeshPipelineError> {
-        let mut descriptor = self.mesh_pipeline.specialize(key, layout)?;
-        let mut attributes = vec![Mesh::ATTRIBUTE_POSITION.at_shader_location(0)];
+        let mut descriptor = self.mesh_pipeline.specialize(key.mesh, layout)?;
         let mut defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 3)];
-        if layout.0.contains(Mesh::ATTRIBUTE_NORMAL) {
-            attributes.push(Mesh::ATTRIBUTE_NORMAL.at_shader_location(1));
-            defs.push("RWT_NORMALS".into());
-        }
+        let attributes = mesh_attributes(layout, key.textured, &mut defs);
         descriptor.vertex.buffers = vec![layout.0.get_layout(&attributes)?, instance_layout()];
         descriptor.vertex.shader = self.bindings.shader.clone();
         descriptor.vertex.shader_defs.extend(defs.iter().cloned());
@@ -68,24 +69,39 @@ impl SpecializedMeshPipeline for InstancedPipeline {
     }
 }
 
+/// The mesh attributes a pipeline reads (position; normals when the mesh has them; UVs when
+/// the class is textured), with the shader definitions they need.
+pub(super) fn mesh_attributes(
+    layout: &MeshVertexBufferLayoutRef,
+    textured: bool,
+    defs: &mut Vec<ShaderDefVal>,
+) -> Vec<VertexAttributeDescriptor> {
+    let mut attributes = vec![Mesh::ATTRIBUTE_POSITION.at_shader_location(0)];
+    if layout.0.contains(Mesh::ATTRIBUTE_NORMAL) {
+        attributes.push(Mesh::ATTRIBUTE_NORMAL.at_shader_location(1));
+        defs.push("RWT_NORMALS".into());
+    }
+    if textured {
+        // A mesh without UVs fails the layout, and the class is reported once.
+        attributes.push(Mesh::ATTRIBUTE_UV_0.at_shader_location(2));
+        defs.push("RWT_TEXTURE".into());
+    }
+    attributes
+}
+
 /// The bin of a chunk's mesh in the binned phases.
 pub(super) fn mesh_bin(mesh: AssetId<Mesh>) -> UntypedAssetId {
     mesh.untyped()
 }
 
 /// Bins every chunk visible from each view (culled by its `Aabb`) into the opaque phase.
-#[allow(clippy::too_many_arguments)]
 pub(in crate::instancing) fn queue_main(
     draw_functions: Res<DrawFunctions<Opaque3d>>,
-    pipeline: Res<InstancedPipeline>,
-    mut pipelines: ResMut<SpecializedMeshPipelines<InstancedPipeline>>,
-    cache: Res<PipelineCache>,
-    meshes: Res<RenderAssets<RenderMesh>>,
+    mut pipelines: ChunkPipelines<InstancedPipeline>,
     chunks: Query<&ExtractedChunk>,
     mut phases: ResMut<ViewBinnedRenderPhases<Opaque3d>>,
     views: Query<(&ExtractedView, &RenderVisibleEntities)>,
     view_keys: Res<ViewKeyCache>,
-    mut reported: ResMut<ReportedMeshes>,
     mut queued: ResMut<Queued<Opaque3d>>,
 ) {
     let draw = draw_functions.read().id::<DrawInstancedChunk>();
@@ -94,34 +110,26 @@ pub(in crate::instancing) fn queue_main(
             continue;
         };
         let view_key = view_keys.get(&view.retained_view_entity).copied();
-        let visible = visible
-            .get::<InstancedChunk>()
-            .map(|v| v.entities_cpu_culling.as_slice())
-            .unwrap_or_default();
-        let items = visible.iter().filter_map(|&(entity, main_entity)| {
-            let chunk = chunks.get(entity).ok()?;
-            let mesh = meshes.get(chunk.mesh)?;
-            let key = view_key? | topology_key(mesh);
-            let id = specialize(
-                &mut pipelines,
-                &cache,
-                &pipeline,
-                key,
-                (chunk.mesh, mesh),
-                &mut reported,
-            )?;
-            let batch_set = Opaque3dBatchSetKey {
-                draw_function: draw,
-                pipeline: id,
-                material_bind_group_index: None,
-                slabs: MeshSlabs::default(),
-                lightmap_slab: None,
-            };
-            let bin = Opaque3dBinKey {
-                asset_id: mesh_bin(chunk.mesh),
-            };
-            Some((batch_set, bin, (entity, main_entity)))
-        });
+        let items = visible_chunks(visible)
+            .iter()
+            .filter_map(|&(entity, main_entity)| {
+                let (chunk, view_key) = (chunks.get(entity).ok()?, view_key?);
+                let id = pipelines.of(chunk, |topology| InstancedKey {
+                    mesh: view_key | topology,
+                    textured: chunk.texture.is_some(),
+                })?;
+                let batch_set = Opaque3dBatchSetKey {
+                    draw_function: draw,
+                    pipeline: id,
+                    material_bind_group_index: None,
+                    slabs: MeshSlabs::default(),
+                    lightmap_slab: None,
+                };
+                let bin = Opaque3dBinKey {
+                    asset_id: mesh_bin(chunk.mesh),
+                };
+                Some((batch_set, bin, (entity, main_entity)))
+            });
         queued.rebin(view.retained_view_entity, phase, items.collect::<Vec<_>>());
     }
     queued.end_frame();

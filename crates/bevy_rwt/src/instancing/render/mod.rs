@@ -23,7 +23,7 @@ pub(super) use retained::Queued;
 
 use super::bend::{BEND_FIELD_TEXELS, BendField};
 use super::{GpuInstance, InstanceBuffer, InstancedChunk, RwtFadeIn, RwtWind};
-use crate::look::{InstancedShadows, check_topology};
+use crate::look::{InstancedShadows, check_texture, check_topology};
 use bevy::camera::primitives::Aabb;
 use bevy::ecs::query::QueryItem;
 use bevy::mesh::VertexBufferLayout;
@@ -34,11 +34,14 @@ use bevy::render::camera::ExtractedCamera;
 use bevy::render::extract_component::ExtractComponent;
 use bevy::render::extract_resource::ExtractResource;
 use bevy::render::mesh::RenderMesh;
+use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{sampler, texture_2d, uniform_buffer_sized};
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::sync_component::SyncComponent;
-use bevy::render::view::ExtractedView;
+use bevy::render::sync_world::MainEntity;
+use bevy::render::texture::{FallbackImage, GpuImage};
+use bevy::render::view::{ExtractedView, RenderVisibleEntities};
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
@@ -66,7 +69,8 @@ struct ChunkUniform {
     wind: [f32; 4],
     /// Wind speed.
     wind_motion: [f32; 4],
-    /// Height fraction where the tip colour starts, bend response, unused.
+    /// Height fraction where the tip colour starts, bend response, alpha cut-off, 1 when
+    /// textured.
     shading: [f32; 4],
 }
 
@@ -90,6 +94,8 @@ pub struct ExtractedChunk {
     /// World-space bounds of the drawn instances, for culling shadow views.
     bounds: Aabb,
     shadows: InstancedShadows,
+    /// The base-colour texture, if the class has one.
+    texture: Option<AssetId<Image>>,
 }
 
 impl SyncComponent for InstancedChunk {
@@ -131,7 +137,12 @@ impl ExtractComponent for InstancedChunk {
                     m.fade_band.max(1e-3),
                 ],
                 falloff: [near, far, on, floor],
-                shading: [m.tip_from.clamp(0.0, 0.99), m.bend_response, 0.0, 0.0],
+                shading: [
+                    m.tip_from.clamp(0.0, 0.99),
+                    m.bend_response,
+                    m.alpha_cutoff,
+                    if m.texture.is_some() { 1.0 } else { 0.0 },
+                ],
                 ..default()
             },
             bounds: Aabb {
@@ -139,6 +150,7 @@ impl ExtractComponent for InstancedChunk {
                 half_extents: local.half_extents,
             },
             shadows: m.shadows,
+            texture: m.texture.as_ref().map(Handle::id),
         })
     }
 }
@@ -177,6 +189,8 @@ pub(super) struct GpuChunk {
     uniform: ChunkUniform,
     uniform_buffer: Buffer,
     bind_group: BindGroup,
+    /// The texture view bound (the fallback's until the class's texture is ready).
+    texture_view: TextureViewId,
 }
 
 /// What every instanced pipeline shares: the shader and the layout of group 2 (the chunk's
@@ -218,6 +232,8 @@ pub(super) fn init_bindings(
         (
             uniform_buffer_sized(false, None),
             uniform_buffer_sized(false, None),
+            texture_2d(TextureSampleType::Float { filterable: true }),
+            sampler(SamplerBindingType::Filtering),
             texture_2d(TextureSampleType::Float { filterable: true }),
             sampler(SamplerBindingType::Filtering),
         ),
@@ -339,8 +355,31 @@ fn snorm8(v: f32) -> i8 {
     (v.clamp(-1.0, 1.0) * 127.0).round() as i8
 }
 
-/// Makes the GPU resources of new or changed chunks; updates the uniform when the wind or
-/// the fade-in setting changes.
+/// The textures a chunk's bind group reads.
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct ChunkTextures<'w> {
+    images: Res<'w, RenderAssets<GpuImage>>,
+    fallback: Res<'w, FallbackImage>,
+}
+
+impl ChunkTextures<'_> {
+    /// The texture `chunk` binds: its class's when it is ready and drawable, the fallback
+    /// image (white) otherwise.
+    fn of(&self, chunk: &ExtractedChunk) -> &GpuImage {
+        chunk
+            .texture
+            .and_then(|id| self.images.get(id))
+            .filter(|image| {
+                let d = &image.texture_descriptor;
+                check_texture(d.dimension, d.size.depth_or_array_layers, d.format).is_ok()
+            })
+            .unwrap_or(&self.fallback.d2)
+    }
+}
+
+/// Makes the GPU resources of new or changed chunks (and the bind group again when the
+/// class's texture became ready or changed); updates the uniform when the wind or the
+/// fade-in setting changes.
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub(super) fn prepare_chunks(
     mut commands: Commands,
@@ -349,6 +388,7 @@ pub(super) fn prepare_chunks(
     queue: Res<RenderQueue>,
     bindings: Res<ChunkBindings>,
     cache: Res<PipelineCache>,
+    textures: ChunkTextures,
     wind: Option<Res<RwtWind>>,
     fade: Option<Res<RwtFadeIn>>,
 ) {
@@ -366,15 +406,21 @@ pub(super) fn prepare_chunks(
         if !fade.0 {
             uniform.falloff[2] = 0.0;
         }
+        let texture = textures.of(chunk);
         match gpu {
             Some(mut gpu) if Arc::ptr_eq(&gpu.source, &chunk.buffer) => {
                 if gpu.uniform != uniform {
                     queue.write_buffer(&gpu.uniform_buffer, 0, bytemuck::bytes_of(&uniform));
                     gpu.uniform = uniform;
                 }
+                if gpu.texture_view != texture.texture_view.id() {
+                    gpu.bind_group =
+                        bind_chunk(&device, &bindings, &cache, &gpu.uniform_buffer, texture);
+                    gpu.texture_view = texture.texture_view.id();
+                }
             }
             _ => {
-                let gpu = upload(&device, &bindings, &cache, chunk, uniform);
+                let gpu = upload(&device, &bindings, &cache, (chunk, uniform), texture);
                 commands.entity(entity).insert(gpu);
             }
         }
@@ -386,8 +432,8 @@ fn upload(
     device: &RenderDevice,
     bindings: &ChunkBindings,
     cache: &PipelineCache,
-    chunk: &ExtractedChunk,
-    uniform: ChunkUniform,
+    (chunk, uniform): (&ExtractedChunk, ChunkUniform),
+    texture: &GpuImage,
 ) -> GpuChunk {
     let instances = device.create_buffer_with_data(&BufferInitDescriptor {
         label: Some("rwt_instances"),
@@ -399,59 +445,88 @@ fn upload(
         contents: bytemuck::bytes_of(&uniform),
         usage: BufferUsages::UNIFORM | BufferUsages::COPY_DST,
     });
-    let bind_group = device.create_bind_group(
-        "rwt_instanced_chunk",
-        &cache.get_bind_group_layout(&bindings.layout),
-        &BindGroupEntries::sequential((
-            uniform_buffer.as_entire_binding(),
-            bindings.frame.as_entire_binding(),
-            &bindings.bend_view,
-            &bindings.bend_sampler,
-        )),
-    );
     GpuChunk {
         source: chunk.buffer.clone(),
         instances,
         count: chunk.buffer.instances.len() as u32,
         uniform,
+        bind_group: bind_chunk(device, bindings, cache, &uniform_buffer, texture),
         uniform_buffer,
-        bind_group,
+        texture_view: texture.texture_view.id(),
     }
 }
 
-/// The pipeline of `specializer` for `mesh` under `key` (with the mesh's topology), or
-/// `None` with the reason logged once when the mesh cannot be drawn.
-fn specialize<S>(
-    pipelines: &mut SpecializedMeshPipelines<S>,
+/// A chunk's bind group: its uniform, the frame's, the bend field, its texture.
+fn bind_chunk(
+    device: &RenderDevice,
+    bindings: &ChunkBindings,
     cache: &PipelineCache,
-    specializer: &S,
-    key: S::Key,
-    (id, mesh): (AssetId<Mesh>, &RenderMesh),
-    reported: &mut ReportedMeshes,
-) -> Option<CachedRenderPipelineId>
+    uniform: &Buffer,
+    texture: &GpuImage,
+) -> BindGroup {
+    device.create_bind_group(
+        "rwt_instanced_chunk",
+        &cache.get_bind_group_layout(&bindings.layout),
+        &BindGroupEntries::sequential((
+            uniform.as_entire_binding(),
+            bindings.frame.as_entire_binding(),
+            &bindings.bend_view,
+            &bindings.bend_sampler,
+            &texture.texture_view,
+            &texture.sampler,
+        )),
+    )
+}
+
+/// What choosing a chunk's pipeline reads: the pipelines of specializer `S`, the meshes,
+/// and the meshes already reported as undrawable.
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct ChunkPipelines<'w, S: SpecializedMeshPipeline + Resource>
 where
-    S: SpecializedMeshPipeline,
+    S::Key: Send + Sync,
 {
-    let specialized = check_topology(mesh.primitive_topology())
-        .map_err(|e| e.to_string())
-        .and_then(|()| {
-            pipelines
-                .specialize(cache, specializer, key, &mesh.layout)
-                .map_err(|e| e.to_string())
-        });
-    match specialized {
-        Ok(pipeline) => Some(pipeline),
-        Err(e) => {
-            reported.once(id, &e);
-            None
-        }
+    specializer: Option<Res<'w, S>>,
+    pipelines: ResMut<'w, SpecializedMeshPipelines<S>>,
+    cache: Res<'w, PipelineCache>,
+    meshes: Res<'w, RenderAssets<RenderMesh>>,
+    reported: ResMut<'w, ReportedMeshes>,
+}
+
+impl<S: SpecializedMeshPipeline + Resource> ChunkPipelines<'_, S>
+where
+    S::Key: Send + Sync,
+{
+    /// The pipeline drawing `chunk` under the key `key` makes of the mesh's topology bits,
+    /// or `None` (the reason logged once when the mesh cannot be drawn; nothing while the
+    /// mesh or the specializer is not ready).
+    fn of(
+        &mut self,
+        chunk: &ExtractedChunk,
+        key: impl FnOnce(MeshPipelineKey) -> S::Key,
+    ) -> Option<CachedRenderPipelineId> {
+        let specializer = self.specializer.as_deref()?;
+        let mesh = self.meshes.get(chunk.mesh)?;
+        let topology = MeshPipelineKey::from_primitive_topology_and_strip_index(
+            mesh.primitive_topology(),
+            mesh.index_format(),
+        );
+        let specialized = check_topology(mesh.primitive_topology())
+            .map_err(|e| e.to_string())
+            .and_then(|()| {
+                self.pipelines
+                    .specialize(&self.cache, specializer, key(topology), &mesh.layout)
+                    .map_err(|e| e.to_string())
+            });
+        specialized
+            .map_err(|e| self.reported.once(chunk.mesh, &e))
+            .ok()
     }
 }
 
-/// The mesh-dependent bits of a pipeline key.
-fn topology_key(mesh: &RenderMesh) -> MeshPipelineKey {
-    MeshPipelineKey::from_primitive_topology_and_strip_index(
-        mesh.primitive_topology(),
-        mesh.index_format(),
-    )
+/// The chunks a camera view's CPU culling kept (by their `Aabb`).
+fn visible_chunks(visible: &RenderVisibleEntities) -> &[(Entity, MainEntity)] {
+    visible
+        .get::<InstancedChunk>()
+        .map(|v| v.entities_cpu_culling.as_slice())
+        .unwrap_or_default()
 }

@@ -79,20 +79,36 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
     fn class(&mut self, c: &ScatterClass) -> Result<ClassDescription, String> {
         let (mesh, material) = match &c.look {
             ClassLook::Mesh { mesh, material } => (self.mesh(mesh)?, self.material(material)?),
-            ClassLook::Instanced(look) => (
-                self.mesh(&look.mesh)?,
-                MaterialDescription::Instanced(InstancedMaterialDescription::from(&look.material)),
-            ),
+            ClassLook::Instanced(look) => {
+                let mut material = InstancedMaterialDescription::from(&look.material);
+                if let Some(texture) = &look.material.texture {
+                    material.texture = Some(self.image(texture)?);
+                }
+                (
+                    self.mesh(&look.mesh)?,
+                    MaterialDescription::Instanced(material),
+                )
+            }
             ClassLook::Custom(_) => return Err("a custom look (code) has no file form".into()),
         };
-        let lod = match &c.lod {
-            Some(lod) => Some(LodDescription {
+        let far = match &c.look {
+            ClassLook::Instanced(look) => look.far.as_ref(),
+            _ => None,
+        };
+        let lod = match (&c.lod, far) {
+            (_, Some(far)) => Some(LodDescription {
+                mesh: self.mesh(&far.mesh)?,
+                material: MaterialDescription::Instanced(InstancedMaterialDescription::default()),
+                distance: far.distance,
+                crossfade: None,
+            }),
+            (Some(lod), None) => Some(LodDescription {
                 mesh: self.mesh(&lod.mesh)?,
                 material: self.material(&lod.material)?,
                 distance: lod.distance,
                 crossfade: Some(lod.crossfade),
             }),
-            None => None,
+            (None, None) => None,
         };
         Ok(ClassDescription {
             density: self.density(&c.density)?,

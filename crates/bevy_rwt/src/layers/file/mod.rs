@@ -200,6 +200,11 @@ pub struct InstancedMaterialDescription {
     pub shadows: InstancedShadows,
     /// See [`InstancedMaterial::bend_response`].
     pub bend_response: f32,
+    /// Asset path of the base-colour texture ([`InstancedMaterial::texture`]), e.g.
+    /// `"foliage/fern.png"`.
+    pub texture: Option<String>,
+    /// See [`InstancedMaterial::alpha_cutoff`].
+    pub alpha_cutoff: f32,
 }
 
 impl Default for InstancedMaterialDescription {
@@ -224,13 +229,16 @@ impl From<&InstancedMaterial> for InstancedMaterialDescription {
             tip_from: m.tip_from,
             shadows: m.shadows,
             bend_response: m.bend_response,
+            // The texture's path is the describer's to give (it knows where images are).
+            texture: None,
+            alpha_cutoff: m.alpha_cutoff,
         }
     }
 }
 
 impl InstancedMaterialDescription {
-    /// The material it describes.
-    pub fn to_material(&self) -> InstancedMaterial {
+    /// The material it describes; `image` loads the texture by its path.
+    pub fn to_material(&self, image: impl FnOnce(&str) -> Handle<Image>) -> InstancedMaterial {
         let color = |(r, g, b): (f32, f32, f32)| Color::linear_rgb(r, g, b);
         InstancedMaterial {
             base_color: color(self.base),
@@ -242,6 +250,8 @@ impl InstancedMaterialDescription {
             tip_from: self.tip_from,
             shadows: self.shadows,
             bend_response: self.bend_response,
+            texture: self.texture.as_deref().map(image),
+            alpha_cutoff: self.alpha_cutoff,
         }
     }
 }
@@ -274,12 +284,14 @@ pub struct ClassDescription {
     pub lod: Option<LodDescription>,
 }
 
-/// The far level of detail of a class in a layer file (see [`MeshLod`]).
+/// The far level of detail of a class in a layer file (see [`MeshLod`]; for an instanced
+/// class, [`InstancedFar`](crate::look::InstancedFar), whose material is `Instanced()`: the
+/// class's shading applies, and whose crossfade is unused).
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct LodDescription {
     /// The far mesh.
     pub mesh: MeshDescription,
-    /// The far material (not `Instanced`).
+    /// The far material (`Instanced()` for an instanced class, and only then).
     pub material: MaterialDescription,
     /// Distance of the switch.
     pub distance: f32,
@@ -479,11 +491,11 @@ impl LayerDescription {
                 "unload_distance {u} is below load_distance {l}"
             )));
         }
-        for (i, lod) in d
+        for (i, c, lod) in d
             .classes
             .iter()
             .enumerate()
-            .filter_map(|(i, c)| Some((i, c.lod.as_ref()?)))
+            .filter_map(|(i, c)| Some((i, c, c.lod.as_ref()?)))
         {
             if !(lod.distance.is_finite() && lod.distance > 0.0) {
                 return Err(LayerFileError::Invalid(format!(
@@ -491,9 +503,10 @@ impl LayerDescription {
                     lod.distance
                 )));
             }
-            if matches!(lod.material, MaterialDescription::Instanced(_)) {
+            let instanced = matches!(c.material, MaterialDescription::Instanced(_));
+            if instanced != matches!(lod.material, MaterialDescription::Instanced(_)) {
                 return Err(LayerFileError::Invalid(format!(
-                    "class {i}: a far material cannot be Instanced"
+                    "class {i}: a far material is Instanced() exactly when the class is instanced"
                 )));
             }
         }
@@ -625,11 +638,20 @@ impl ClassDescription {
         let mesh = handles.mesh(&self.mesh)?;
         let class = match &self.material {
             MaterialDescription::Instanced(m) => {
-                ScatterClass::instanced(density, mesh, m.to_material())
+                ScatterClass::instanced(density, mesh, m.to_material(&mut handles.image))
             }
             other => ScatterClass::new(density, mesh, handles.material(other)?),
         };
+        let instanced = matches!(self.material, MaterialDescription::Instanced(_));
         let lod = match &self.lod {
+            Some(lod) if instanced => {
+                let far = handles.mesh(&lod.mesh)?;
+                return Ok(ScatterClass {
+                    scale: self.scale,
+                    scale_variation: self.scale_variation,
+                    ..class.with_instanced_far(far, lod.distance)
+                });
+            }
             Some(lod) => Some(MeshLod {
                 mesh: handles.mesh(&lod.mesh)?,
                 material: handles.material(&lod.material)?,

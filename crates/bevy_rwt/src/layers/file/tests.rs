@@ -38,7 +38,8 @@ fn a_layer_file_writes_and_reads_back_the_same() {
         "classes: [",
         r#"classes: [
         (density: Image(path: "m.png", min: (0.0, 0.0), size: (8.0, 8.0), scale: 2.0),
-         mesh: Blade(width: 0.1, height: 0.6), material: Instanced(tip: (0.3, 0.5, 0.1), tip_from: 0.8, shadows: Within(30.0))),
+         mesh: Blade(width: 0.1, height: 0.6), material: Instanced(tip: (0.3, 0.5, 0.1), tip_from: 0.8, shadows: Within(30.0), texture: Some("fern.png"), alpha_cutoff: 0.3),
+         lod: (mesh: Blade(width: 0.1, height: 0.3), material: Instanced(), distance: 40.0)),
         (density: Constant(1.0), mesh: Path("a.glb#Mesh0/Primitive0"), material: Path("a.glb#Material0")),"#,
     );
     let d = LayerDescription::from_ron(&with_all).unwrap();
@@ -46,7 +47,16 @@ fn a_layer_file_writes_and_reads_back_the_same() {
     let MaterialDescription::Instanced(m) = &d.classes[0].material else {
         panic!("the first class is instanced");
     };
-    assert_eq!(m.to_material().shadows, InstancedShadows::Within(30.0));
+    let mut loaded = Vec::new();
+    let material = m.to_material(|path| {
+        loaded.push(path.to_string());
+        Handle::default()
+    });
+    assert_eq!(material.shadows, InstancedShadows::Within(30.0));
+    assert_eq!(
+        (loaded, material.alpha_cutoff),
+        (vec!["fern.png".to_string()], 0.3)
+    );
     let text = d.to_ron().unwrap();
     assert!(!text.contains("Some("), "{text}");
     assert_eq!(LayerDescription::from_ron(&text).unwrap(), d);
@@ -269,6 +279,21 @@ fn what_a_file_cannot_name_is_a_typed_error() {
         LayerDensity::Custom(std::sync::Arc::new(rwt_core::density::Constant(1.0)));
     let err = LayerDescription::describe(&custom, &names, |_| Some("m.png".into())).unwrap_err();
     assert!(err.to_string().contains("custom density"), "{err}");
+    // A far material is `Instanced()` exactly when the class is instanced.
+    for (class, far) in [
+        ("Color(0.6, 0.2, 0.2)", "Instanced()"),
+        ("Instanced()", "Color(0.1, 0.1, 0.1)"),
+    ] {
+        let text = MEADOW.replace(
+            "material: Color(0.6, 0.2, 0.2), scale: 1.5",
+            &format!("material: {class}, lod: (mesh: Sphere(radius: 0.1), material: {far}, distance: 30.0)"),
+        );
+        let err = LayerDescription::from_ron(&text).unwrap_err();
+        assert!(
+            matches!(&err, LayerFileError::Invalid(why) if why.contains("far material")),
+            "{err}"
+        );
+    }
     // A file naming what the game did not register does not load.
     let text = MEADOW.replace("mesh: Sphere(radius: 0.3)", "mesh: Named(\"oak\")");
     let err = LayerDescription::from_ron(&text)
