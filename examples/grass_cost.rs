@@ -5,10 +5,16 @@
 //! `cargo run --release --example grass_cost -- entities 1000000`
 //!
 //! A flat field holds about the given number of live blades (streamed by the plugin) around
-//! a camera 2 m above it. Once streaming has settled and 10 frames have warmed up, 30
-//! frames are timed and one line is printed:
+//! a camera 2 m above it, under a sun with cascaded shadow maps. The instanced path is
+//! timed in four settings in one run: the grass class's shadows off, on, on within 30 m of
+//! the camera, and off with the camera's depth, normal and motion-vector prepasses on (the
+//! entity path in the first only). In each, once streaming has settled and 10 frames have
+//! warmed up, 30 frames are timed and one line is printed:
 //!
-//! `grass-cost: path=P live=N main_ms=X/Y render_world_ms=X/Y frame_ms=X/Y` (median/p95)
+//! `grass-cost: path=P live=N shadows=S prepass=Q main_ms=X/Y render_world_ms=X/Y frame_ms=X/Y`
+//! (median/p95), then the frame-time ratios to the first setting, measured in the same run:
+//!
+//! `grass-cost: frame_ms ratio shadows_on=R shadows_within_30m=R prepass_on=R`
 //!
 //! `main_ms` is the main world's schedules (the plugin, transforms, visibility);
 //! `render_world_ms` is extraction, preparation and queueing in the render world, from the
@@ -16,6 +22,7 @@
 //! off, so the two run one after the other); `frame_ms` is the whole frame, including the
 //! render graph and, with a software driver such as lavapipe, the drawing itself.
 
+use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass, NormalPrepass};
 use bevy::prelude::*;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::{Render, RenderApp, RenderSystems};
@@ -33,6 +40,13 @@ const CHUNK: f64 = 32.0;
 const TIMED: usize = 30;
 /// Frames run before, to warm up.
 const WARM_UP: usize = 10;
+/// The settings timed: the grass class's shadows, and whether the camera has prepasses.
+const SETTINGS: [(InstancedShadows, bool); 4] = [
+    (InstancedShadows::Off, false),
+    (InstancedShadows::On, false),
+    (InstancedShadows::Within(30.0), false),
+    (InstancedShadows::Off, true),
+];
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -57,7 +71,12 @@ fn main() {
             .with_spawn_budget(200_000)
             .with_max_tasks(16),
     )
-    .insert_resource(Field { entities, count })
+    .insert_resource(Field {
+        entities,
+        count,
+        setting: 0,
+        frame_ms: Vec::new(),
+    })
     .insert_resource(clock.clone())
     .add_systems(Startup, setup)
     .add_systems(First, start_frame)
@@ -73,11 +92,13 @@ fn main() {
     app.run();
 }
 
-/// What to draw.
+/// What to draw, the setting being timed and the median frame times of those timed.
 #[derive(Resource)]
 struct Field {
     entities: bool,
     count: f64,
+    setting: usize,
+    frame_ms: Vec<f64>,
 }
 
 /// Timestamps shared by the main and render worlds.
@@ -108,7 +129,10 @@ fn setup(
         Transform::from_xyz(0.0, 2.0, 0.0).looking_at(Vec3::new(40.0, 0.0, 30.0), Vec3::Y),
     ));
     commands.spawn((
-        DirectionalLight::default(),
+        DirectionalLight {
+            shadow_maps_enabled: true,
+            ..default()
+        },
         Transform::from_xyz(1.0, 2.0, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
     ));
     commands.spawn((
@@ -127,7 +151,11 @@ fn setup(
         });
         ScatterClass::new(density, blade, material)
     } else {
-        ScatterClass::instanced(density, blade, InstancedMaterial::default())
+        let material = InstancedMaterial {
+            shadows: SETTINGS[0].0,
+            ..default()
+        };
+        ScatterClass::instanced(density, blade, material)
     };
     commands.spawn(
         ScatterLayer::new(vec![grass])
@@ -169,13 +197,17 @@ fn end_render_world(clock: Res<Clock>) {
 }
 
 /// Waits for streaming to settle, warms up for [`WARM_UP`] frames, times [`TIMED`]
-/// frames, prints and exits.
+/// frames and prints them; then moves to the next setting, or prints the ratios and exits.
+#[allow(clippy::too_many_arguments)]
 fn settle(
     clock: Res<Clock>,
     stats: Res<RwtStats>,
-    field: Res<Field>,
+    mut field: ResMut<Field>,
     mut settled_frames: Local<usize>,
     mut exit: MessageWriter<AppExit>,
+    layers: Query<(Entity, &ScatterLayer)>,
+    cameras: Query<Entity, With<Camera3d>>,
+    mut commands: Commands,
 ) {
     let live = stats.live_instances + stats.live_instanced;
     if *settled_frames == 0 && (stats.pending_tasks > 0 || stats.queued_spawns > 0 || live == 0) {
@@ -190,18 +222,70 @@ fn settle(
     let column = |i: usize| {
         let mut v: Vec<f64> = t.samples.iter().map(|s| s[i]).collect();
         v.sort_by(f64::total_cmp);
-        format!("{:.2}/{:.2}", v[v.len() / 2], v[v.len() * 95 / 100])
+        (v[v.len() / 2], v[v.len() * 95 / 100])
     };
+    let shown = |(median, p95): (f64, f64)| format!("{median:.2}/{p95:.2}");
     let path = if field.entities {
         "entities"
     } else {
         "instanced"
     };
+    let (shadows, prepass) = SETTINGS[field.setting];
+    let shadows = match shadows {
+        InstancedShadows::Off => "off".to_string(),
+        InstancedShadows::On => "on".to_string(),
+        InstancedShadows::Within(d) => format!("within_{d}m"),
+    };
+    let prepass = if prepass { "on" } else { "off" };
     println!(
-        "grass-cost: path={path} live={live} main_ms={} render_world_ms={} frame_ms={}",
-        column(0),
-        column(1),
-        column(2)
+        "grass-cost: path={path} live={live} shadows={shadows} prepass={prepass} main_ms={} render_world_ms={} frame_ms={}",
+        shown(column(0)),
+        shown(column(1)),
+        shown(column(2))
     );
-    exit.write(AppExit::Success);
+    field.frame_ms.push(column(2).0);
+    t.samples.clear();
+    t.recording = false;
+    *settled_frames = 0;
+    field.setting += 1;
+    if field.entities || field.setting == SETTINGS.len() {
+        if let [base, on, within, prepass] = field.frame_ms[..] {
+            println!(
+                "grass-cost: frame_ms ratio shadows_on={:.2} shadows_within_30m={:.2} prepass_on={:.2}",
+                on / base,
+                within / base,
+                prepass / base
+            );
+        }
+        exit.write(AppExit::Success);
+        return;
+    }
+    apply(SETTINGS[field.setting], &layers, &cameras, &mut commands);
+}
+
+/// Gives the grass class the setting's shadows (a replaced layer streams anew) and the
+/// camera its prepasses or none.
+fn apply(
+    (shadows, prepass): (InstancedShadows, bool),
+    layers: &Query<(Entity, &ScatterLayer)>,
+    cameras: &Query<Entity, With<Camera3d>>,
+    commands: &mut Commands,
+) {
+    for (entity, layer) in layers {
+        let mut layer = layer.clone();
+        for class in &mut layer.classes {
+            if let ClassLook::Instanced(look) = &mut class.look {
+                look.material.shadows = shadows;
+            }
+        }
+        commands.entity(entity).insert(layer);
+    }
+    for camera in cameras {
+        let mut camera = commands.entity(camera);
+        if prepass {
+            camera.insert((DepthPrepass, NormalPrepass, MotionVectorPrepass));
+        } else {
+            camera.remove::<(DepthPrepass, NormalPrepass, MotionVectorPrepass)>();
+        }
+    }
 }
