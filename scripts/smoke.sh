@@ -60,7 +60,7 @@ for run in "${runs[@]}"; do
         # Its own screenshots, compared region by region: grass receives and casts
         # shadows, and is drawn with the prepasses and SSAO.
         RWT_PASSES_DIR=$out/passes timeout 1200 "$bin/$ex" >"$out/$name.log" 2>&1 || true
-        line=$(grep -E '^rwt-passes: receive' "$out/$name.log" || true)
+        line=$(grep -E '^rwt-passes: cards' "$out/$name.log" || true)
         echo "$name: ${line:-no result line}, $(( $(date +%s) - start )) s"
         if [ -z "$line" ] || grep -qE '^rwt-passes: FAIL|ERROR' "$out/$name.log"; then
             echo "FAIL $name"; grep -E 'FAIL|ERROR' -A6 "$out/$name.log" | head -30; failed=1
