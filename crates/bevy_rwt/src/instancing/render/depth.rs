@@ -8,7 +8,7 @@ use super::draw::{DrawChunkInstances, SetChunkBindGroup};
 use super::main_pass::{mesh_attributes, mesh_bin};
 use super::{
     ChunkBindings, ChunkPipelines, ExtractedChunk, MainViewer, Queued, instance_layout,
-    visible_chunks,
+    rebin_cameras,
 };
 use crate::instancing::distance_to_box;
 use crate::look::InstancedShadows;
@@ -165,34 +165,31 @@ pub(in crate::instancing) fn queue_prepass(
     mut queued: ResMut<Queued<Opaque3dPrepass>>,
 ) {
     let draw = draw_functions.read().id::<DrawInstancedDepth>();
-    for (view, visible) in &views {
-        let Some(phase) = phases.get_mut(&view.retained_view_entity) else {
-            continue;
-        };
-        let view_key = view_keys.get(&view.retained_view_entity).copied();
-        let items = visible_chunks(visible)
-            .iter()
-            .filter_map(|&(entity, main_entity)| {
-                let (chunk, view_key) = (chunks.get(entity).ok()?, view_key?);
-                let id = pipelines.of(chunk, |topology| DepthKey {
-                    mesh: view_key | topology,
-                    shadow: false,
-                    textured: chunk.texture.is_some(),
-                })?;
-                let batch_set = OpaqueNoLightmap3dBatchSetKey {
-                    draw_function: draw,
-                    pipeline: id,
-                    material_bind_group_index: None,
-                    slabs: MeshSlabs::default(),
-                };
-                let bin = OpaqueNoLightmap3dBinKey {
-                    asset_id: mesh_bin(chunk.mesh),
-                };
-                Some((batch_set, bin, (entity, main_entity)))
-            });
-        queued.rebin(view.retained_view_entity, phase, items.collect::<Vec<_>>());
-    }
-    queued.end_frame();
+    let key_of = |view: &_| view_keys.get(view).copied();
+    rebin_cameras(
+        &mut phases,
+        &mut queued,
+        &views,
+        key_of,
+        |view_key, entity, main| {
+            let chunk = chunks.get(entity).ok()?;
+            let id = pipelines.of(chunk, |topology| DepthKey {
+                mesh: view_key | topology,
+                shadow: false,
+                textured: chunk.texture.is_some(),
+            })?;
+            let batch_set = OpaqueNoLightmap3dBatchSetKey {
+                draw_function: draw,
+                pipeline: id,
+                material_bind_group_index: None,
+                slabs: MeshSlabs::default(),
+            };
+            let bin = OpaqueNoLightmap3dBinKey {
+                asset_id: mesh_bin(chunk.mesh),
+            };
+            Some((batch_set, bin, (entity, main)))
+        },
+    );
 }
 
 /// A shadow view: where it looks (a directional light's frustum reaches to the light), and

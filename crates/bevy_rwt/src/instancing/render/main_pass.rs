@@ -2,7 +2,7 @@
 
 use super::draw::DrawInstancedChunk;
 use super::{
-    ChunkBindings, ChunkPipelines, ExtractedChunk, Queued, instance_layout, visible_chunks,
+    ChunkBindings, ChunkPipelines, ExtractedChunk, Queued, instance_layout, rebin_cameras,
 };
 use bevy::asset::UntypedAssetId;
 use bevy::core_pipeline::core_3d::{Opaque3d, Opaque3dBatchSetKey, Opaque3dBinKey};
@@ -105,32 +105,29 @@ pub(in crate::instancing) fn queue_main(
     mut queued: ResMut<Queued<Opaque3d>>,
 ) {
     let draw = draw_functions.read().id::<DrawInstancedChunk>();
-    for (view, visible) in &views {
-        let Some(phase) = phases.get_mut(&view.retained_view_entity) else {
-            continue;
-        };
-        let view_key = view_keys.get(&view.retained_view_entity).copied();
-        let items = visible_chunks(visible)
-            .iter()
-            .filter_map(|&(entity, main_entity)| {
-                let (chunk, view_key) = (chunks.get(entity).ok()?, view_key?);
-                let id = pipelines.of(chunk, |topology| InstancedKey {
-                    mesh: view_key | topology,
-                    textured: chunk.texture.is_some(),
-                })?;
-                let batch_set = Opaque3dBatchSetKey {
-                    draw_function: draw,
-                    pipeline: id,
-                    material_bind_group_index: None,
-                    slabs: MeshSlabs::default(),
-                    lightmap_slab: None,
-                };
-                let bin = Opaque3dBinKey {
-                    asset_id: mesh_bin(chunk.mesh),
-                };
-                Some((batch_set, bin, (entity, main_entity)))
-            });
-        queued.rebin(view.retained_view_entity, phase, items.collect::<Vec<_>>());
-    }
-    queued.end_frame();
+    let key_of = |view: &_| view_keys.get(view).copied();
+    rebin_cameras(
+        &mut phases,
+        &mut queued,
+        &views,
+        key_of,
+        |view_key, entity, main| {
+            let chunk = chunks.get(entity).ok()?;
+            let id = pipelines.of(chunk, |topology| InstancedKey {
+                mesh: view_key | topology,
+                textured: chunk.texture.is_some(),
+            })?;
+            let batch_set = Opaque3dBatchSetKey {
+                draw_function: draw,
+                pipeline: id,
+                material_bind_group_index: None,
+                slabs: MeshSlabs::default(),
+                lightmap_slab: None,
+            };
+            let bin = Opaque3dBinKey {
+                asset_id: mesh_bin(chunk.mesh),
+            };
+            Some((batch_set, bin, (entity, main)))
+        },
+    );
 }

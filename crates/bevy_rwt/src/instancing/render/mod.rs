@@ -19,6 +19,7 @@ pub(super) use depth::{
 };
 pub(super) use draw::DrawInstancedChunk;
 pub(super) use main_pass::{InstancedPipeline, init_main_pipeline, queue_main};
+use retained::BinnedChunk;
 pub(super) use retained::Queued;
 
 use super::bend::{BEND_FIELD_TEXELS, BendField};
@@ -35,13 +36,14 @@ use bevy::render::extract_component::ExtractComponent;
 use bevy::render::extract_resource::ExtractResource;
 use bevy::render::mesh::RenderMesh;
 use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_phase::{BinnedPhaseItem, ViewBinnedRenderPhases};
 use bevy::render::render_resource::binding_types::{sampler, texture_2d, uniform_buffer_sized};
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::sync_component::SyncComponent;
 use bevy::render::sync_world::MainEntity;
 use bevy::render::texture::{FallbackImage, GpuImage};
-use bevy::render::view::{ExtractedView, RenderVisibleEntities};
+use bevy::render::view::{ExtractedView, RenderVisibleEntities, RetainedViewEntity};
 use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
@@ -523,10 +525,30 @@ where
     }
 }
 
-/// The chunks a camera view's CPU culling kept (by their `Aabb`).
-fn visible_chunks(visible: &RenderVisibleEntities) -> &[(Entity, MainEntity)] {
-    visible
-        .get::<InstancedChunk>()
-        .map(|v| v.entities_cpu_culling.as_slice())
-        .unwrap_or_default()
+/// Bins into each camera view's phase the chunks its CPU culling kept (by their `Aabb`)
+/// that `item` makes an item of under the view's key (`key_of`; none binned while a view
+/// has no key), and takes out what the views no longer show.
+fn rebin_cameras<P: BinnedPhaseItem, K: Copy>(
+    phases: &mut ViewBinnedRenderPhases<P>,
+    queued: &mut Queued<P>,
+    views: &Query<(&ExtractedView, &RenderVisibleEntities)>,
+    key_of: impl Fn(&RetainedViewEntity) -> Option<K>,
+    mut item: impl FnMut(K, Entity, MainEntity) -> Option<BinnedChunk<P>>,
+) {
+    for (view, visible) in views {
+        let Some(phase) = phases.get_mut(&view.retained_view_entity) else {
+            continue;
+        };
+        let key = key_of(&view.retained_view_entity);
+        let visible = visible
+            .get::<InstancedChunk>()
+            .map(|v| v.entities_cpu_culling.as_slice())
+            .unwrap_or_default();
+        let items: Vec<_> = visible
+            .iter()
+            .filter_map(|&(entity, main_entity)| item(key?, entity, main_entity))
+            .collect();
+        queued.rebin(view.retained_view_entity, phase, items);
+    }
+    queued.end_frame();
 }
