@@ -9,8 +9,9 @@
 //!    grass receives shadows;
 //! 3. the grass class's shadows off ([`InstancedShadows::Off`]): the bare ground just
 //!    behind the field (away from the sun) must be brighter there, so the grass casts;
-//! 4. depth, normal and motion-vector prepasses with SSAO (and MSAA off, as they need): the
-//!    grass must still be drawn (its region unlike the bare ground) and the image not blank;
+//! 4. depth, normal and motion-vector prepasses with TAA and SSAO (and MSAA off, as they
+//!    need): the grass must still be drawn (its region unlike the bare ground) and the image
+//!    not blank;
 //! 5. a [`Bender`] standing in the grass: the blades around it must lie down (the pixels
 //!    around it change much more than pixels of grass far from it).
 //!
@@ -20,6 +21,7 @@
 //! when a check fails. Screenshots go to `RWT_PASSES_DIR` (default
 //! `target/passes`).
 
+use bevy::anti_alias::taa::TemporalAntiAliasing;
 use bevy::app::AppExit;
 use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass, NormalPrepass};
 use bevy::light::CascadeShadowConfigBuilder;
@@ -372,6 +374,7 @@ fn next(step: Step, scene: &mut Scene, commands: &mut Commands) -> Step {
                     DepthPrepass,
                     NormalPrepass,
                     MotionVectorPrepass,
+                    TemporalAntiAliasing::default(),
                     ScreenSpaceAmbientOcclusion::default(),
                 ));
             }
@@ -473,11 +476,11 @@ fn report(check: &Check) -> bool {
         ),
         (
             (prepass[2] - prepass[1]).abs() > 10.0,
-            "with the prepasses and SSAO the grass is not drawn",
+            "with the prepasses, TAA and SSAO the grass is not drawn",
         ),
         (
             not_blank(straight),
-            "the screenshot with the prepasses and SSAO is blank",
+            "the screenshot with the prepasses, TAA and SSAO is blank",
         ),
         (
             bent_near > 12.0 && bent_near > 3.0 * bent_far,

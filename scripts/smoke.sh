@@ -7,7 +7,7 @@
 # the painted maps and layer files, or (its `eye` view) the trees it chopped and the ground
 # its cabin cleared did not persist through a flight 3 km away and back, or its walker on
 # foot did not stop at a tree's trunk; and runs instanced_passes, which fails unless
-# instanced grass receives and casts shadows and is drawn with the prepasses and SSAO.
+# instanced grass receives and casts shadows and is drawn with the prepasses, TAA and SSAO.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -58,7 +58,7 @@ for run in "${runs[@]}"; do
     start=$(date +%s)
     if [ "$ex" = instanced_passes ]; then
         # Its own screenshots, compared region by region: grass receives and casts
-        # shadows, and is drawn with the prepasses and SSAO.
+        # shadows, and is drawn with the prepasses, TAA and SSAO.
         RWT_PASSES_DIR=$out/passes timeout 1200 "$bin/$ex" >"$out/$name.log" 2>&1 || true
         line=$(grep -E '^rwt-passes: cards' "$out/$name.log" || true)
         echo "$name: ${line:-no result line}, $(( $(date +%s) - start )) s"

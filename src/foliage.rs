@@ -1,6 +1,8 @@
 //! The showcase's own meshes, generated in code: three tree species (each with a cheap far
 //! mesh), bushes, rocks and a flower for instanced classes. Low-poly and faceted (flat
-//! normals), coloured per vertex, so that one white material per species is enough.
+//! normals), coloured per vertex, so that one white material per species is enough. The
+//! fern is a ring of textured fronds instead: cards whose texture's alpha cuts out the
+//! leaflets.
 
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
@@ -269,6 +271,102 @@ pub fn flower(height: f32) -> Mesh {
     .with_inserted_indices(Indices::U32(indices))
 }
 
+/// A fern for a textured instanced class: `fronds` cards of `length` metres (and a third of
+/// that wide) rising steeply from the centre and arching over, each mapped to the whole of
+/// [`fern_texture`] (v from the stem to the tip). About half `length` tall.
+pub fn fern(fronds: u32, length: f32) -> Mesh {
+    const SEGMENTS: u32 = 6;
+    let (mut positions, mut normals, mut uvs) = (Vec::new(), Vec::new(), Vec::new());
+    let mut indices: Vec<u32> = Vec::new();
+    let half_width = length / 6.0;
+    for f in 0..fronds {
+        // Evenly around, each frond turned a little off the even spacing.
+        let turn = (f as f32 + 0.3 * (f as f32 * 2.4).sin()) / fronds as f32;
+        let out = Vec2::from_angle(turn * std::f32::consts::TAU);
+        let side = Vec3::new(-out.y, 0.0, out.x);
+        let first = positions.len() as u32;
+        let mut at = Vec2::new(0.0, 0.02); // (outwards, up)
+        for j in 0..=SEGMENTS {
+            let s = j as f32 / SEGMENTS as f32;
+            // Rises at 80 degrees, arches over to -10 at the tip.
+            let angle = (80.0 - 90.0 * s).to_radians();
+            let along = Vec3::new(out.x * angle.cos(), angle.sin(), out.y * angle.cos());
+            let centre = Vec3::new(out.x * at.x, at.y, out.y * at.x);
+            let normal = side.cross(along).normalize();
+            // The stem is narrow; the frond is widest a third of the way up.
+            let width = half_width * (s * 3.0).min(1.0);
+            for (u, k) in [(0.0, -1.0), (1.0, 1.0)] {
+                positions.push((centre + side * (k * width)).to_array());
+                normals.push(normal.to_array());
+                // Image rows run top-down: the texture's stem is its bottom row.
+                uvs.push([u, 1.0 - s]);
+            }
+            at += Vec2::new(angle.cos(), angle.sin()) * (length / SEGMENTS as f32);
+        }
+        for j in 0..SEGMENTS {
+            let a = first + 2 * j;
+            indices.extend([a, a + 1, a + 3, a, a + 3, a + 2]);
+        }
+    }
+    Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, normals)
+    .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, uvs)
+    .with_inserted_indices(Indices::U32(indices))
+}
+
+/// A fern frond (stem along v, from the bottom edge up): slanted leaflets on both sides of
+/// a dark midrib, longest near the base, serrated, opaque; transparent (alpha 0) between
+/// them. Light grey with darker veins: the class's colours tint it.
+pub fn fern_texture() -> Image {
+    const WIDTH: u32 = 128;
+    const HEIGHT: u32 = 256;
+    const LEAFLETS: f32 = 15.0;
+    let mut data = Vec::with_capacity((WIDTH * HEIGHT * 4) as usize);
+    for y in 0..HEIGHT {
+        // Image rows run top-down; v runs from the stem (bottom) to the tip.
+        let v = 1.0 - (y as f32 + 0.5) / HEIGHT as f32;
+        for x in 0..WIDTH {
+            let u = (x as f32 + 0.5) / WIDTH as f32;
+            let off = (u - 0.5).abs() * 2.0; // 0 at the midrib, 1 at the card's edge
+            // Leaflets slant towards the tip; `w` is where this pixel's leaflet leaves the
+            // midrib.
+            let w = v - 0.35 * off;
+            let reach = if w < 0.08 { 0.0 } else { (1.0 - w).powf(0.6) };
+            let phase = (w * LEAFLETS).fract() - 0.5;
+            let serrated = 0.85 + 0.15 * (off * 40.0).sin();
+            let half = 0.36 * (1.0 - off / reach.max(1e-3)).max(0.0).sqrt() * serrated;
+            let leaflet = off < reach && phase.abs() < half;
+            let midrib = off < 0.03 && v < 0.99;
+            let (rgba, alpha) = if midrib {
+                ([150, 140, 110], 255)
+            } else if leaflet {
+                // Darker along each leaflet's own vein, lighter towards its edges.
+                let shade = 200.0 + 55.0 * (phase.abs() / half.max(1e-3));
+                let s = shade.min(255.0) as u8;
+                ([s, s, (shade * 0.9) as u8], 255)
+            } else {
+                ([200, 200, 180], 0)
+            };
+            data.extend_from_slice(&[rgba[0], rgba[1], rgba[2], alpha]);
+        }
+    }
+    Image::new(
+        bevy::render::render_resource::Extent3d {
+            width: WIDTH,
+            height: HEIGHT,
+            depth_or_array_layers: 1,
+        },
+        bevy::render::render_resource::TextureDimension::D2,
+        data,
+        bevy::render::render_resource::TextureFormat::Rgba8UnormSrgb,
+        RenderAssetUsages::default(),
+    )
+}
+
 /// A trunk standing on the origin, tapering to 60 % of its radius.
 fn trunk(radius: f32, height: f32, sides: u32) -> Mesh {
     let mut mesh = Cylinder::new(radius, height)
@@ -377,7 +475,12 @@ mod tests {
     #[test]
     fn the_meshes_stand_on_their_origin_and_have_what_the_renderer_needs() {
         let trees = [conifer(), broadleaf(), birch()];
-        let mut all: Vec<(Mesh, f32)> = vec![(bush(), 0.8), (rock(), 0.0), (flower(0.4), 0.4)];
+        let mut all: Vec<(Mesh, f32)> = vec![
+            (bush(), 0.8),
+            (rock(), 0.0),
+            (flower(0.4), 0.4),
+            (fern(7, 1.6), 0.8),
+        ];
         for t in trees {
             let (far, near) = (t.far.count_vertices(), t.near.count_vertices());
             assert!(far * 2 < near, "a cheaper far mesh: {far} vs {near}");
@@ -396,5 +499,30 @@ mod tests {
             );
             assert!(mesh.attribute(Mesh::ATTRIBUTE_NORMAL).is_some());
         }
+    }
+
+    #[test]
+    fn the_fern_is_cut_out_between_its_leaflets_and_mapped_to_the_whole_texture() {
+        let texture = fern_texture();
+        let alpha = |x: u32, y: u32| texture.get_color_at(x, y).unwrap().alpha();
+        let (w, h) = (texture.width(), texture.height());
+        let opaque = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .filter(|&(x, y)| alpha(x, y) > 0.5)
+            .count() as f32
+            / (w * h) as f32;
+        assert!((0.2..0.7).contains(&opaque), "opaque fraction {opaque}");
+        // The midrib is opaque up to near the tip; the corners beside the tip are not.
+        assert!(alpha(w / 2, h / 2) > 0.5 && alpha(w / 2, h - 2) > 0.5);
+        assert!(alpha(0, 0) < 0.5 && alpha(w - 1, 0) < 0.5);
+        let mesh = fern(7, 1.6);
+        let Some(VertexAttributeValues::Float32x2(uv)) = mesh.attribute(Mesh::ATTRIBUTE_UV_0)
+        else {
+            panic!("a fern has UVs");
+        };
+        let (lo, hi) = uv.iter().fold((f32::MAX, f32::MIN), |(lo, hi), t| {
+            (lo.min(t[0].min(t[1])), hi.max(t[0].max(t[1])))
+        });
+        assert_eq!((lo, hi), (0.0, 1.0));
     }
 }

@@ -5,10 +5,12 @@ use bevy_rwt::brush::{BrushTarget, DensityBrush};
 use bevy_rwt::layers::file::NamedAssets;
 use bevy_rwt::look::blade_mesh;
 use bevy_rwt::prelude::*;
+use glam::DVec2;
 use noise::{NoiseFn, Perlin};
-use rwt_core::density::{NoiseDensity, NoiseParams};
+use rwt_core::density::{Density, NoiseDensity, NoiseParams};
 use rwt_examples::foliage;
 use rwt_examples::terrain::{Terrain, WATER};
+use std::sync::Arc;
 
 /// The painted maps: `MAP_TEXELS` a side over `MAP_SIZE` metres centred on the origin.
 const MAP_TEXELS: u32 = 2048;
@@ -47,6 +49,8 @@ pub fn setup_layers(
     let rocks = rocks(&ground, &mut meshes, &white);
     commands.spawn((Name::new("rocks"), rocks));
     commands.spawn((Name::new("grass"), grass(&ground, &mut meshes)));
+    let ferns = ferns(&ground, &mut meshes, &mut images);
+    commands.spawn((Name::new("ferns"), ferns));
     let (flowers, flower_targets) = flowers(&ground, &mut meshes, &names, &mut images);
     let flowers = commands.spawn((Name::new("flowers"), flowers)).id();
     let bush_density = painted_map(&mut images, 9, 0.05, 120.0);
@@ -94,10 +98,10 @@ pub const TREE_SPECIES: [u16; 3] = [0, 1, 2];
 pub const STUMP: u16 = 3;
 
 /// The forests' noise seeds and bases, one per species.
-pub const FORESTS: [(u32, f64); 3] = [(11, -0.1), (12, -0.2), (13, -0.35)];
+const FORESTS: [(u32, f64); 3] = [(11, -0.1), (12, -0.2), (13, -0.35)];
 
 /// The density of one species' forest (trees per square metre).
-pub fn forest(seed: u32, base: f64) -> NoiseDensity {
+fn forest(seed: u32, base: f64) -> NoiseDensity {
     NoiseDensity::new(NoiseParams {
         seed,
         frequency: 1.0 / 650.0,
@@ -106,6 +110,44 @@ pub fn forest(seed: u32, base: f64) -> NoiseDensity {
         amplitude: 1.9,
         scale: 0.01,
     })
+}
+
+/// The three forests together: trees per square metre of all species.
+pub struct ForestCover([NoiseDensity; 3]);
+
+impl ForestCover {
+    pub fn new() -> Self {
+        Self(FORESTS.map(|(seed, base)| forest(seed, base)))
+    }
+}
+
+impl Density for ForestCover {
+    fn density(&self, p: DVec2) -> f64 {
+        self.0.iter().map(|f| f.density(p)).sum()
+    }
+
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        self.0.iter().map(|f| f.max_over(min, max)).sum()
+    }
+}
+
+/// Ferns per square metre under a full canopy.
+const FERNS: f64 = 0.3;
+/// The forest cover (trees per square metre) from which ferns grow at full density; they
+/// thin out towards forest edges.
+const FERN_COVER: f64 = 0.005;
+
+/// The ferns' density: the forest floor's, from the forest cover.
+struct FernDensity(ForestCover);
+
+impl Density for FernDensity {
+    fn density(&self, p: DVec2) -> f64 {
+        FERNS * (self.0.density(p) / FERN_COVER).min(1.0)
+    }
+
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        FERNS * (self.0.max_over(min, max) / FERN_COVER).min(1.0)
+    }
 }
 
 /// Forests of three species from fractal noise; near and far meshes crossfade at 180 m.
@@ -251,6 +293,41 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
         .with_falloff(35.0, 115.0)
         .with_height(ground.clone())
         .with_height_range(WATER + 0.3, 105.0)
+}
+
+/// Ferns on the forest floor: textured fronds, cut out by the texture's alpha, instanced.
+fn ferns(
+    ground: &HeightSource,
+    meshes: &mut Assets<Mesh>,
+    images: &mut Assets<Image>,
+) -> ScatterLayer {
+    let mut class = ScatterClass::instanced(
+        LayerDensity::Custom(Arc::new(FernDensity(ForestCover::new()))),
+        meshes.add(foliage::fern(7, 1.6)),
+        InstancedMaterial {
+            base_color: Color::srgb(0.07, 0.17, 0.04),
+            tip_color: Color::srgb(0.3, 0.5, 0.12),
+            tip_from: 0.2,
+            wind_response: 0.35,
+            texture: Some(images.add(foliage::fern_texture())),
+            shadows: InstancedShadows::Within(GRASS_SHADOWS),
+            ..default()
+        },
+    );
+    class.scale_variation = 0.3;
+    ScatterLayer::new(vec![class])
+        .with_seed(6)
+        .with_tile_size(16.0)
+        .with_streaming(StreamingConfig {
+            chunk_size: 32.0,
+            load_distance: 110.0,
+            unload_distance: 130.0,
+            near_distance: 32.0,
+        })
+        .with_falloff(60.0, 105.0)
+        .with_height(ground.clone())
+        .with_height_range(WATER + 1.5, 112.0)
+        .with_max_slope(0.7)
 }
 
 /// Flowers in three colours, each from its own painted map (up to 5 per square metre),

@@ -1,8 +1,9 @@
 //! A game scene streamed by `bevy_rwt`: an unbounded hilly world (walk 10 km in any
 //! direction: nothing is precomputed) with dense wind-blown grass and painted flower
-//! meadows drawn from per-chunk instance buffers, bushes, rocks and three tree species as
-//! entities (near and far meshes crossfading), forests thinning to a sparse remainder that
-//! reaches the horizon, and a density brush that paints the flower and bush maps live.
+//! meadows drawn from per-chunk instance buffers, ferns with textured fronds on the forest
+//! floor, bushes, rocks and three tree species as entities (near and far meshes
+//! crossfading), forests thinning to a sparse remainder that reaches the horizon, and a
+//! density brush that paints the flower and bush maps live.
 //!
 //! `cargo run --release --example open_world`
 //! - WASD / arrows fly, Q / E down and up, Shift boosts, hold the right mouse button to
@@ -10,7 +11,8 @@
 //! - B toggles the brush: left mouse paints, right erases, the wheel sizes it, T sets the
 //!   strength, 1-4 choose the map, Z undoes, F5 saves the maps and the flower and bush
 //!   layer files to `painted/` (or `RWT_PAINT_DIR`), F9 loads the maps;
-//! - V toggles the wind, F the fade-in (see the popping it hides), G chunk outlines;
+//! - V toggles the wind, F the fade-in (see the popping it hides), G chunk outlines, O
+//!   temporal anti-aliasing with ambient occlusion (on; off gives 4x MSAA instead);
 //! - with the brush off, a left click chops the tree under the cursor (a stump stays), H
 //!   places a cabin that clears the ground under it; F5 saves these edits with the maps;
 //! - K walks on foot (a capsule that trunks, stumps and rocks stop; avian3d), K again flies.
@@ -21,8 +23,9 @@ mod play;
 mod script;
 mod walk;
 
+use bevy::anti_alias::taa::TemporalAntiAliasing;
 use bevy::light::CascadeShadowConfigBuilder;
-use bevy::pbr::{DistanceFog, FogFalloff};
+use bevy::pbr::{DistanceFog, FogFalloff, ScreenSpaceAmbientOcclusion};
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
@@ -54,7 +57,13 @@ fn main() {
         .add_systems(Startup, (setup_scene, layers::setup_layers))
         .add_systems(
             Update,
-            (stay_above_ground, follow_ground, toggles, hud)
+            (
+                stay_above_ground,
+                follow_ground,
+                toggles,
+                toggle_taa_ssao,
+                hud,
+            )
                 .chain()
                 .after(script::ScriptSystems),
         )
@@ -77,6 +86,7 @@ fn setup_scene(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut gizmos: ResMut<RwtGizmos>,
+    smoke: Res<Smoke>,
 ) {
     *gizmos = RwtGizmos {
         chunks: false,
@@ -84,29 +94,42 @@ fn setup_scene(
         lift: 60.0,
     };
     let start = Vec2::ZERO;
-    commands.spawn((
-        Camera3d::default(),
-        Projection::Perspective(PerspectiveProjection {
-            far: 7000.0,
-            ..default()
-        }),
-        Transform::from_xyz(start.x, terrain.height(start) + 40.0, start.y),
-        FlyCamera {
-            speed: 40.0,
-            ..default()
-        },
-        RwtViewer::default(),
-        DistanceFog {
-            color: SKY,
-            directional_light_color: Color::srgba(1.0, 0.93, 0.78, 0.5),
-            directional_light_exponent: 24.0,
-            falloff: FogFalloff::from_visibility_colors(
-                4500.0,
-                Color::srgb(0.42, 0.52, 0.64),
-                Color::srgb(0.72, 0.8, 0.9),
-            ),
-        },
-    ));
+    let camera = commands
+        .spawn((
+            Camera3d::default(),
+            Projection::Perspective(PerspectiveProjection {
+                far: 7000.0,
+                ..default()
+            }),
+            Transform::from_xyz(start.x, terrain.height(start) + 40.0, start.y),
+            FlyCamera {
+                speed: 40.0,
+                ..default()
+            },
+            RwtViewer::default(),
+            DistanceFog {
+                color: SKY,
+                directional_light_color: Color::srgba(1.0, 0.93, 0.78, 0.5),
+                directional_light_exponent: 24.0,
+                falloff: FogFalloff::from_visibility_colors(
+                    4500.0,
+                    Color::srgb(0.42, 0.52, 0.64),
+                    Color::srgb(0.72, 0.8, 0.9),
+                ),
+            },
+        ))
+        .id();
+    // TAA and SSAO read the depth, normal and motion-vector prepasses, which the instanced
+    // grass takes part in (its sway included), and need MSAA off. Not in a scripted smoke
+    // session: lavapipe keeps recompiling this scene's shader variants every frame (its
+    // memory grows by tens of MB a second) and these add more; instanced_passes checks them.
+    if !smoke.active() {
+        commands.entity(camera).insert((
+            Msaa::Off,
+            TemporalAntiAliasing::default(),
+            ScreenSpaceAmbientOcclusion::default(),
+        ));
+    }
     commands.spawn((
         DirectionalLight {
             illuminance: 11_000.0,
@@ -213,6 +236,31 @@ fn toggles(
     }
 }
 
+/// O: TAA with SSAO (the default), or 4x MSAA without them (they cannot be combined).
+fn toggle_taa_ssao(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut commands: Commands,
+    mut cameras: Query<(Entity, &mut Msaa, Has<TemporalAntiAliasing>), With<FlyCamera>>,
+) {
+    if !keys.just_pressed(KeyCode::KeyO) {
+        return;
+    }
+    for (camera, mut msaa, taa) in &mut cameras {
+        if taa {
+            commands
+                .entity(camera)
+                .remove::<(TemporalAntiAliasing, ScreenSpaceAmbientOcclusion)>();
+            *msaa = Msaa::Sample4;
+        } else {
+            *msaa = Msaa::Off;
+            commands.entity(camera).insert((
+                TemporalAntiAliasing::default(),
+                ScreenSpaceAmbientOcclusion::default(),
+            ));
+        }
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn hud(
     time: Res<Time>,
@@ -221,7 +269,7 @@ fn hud(
     wind: Res<RwtWind>,
     fade: Res<RwtFadeIn>,
     layers: Query<(&Name, &ScatterLayerStatus)>,
-    camera: Query<(&Transform, &FlyCamera)>,
+    camera: Query<(&Transform, &FlyCamera, Has<TemporalAntiAliasing>)>,
     mut hud: ResMut<Hud>,
     mut fps: Local<f32>,
 ) {
@@ -231,7 +279,7 @@ fn hud(
     } else {
         *fps * 0.95 + 0.05 / dt
     };
-    let Ok((t, cam)) = camera.single() else {
+    let Ok((t, cam, taa)) = camera.single() else {
         return;
     };
     let on = |b: bool| if b { "on" } else { "off" };
@@ -244,7 +292,7 @@ fn hud(
         })
         .collect();
     hud.lines = vec![
-        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | click chops a tree, H cabin, K walk | V wind, F fade-in, G chunks".into(),
+        "WASD fly, Q/E down/up, right mouse look, wheel speed | B brush | click chops, H cabin, K walk | V wind, F fade, G chunks, O TAA".into(),
         format!(
             "position {:.0}, {:.0} m, altitude {:.0} m, speed {:.0} m/s",
             t.translation.x, t.translation.z, t.translation.y, cam.speed
@@ -260,9 +308,10 @@ fn hud(
             *fps
         ),
         format!(
-            "wind {}  fade-in {}  {}",
+            "wind {}  fade-in {}  TAA+SSAO {}  {}",
             on(wind.strength > 0.0),
             on(fade.0),
+            on(taa),
             brush_line(&brush)
         ),
     ];

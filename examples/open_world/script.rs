@@ -6,7 +6,7 @@
 //! the cabin's clearing from above); then the brush saves the painted world (maps, layer
 //! files and edits) to `RWT_PAINT_DIR`.
 
-use crate::layers::{FORESTS, forest};
+use crate::layers::ForestCover;
 use crate::play::{Play, play};
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushCommand, BrushSystems, DensityBrush, PaintDab};
@@ -201,11 +201,8 @@ fn end_pose(view: View, terrain: &Terrain, (p, yaw): (Vec2, f32)) -> (Vec3, f32,
 /// A place near `p` in open ground that looks at a forest about 60 m ahead, and the yaw
 /// that looks there.
 fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
-    let forests = FORESTS.map(|(seed, base)| forest(seed, base));
-    let density = |q: Vec2| -> f64 {
-        let d = glam::DVec2::new(q.x as f64, q.y as f64);
-        forests.iter().map(|f| f.density(d)).sum()
-    };
+    let cover = ForestCover::new();
+    let density = |q: Vec2| cover.density(glam::DVec2::new(q.x as f64, q.y as f64));
     let mut best = (f64::MIN, p, 0.0);
     for ring in 0..30 {
         for k in 0..24 {
