@@ -197,17 +197,7 @@ fn disc_texture() -> Image {
             data.extend_from_slice(&[220, 30, 30, if inside { 255 } else { 0 }]);
         }
     }
-    Image::new(
-        bevy::render::render_resource::Extent3d {
-            width: n,
-            height: n,
-            depth_or_array_layers: 1,
-        },
-        bevy::render::render_resource::TextureDimension::D2,
-        data,
-        bevy::render::render_resource::TextureFormat::Rgba8UnormSrgb,
-        bevy::asset::RenderAssetUsages::default(),
-    )
+    rwt_examples::foliage::srgba_image(n, n, data)
 }
 
 /// Where the check stands.

@@ -354,10 +354,16 @@ pub fn fern_texture() -> Image {
             data.extend_from_slice(&[rgba[0], rgba[1], rgba[2], alpha]);
         }
     }
+    srgba_image(WIDTH, HEIGHT, data)
+}
+
+/// A 2-D sRGB colour image with alpha of `width` x `height` texels, `data` row by row
+/// from the top, 4 bytes a texel.
+pub fn srgba_image(width: u32, height: u32, data: Vec<u8>) -> Image {
     Image::new(
         bevy::render::render_resource::Extent3d {
-            width: WIDTH,
-            height: HEIGHT,
+            width,
+            height,
             depth_or_array_layers: 1,
         },
         bevy::render::render_resource::TextureDimension::D2,
