@@ -198,7 +198,7 @@ fn end_pose(view: View, terrain: &Terrain, (p, yaw): (Vec2, f32)) -> (Vec3, f32,
     }
 }
 
-/// A place near `p` in open ground that looks at a forest about 60 m ahead, and the yaw
+/// A place near `p` in open ground that looks at a forest about 35 m ahead (its ferns in view), and the yaw
 /// that looks there.
 fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
     let cover = ForestCover::new();
@@ -211,7 +211,7 @@ fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
             for j in 0..8 {
                 let yaw = j as f32 / 8.0 * std::f32::consts::TAU;
                 // FlyCamera looks along -z turned by yaw.
-                let ahead = at + Vec2::new(-yaw.sin(), -yaw.cos()) * 60.0;
+                let ahead = at + Vec2::new(-yaw.sin(), -yaw.cos()) * 35.0;
                 let dry = terrain.height(at) > WATER + 2.0 && terrain.height(ahead) > WATER + 2.0;
                 let score = density(ahead) - 3.0 * density(at) - 1e-6 * ring as f64;
                 if dry && score > best.0 {
