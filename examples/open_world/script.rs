@@ -198,8 +198,8 @@ fn end_pose(view: View, terrain: &Terrain, (p, yaw): (Vec2, f32)) -> (Vec3, f32,
     }
 }
 
-/// A place near `p` in open ground that looks at a forest about 35 m ahead (its ferns in view), and the yaw
-/// that looks there.
+/// A place near `p` in open ground that looks at a forest about 35 m ahead (its ferns in
+/// view), and the yaw that looks there.
 fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
     let cover = ForestCover::new();
     let density = |q: Vec2| cover.density(glam::DVec2::new(q.x as f64, q.y as f64));
