@@ -129,6 +129,10 @@ impl Density for ForestCover {
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         self.0.iter().map(|f| f.max_over(min, max)).sum()
     }
+
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        self.0.iter().map(|f| f.min_over(min, max)).sum()
+    }
 }
 
 /// Ferns per square metre under a full canopy.
@@ -147,6 +151,11 @@ impl Density for FernDensity {
 
     fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
         FERNS * (self.0.max_over(min, max) / FERN_COVER).min(1.0)
+    }
+
+    /// The density grows with the cover, so the cover's bounds bound it.
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        FERNS * (self.0.min_over(min, max) / FERN_COVER).min(1.0)
     }
 }
 
