@@ -124,11 +124,7 @@ fn setup_scene(
     // session: lavapipe keeps recompiling this scene's shader variants every frame (its
     // memory grows by tens of MB a second) and these add more; instanced_passes checks them.
     if !smoke.active() {
-        commands.entity(camera).insert((
-            Msaa::Off,
-            TemporalAntiAliasing::default(),
-            ScreenSpaceAmbientOcclusion::default(),
-        ));
+        commands.entity(camera).insert(taa_ssao());
     }
     commands.spawn((
         DirectionalLight {
@@ -240,25 +236,30 @@ fn toggles(
 fn toggle_taa_ssao(
     keys: Res<ButtonInput<KeyCode>>,
     mut commands: Commands,
-    mut cameras: Query<(Entity, &mut Msaa, Has<TemporalAntiAliasing>), With<FlyCamera>>,
+    cameras: Query<(Entity, Has<TemporalAntiAliasing>), With<FlyCamera>>,
 ) {
     if !keys.just_pressed(KeyCode::KeyO) {
         return;
     }
-    for (camera, mut msaa, taa) in &mut cameras {
+    for (camera, taa) in &cameras {
         if taa {
             commands
                 .entity(camera)
-                .remove::<(TemporalAntiAliasing, ScreenSpaceAmbientOcclusion)>();
-            *msaa = Msaa::Sample4;
+                .remove::<(TemporalAntiAliasing, ScreenSpaceAmbientOcclusion)>()
+                .insert(Msaa::Sample4);
         } else {
-            *msaa = Msaa::Off;
-            commands.entity(camera).insert((
-                TemporalAntiAliasing::default(),
-                ScreenSpaceAmbientOcclusion::default(),
-            ));
+            commands.entity(camera).insert(taa_ssao());
         }
     }
+}
+
+/// TAA and SSAO, and MSAA off (they cannot be combined with it).
+fn taa_ssao() -> impl Bundle {
+    (
+        Msaa::Off,
+        TemporalAntiAliasing::default(),
+        ScreenSpaceAmbientOcclusion::default(),
+    )
 }
 
 #[allow(clippy::too_many_arguments)]
