@@ -86,7 +86,6 @@ fn setup_scene(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut gizmos: ResMut<RwtGizmos>,
-    smoke: Res<Smoke>,
 ) {
     *gizmos = RwtGizmos {
         chunks: false,
@@ -120,12 +119,8 @@ fn setup_scene(
         ))
         .id();
     // TAA and SSAO read the depth, normal and motion-vector prepasses, which the instanced
-    // grass takes part in (its sway included), and need MSAA off. Not in a scripted smoke
-    // session: lavapipe keeps recompiling this scene's shader variants every frame (its
-    // memory grows by tens of MB a second) and these add more; instanced_passes checks them.
-    if !smoke.active() {
-        commands.entity(camera).insert(taa_ssao());
-    }
+    // grass takes part in (its sway included), and need MSAA off.
+    commands.entity(camera).insert(taa_ssao());
     commands.spawn((
         DirectionalLight {
             illuminance: 11_000.0,

@@ -103,12 +103,14 @@ fn value_noise(p: vec2<f32>) -> f32 {
     return mix(mix(a, b, u.x), mix(c, d, u.x), u.y);
 }
 
+// No branch below depends on uniforms alone (`select` and factors instead): Mesa's lavapipe
+// inlines the uniforms that steer branches and compiles the shader anew at every draw whose
+// values it has not seen, which with one draw per chunk and view is a compile per draw,
+// and memory that grows by megabytes a second.
+
 // Growth of an instance: 0 until the level-of-detail factor at its place reaches the one at
-// which its point appears, then up to 1 over the fade band.
+// which its point appears, then up to 1 over the fade band (always 1 without fall-off).
 fn growth(root: vec3<f32>, appear: f32) -> f32 {
-    if chunk.falloff.z == 0.0 {
-        return 1.0;
-    }
 #ifdef RWT_SHADOW_PASS
     let eye = frame.viewer.xz;
 #else
@@ -117,7 +119,8 @@ fn growth(root: vec3<f32>, appear: f32) -> f32 {
     let distance = length(root.xz - eye);
     let span = max(chunk.falloff.y - chunk.falloff.x, 1e-3);
     let factor = max(chunk.falloff.w, clamp(1.0 - (distance - chunk.falloff.x) / span, 0.0, 1.0));
-    return clamp((factor - appear) / chunk.params.w, 0.0, 1.0);
+    let grown = clamp((factor - appear) / chunk.params.w, 0.0, 1.0);
+    return select(grown, 1.0, chunk.falloff.z == 0.0);
 }
 
 // Sideways displacement of a point at height fraction `t` (0 root, 1 tip) of an instance
@@ -132,16 +135,15 @@ fn sway(root: vec3<f32>, t: f32, tint: f32, height: f32, time: f32) -> vec3<f32>
     return vec3<f32>(dir.x * bend, -0.3 * abs(bend) * t, dir.y * bend);
 }
 
-// The lean of an instance rooted at `root` (x, z; length 0..1, 1 is flat).
+// The lean of an instance rooted at `root` (x, z; length 0..1, 1 is flat): none outside
+// the field, while nothing leans or when the class does not respond.
 fn lean_at(root: vec3<f32>) -> vec2<f32> {
-    if frame.bend.w == 0.0 || chunk.shading.y == 0.0 {
-        return vec2<f32>(0.0);
-    }
     let uv = (root.xz - frame.bend.xy) * frame.bend.z;
     if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
         return vec2<f32>(0.0);
     }
-    let lean = textureSampleLevel(bend_field, bend_sampler, uv, 0.0).xy * chunk.shading.y;
+    let response = chunk.shading.y * frame.bend.w;
+    let lean = textureSampleLevel(bend_field, bend_sampler, uv, 0.0).xy * response;
     let amount = length(lean);
     return select(lean, lean / amount, amount > 1.0);
 }
