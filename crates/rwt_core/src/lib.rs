@@ -83,6 +83,8 @@ pub mod analysis;
 pub mod bench;
 #[cfg(feature = "build")]
 pub mod construction;
+#[cfg(feature = "build")]
+pub mod dart_throwing;
 pub mod density;
 pub mod edits;
 pub mod files;

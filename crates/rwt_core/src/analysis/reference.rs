@@ -2,7 +2,7 @@
 //! with. All fill the square `[origin, origin + side)` with about `count` points.
 
 #[cfg(feature = "build")]
-use crate::construction::DartThrowing;
+use crate::dart_throwing::DartThrowing;
 use crate::rng::Rng;
 use glam::DVec2;
 

@@ -2,7 +2,7 @@
 //! Compiled with the `build` feature: games that only query a shipped set need none of it.
 //!
 //! [`build`] runs the paper's stages, one call each:
-//! 1. progressive toroidal source tiles (`source_tile`), one per edge colour and
+//! 1. progressive toroidal source tiles (`crate::dart_throwing`), one per edge colour and
 //!    orientation plus one unique interior per tile;
 //! 2. Wang tiles by merging sources along min-cost Voronoi seams (`seam`, `merging`),
 //!    keeping the first `N` of the interleaved source ranks;
@@ -20,10 +20,9 @@ mod progressive;
 mod ranking;
 mod relaxation;
 mod seam;
-mod source_tile;
 mod subdivision;
 
-pub use source_tile::DartThrowing;
+pub use crate::dart_throwing::DartThrowing;
 pub use subdivision::RulesError;
 
 use crate::rng::Rng;

@@ -334,7 +334,7 @@ impl SeamGraph {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::construction::source_tile::DartThrowing;
+    use crate::dart_throwing::DartThrowing;
     use crate::rng::Rng;
 
     fn source(seed: u64, origin: Origin) -> Vec<SourcedPoint> {
