@@ -164,8 +164,8 @@ use bevy::prelude::*;
 pub use diagnostics::RwtStats;
 pub use instancing::{Bender, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind};
 pub use layers::{
-    AssetStatus, HeightSource, LayerDensity, Promotion, ScatterClass, ScatterInstance,
-    ScatterLayer, ScatterLayerStatus,
+    AssetStatus, DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, HeightSource, LayerDensity, Promotion,
+    ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus,
 };
 pub use look::{
     ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, InstancedShadows,

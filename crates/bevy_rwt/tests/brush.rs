@@ -3,7 +3,7 @@
 mod common;
 
 use bevy::prelude::*;
-use bevy_rwt::brush::{BrushError, PaintedMaps};
+use bevy_rwt::brush::{BrushError, MapAccess, PaintedMaps};
 use bevy_rwt::edits::{EditInstance, ScatterEdits};
 use bevy_rwt::layers::file::NamedAssets;
 use bevy_rwt::prelude::*;
@@ -240,8 +240,18 @@ fn bad_targets_and_files_are_typed_errors() {
     let (mut app, _) = painted_app();
     let before = instances(&mut app);
     for (target, expected) in [
-        (1, BrushError::NotPaintable("constant".into())),
-        (2, BrushError::NoLayer("no class".into())),
+        (
+            1,
+            BrushError::NotPaintable {
+                target: "constant".into(),
+            },
+        ),
+        (
+            2,
+            BrushError::NoLayer {
+                target: "no class".into(),
+            },
+        ),
         (9, BrushError::NoTarget(9)),
     ] {
         stroke(&mut app, target, Vec2::ZERO, 1.0, 1);
@@ -525,7 +535,15 @@ fn a_save_that_fails_part_way_changes_no_file() {
         .targets
         .push(BrushTarget::new(odd, 0, "odd"));
     let err = command(&mut app, BrushCommand::Save(dir.clone())).unwrap_err();
-    assert_eq!(err, BrushError::MapUnavailable("odd".into()));
+    assert_eq!(
+        err,
+        BrushError::MapUnavailable {
+            target: "odd".into(),
+            why: MapAccess::NotOnCpu {
+                format: bevy::render::render_resource::TextureFormat::Bc1RgbaUnorm
+            },
+        }
+    );
     assert_eq!(folder(&dir), before);
     std::fs::remove_dir_all(&dir).ok();
 }

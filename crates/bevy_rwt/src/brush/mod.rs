@@ -79,6 +79,7 @@ pub use plugin::RwtBrushPlugin;
 pub use ray::ground_hit;
 
 use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
 use std::path::PathBuf;
 
 /// The brush's systems (cursor, input, dabs, commands), in `Update` before
@@ -237,6 +238,38 @@ pub enum BrushCommand {
     Load(PathBuf),
 }
 
+/// Why a painted map's texels could not be read or written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum MapAccess {
+    /// The image asset is not loaded (or was removed).
+    #[error("not loaded")]
+    NotLoaded,
+    /// Its texels cannot be read or written on the CPU: no CPU copy (the asset kept only on
+    /// the GPU), or a format without per-texel colour access.
+    #[error("not editable on the CPU (format {format:?})")]
+    NotOnCpu {
+        /// The image's format.
+        format: TextureFormat,
+    },
+}
+
+impl MapAccess {
+    /// Why `image`'s texels could not be used: not loaded, or not on the CPU.
+    pub(crate) fn of(image: Option<&Image>) -> Self {
+        image.map_or(Self::NotLoaded, |image| Self::NotOnCpu {
+            format: image.texture_descriptor.format,
+        })
+    }
+
+    /// The brush error for target `target`.
+    pub(crate) fn at(self, target: &str) -> BrushError {
+        BrushError::MapUnavailable {
+            target: target.to_string(),
+            why: self,
+        }
+    }
+}
+
 /// Why the brush could not do something.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BrushError {
@@ -244,14 +277,25 @@ pub enum BrushError {
     #[error("no brush target {0}")]
     NoTarget(usize),
     /// The target's layer entity has no `ScatterLayer`, or no such class.
-    #[error("target {0}: no such layer or class")]
-    NoLayer(String),
+    #[error("target {target}: no such layer or class")]
+    NoLayer {
+        /// The target's name.
+        target: String,
+    },
     /// The target's class density is not a painted map.
-    #[error("target {0}: its density is not an image map")]
-    NotPaintable(String),
-    /// The map is not loaded, or its texels cannot be read or written on the CPU.
-    #[error("target {0}: map not loaded or not editable on the CPU")]
-    MapUnavailable(String),
+    #[error("target {target}: its density is not an image map")]
+    NotPaintable {
+        /// The target's name.
+        target: String,
+    },
+    /// The target's map cannot be painted, saved or loaded into.
+    #[error("target {target}: map {why}")]
+    MapUnavailable {
+        /// The target's name.
+        target: String,
+        /// Why.
+        why: MapAccess,
+    },
     /// Nothing to undo.
     #[error("nothing to undo")]
     NothingToUndo,

@@ -1,6 +1,6 @@
 //! Dabs of paint on a map's texels, and what a stroke needs to be undone.
 
-use super::{BrushError, DensityBrush};
+use super::{BrushError, DensityBrush, MapAccess};
 use crate::layers::{LayerDensity, ScatterLayer, ground_rect, texel_luminance};
 use bevy::asset::RenderAssetUsages;
 use bevy::platform::collections::HashMap;
@@ -60,7 +60,9 @@ pub(super) fn target_map(
         .ok()
         .and_then(|l| l.classes.get(target.class))
         .map(|c| &c.density)
-        .ok_or_else(|| BrushError::NoLayer(target.name.clone()))?;
+        .ok_or_else(|| BrushError::NoLayer {
+            target: target.name.clone(),
+        })?;
     match density {
         LayerDensity::Image {
             image,
@@ -75,7 +77,9 @@ pub(super) fn target_map(
             },
             scale: *scale,
         }),
-        _ => Err(BrushError::NotPaintable(target.name.clone())),
+        _ => Err(BrushError::NotPaintable {
+            target: target.name.clone(),
+        }),
     }
 }
 
@@ -163,14 +167,14 @@ pub(super) struct Dab {
 /// weighted by a smooth bump (1 at the centre, 0 at the radius), clamped to `0..=1`: read
 /// only, so that a dab changing nothing (outside the map, or already full or empty) leaves
 /// the map unmodified (a modified map is re-read and re-scattered). `Err` for a map whose
-/// texels cannot be read.
+/// texels cannot be read on the CPU.
 pub(super) fn dab(
     image: &Image,
     at: MapPlacement,
     centre: Vec2,
     radius: f32,
     amount: f32,
-) -> Result<Dab, ()> {
+) -> Result<Dab, MapAccess> {
     let (w, h) = (image.width(), image.height());
     let radius = radius.max(1e-3);
     let (x0, x1, y0, y1) = at.texel_span(centre, radius, w, h);
@@ -182,7 +186,7 @@ pub(super) fn dab(
                 continue;
             }
             let weight = (1.0 - d * d).powi(2);
-            let old = texel_luminance(image, x, y).ok_or(())?;
+            let old = texel_luminance(image, x, y).ok_or(MapAccess::of(Some(image)))?;
             let new = (old + amount * weight).clamp(0.0, 1.0);
             if (new - old).abs() >= 1e-4 {
                 changes.push((y * w + x, old, new));
@@ -207,7 +211,7 @@ impl Dab {
         image: &mut Image,
         id: AssetId<Image>,
         record: &mut StrokeRecord,
-    ) -> Result<Option<Rect>, ()> {
+    ) -> Result<Option<Rect>, MapAccess> {
         if self.is_empty() {
             return Ok(None);
         }
@@ -215,7 +219,7 @@ impl Dab {
         for &(texel, old, new) in &self.changes {
             record.note(id, texel, old);
             if !set_texel_luminance(image, texel % w, texel / w, new) {
-                return Err(());
+                return Err(MapAccess::of(Some(image)));
             }
         }
         if let Some(r) = self.region {
@@ -260,7 +264,7 @@ mod tests {
         radius: f32,
         amount: f32,
         record: &mut StrokeRecord,
-    ) -> Result<Option<Rect>, ()> {
+    ) -> Result<Option<Rect>, MapAccess> {
         dab(image, at, centre, radius, amount)?.apply(image, id, record)
     }
 

@@ -8,7 +8,7 @@
 //! the world only when all of it is good.
 
 use super::paint::{set_texel_luminance, target_map};
-use super::{BrushError, BrushTarget, DensityBrush};
+use super::{BrushError, BrushTarget, DensityBrush, MapAccess};
 use crate::edits::{EditSet, EditStamp};
 use crate::layers::file::{LayerDescription, NamedAssets};
 use crate::layers::{ScatterLayer, texel_luminance};
@@ -141,12 +141,12 @@ fn write_map(image: &Image, target: &str, w: &mut dyn Write) -> Result<(), Brush
     for y in 0..height {
         for x in 0..width {
             let v = texel_luminance(image, x, y)
-                .ok_or_else(|| BrushError::MapUnavailable(target.to_string()))?;
+                .ok_or_else(|| MapAccess::of(Some(image)).at(target))?;
             pixels.push((v.clamp(0.0, 1.0) * 65535.0).round() as u16);
         }
     }
     let png = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels)
-        .ok_or_else(|| BrushError::MapUnavailable(target.to_string()))?;
+        .ok_or_else(|| MapAccess::of(Some(image)).at(target))?;
     png.write_with_encoder(image::codecs::png::PngEncoder::new(w))
         .map_err(|e| BrushError::Encode {
             target: target.to_string(),
@@ -220,7 +220,7 @@ pub(super) fn save(
         let image = from
             .images
             .get(&map.image)
-            .ok_or_else(|| BrushError::MapUnavailable(name.clone()))?;
+            .ok_or_else(|| MapAccess::NotLoaded.at(name))?;
         let file = names.claim(name, "png");
         let mut failed = None;
         save.write_with(&file, |w| {
@@ -282,10 +282,9 @@ fn stage_layer_files(
     }
     for entity in entities {
         let name = (from.layer_name)(entity).unwrap_or_else(|| format!("layer {entity}"));
-        let layer = from
-            .layers
-            .get(entity)
-            .map_err(|_| BrushError::NoLayer(name.clone()))?;
+        let layer = from.layers.get(entity).map_err(|_| BrushError::NoLayer {
+            target: name.clone(),
+        })?;
         let image_path = |h: &Handle<Image>| saved.get(&h.id()).cloned();
         match LayerDescription::describe(layer, from.names, image_path).and_then(|d| d.to_ron()) {
             Ok(text) => {
@@ -323,10 +322,10 @@ pub(super) fn load(
             continue;
         };
         let map = target_map(brush, i, layers)?;
-        let image = images
-            .get(&map.image)
+        let image = images.get(&map.image);
+        let image = image
             .filter(|image| texel_luminance(image, 0, 0).is_some())
-            .ok_or_else(|| BrushError::MapUnavailable(entry.name.clone()))?;
+            .ok_or_else(|| MapAccess::of(image).at(&entry.name))?;
         let values = read_map(&dir.join(&entry.file), image.width(), image.height())?;
         read.push((map.image, entry.name.clone(), values));
     }
@@ -340,12 +339,12 @@ pub(super) fn load(
     for (handle, name, values) in &read {
         let mut image = images
             .get_mut(handle)
-            .ok_or_else(|| BrushError::MapUnavailable(name.clone()))?;
+            .ok_or_else(|| MapAccess::NotLoaded.at(name))?;
         let width = image.width();
         for (texel, &v) in values.iter().enumerate() {
             let (x, y) = (texel as u32 % width, texel as u32 / width);
             if !set_texel_luminance(&mut image, x, y, v) {
-                return Err(BrushError::MapUnavailable(name.clone()));
+                return Err(MapAccess::of(Some(&image)).at(name));
             }
         }
     }

@@ -2,7 +2,9 @@
 
 use super::paint::{StrokeRecord, dab, restore, target_map};
 use super::persist::{LayerEdits, SaveSources, load, save};
-use super::{BrushCommand, BrushError, BrushSystems, DensityBrush, PaintDab, ground_hit};
+use super::{
+    BrushCommand, BrushError, BrushSystems, DensityBrush, MapAccess, PaintDab, ground_hit,
+};
 use crate::edits::ScatterEdits;
 use crate::layers::file::NamedAssets;
 use crate::layers::{HeightFn, ScatterLayer};
@@ -205,24 +207,19 @@ fn apply_dabs(
             }
         };
         let record = history.open.get_or_insert_with(StrokeRecord::default);
-        let unavailable = || {
-            Some(Err(BrushError::MapUnavailable(
-                brush.targets[d.target].name.clone(),
-            )))
-        };
         // Read first: the map is only modified (and re-read, its chunks re-scattered) when
         // the dab changes a texel.
         let planned = images
             .get(&map.image)
-            .ok_or(())
+            .ok_or(MapAccess::NotLoaded)
             .and_then(|image| dab(image, map.at, d.centre, d.radius, d.amount));
         let written = match planned {
             Ok(planned) if planned.is_empty() => Ok(None),
             Ok(planned) => match images.get_mut(&map.image) {
                 Some(mut image) => planned.apply(&mut image, map.image.id(), record),
-                None => Err(()),
+                None => Err(MapAccess::NotLoaded),
             },
-            Err(()) => Err(()),
+            Err(why) => Err(why),
         };
         match written {
             Ok(Some(region)) => {
@@ -232,7 +229,7 @@ fn apply_dabs(
                 });
             }
             Ok(None) => {}
-            Err(()) => brush.last = unavailable(),
+            Err(why) => brush.last = Some(Err(why.at(&brush.targets[d.target].name))),
         }
     }
     if !any {

@@ -222,7 +222,7 @@ impl ScatterClass {
             density,
             look,
             scale: 1.0,
-            scale_variation: 0.2,
+            scale_variation: DEFAULT_SCALE_VARIATION,
             lod: None,
             pick_bounds: None,
             promotion: None,
@@ -367,12 +367,18 @@ pub struct ScatterLayer {
     pub exclusion: Option<LayerDensity>,
 }
 
+/// A layer's tile size (world units per base tile) unless set: in code and in layer files.
+pub const DEFAULT_TILE_SIZE: f64 = 8.0;
+
+/// A class's hashed scale variation unless set: in code and in layer files.
+pub const DEFAULT_SCALE_VARIATION: f32 = 0.2;
+
 impl ScatterLayer {
-    /// A layer with one class, tiles of 8 units, default streaming and flat ground.
+    /// A layer with one class, tiles of [`DEFAULT_TILE_SIZE`] units, default streaming and flat ground.
     pub fn new(classes: Vec<ScatterClass>) -> Self {
         Self {
             classes,
-            tile_size: 8.0,
+            tile_size: DEFAULT_TILE_SIZE,
             seed: 0,
             streaming: StreamingConfig::default(),
             falloff: None,

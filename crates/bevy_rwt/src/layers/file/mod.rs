@@ -68,7 +68,10 @@ mod tests;
 pub use loader::ScatterLayerLoader;
 pub use names::NamedAssets;
 
-use super::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+use super::{
+    DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, HeightSource, LayerDensity, ScatterClass,
+    ScatterLayer,
+};
 use crate::look::{GroundPlane, InstancedMaterial, InstancedShadows, MeshLod, blade_mesh};
 use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
@@ -261,7 +264,7 @@ fn one() -> f32 {
 }
 
 fn variation() -> f32 {
-    0.2
+    DEFAULT_SCALE_VARIATION
 }
 
 /// A class in a layer file.
@@ -319,7 +322,7 @@ pub enum HeightDescription {
 }
 
 fn default_tile() -> f64 {
-    8.0
+    DEFAULT_TILE_SIZE
 }
 
 /// A whole layer file.
