@@ -2,8 +2,8 @@
 
 use super::{
     ClassDescription, DensityDescription, HeightDescription, InstancedMaterialDescription,
-    LayerDescription, LayerFileError, LodDescription, MaterialDescription, MeshDescription,
-    NamedAssets,
+    LayerDescription, LayerFileError, LayerPart, LodDescription, MaterialDescription,
+    MeshDescription, NamedAssets, Undescribable,
 };
 use crate::layers::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
 use crate::look::ClassLook;
@@ -35,9 +35,11 @@ impl LayerDescription {
             .classes
             .iter()
             .enumerate()
-            .map(|(i, c)| namer.class(c).map_err(|e| in_class(i, e)))
+            .map(|(i, c)| namer.class(c).map_err(|e| not(LayerPart::Class(i), e)))
             .collect::<Result<_, _>>()?;
-        let (height, ground) = namer.height(&layer.height)?;
+        let (height, ground) = namer
+            .height(&layer.height)
+            .map_err(|e| not(LayerPart::Ground, e))?;
         let streaming = &layer.streaming;
         Ok(Self {
             classes,
@@ -55,20 +57,15 @@ impl LayerDescription {
             height_range: layer.height_range,
             max_slope: layer.max_slope,
             exclusion: match &layer.exclusion {
-                Some(d) => Some(
-                    namer
-                        .density(d)
-                        .map_err(|e| format!("the exclusion: {e}"))
-                        .map_err(LayerFileError::NotDescribable)?,
-                ),
+                Some(d) => Some(namer.density(d).map_err(|e| not(LayerPart::Exclusion, e))?),
                 None => None,
             },
         })
     }
 }
 
-fn in_class(i: usize, why: String) -> LayerFileError {
-    LayerFileError::NotDescribable(format!("class {i}: {why}"))
+fn not(part: LayerPart, what: Undescribable) -> LayerFileError {
+    LayerFileError::NotDescribable { part, what }
 }
 
 fn asset_path<A: Asset>(handle: &Handle<A>) -> Option<String> {
@@ -76,7 +73,7 @@ fn asset_path<A: Asset>(handle: &Handle<A>) -> Option<String> {
 }
 
 impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
-    fn class(&mut self, c: &ScatterClass) -> Result<ClassDescription, String> {
+    fn class(&mut self, c: &ScatterClass) -> Result<ClassDescription, Undescribable> {
         let (mesh, material) = match &c.look {
             ClassLook::Mesh { mesh, material } => (self.mesh(mesh)?, self.material(material)?),
             ClassLook::Instanced(look) => {
@@ -89,7 +86,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
                     MaterialDescription::Instanced(material),
                 )
             }
-            ClassLook::Custom(_) => return Err("a custom look (code) has no file form".into()),
+            ClassLook::Custom(_) => return Err(Undescribable::CustomLook),
         };
         let far = match &c.look {
             ClassLook::Instanced(look) => look.far.as_ref(),
@@ -120,31 +117,34 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
         })
     }
 
-    fn mesh(&self, mesh: &Handle<Mesh>) -> Result<MeshDescription, String> {
+    fn mesh(&self, mesh: &Handle<Mesh>) -> Result<MeshDescription, Undescribable> {
         if let Some(name) = self.names.mesh_name(mesh) {
             return Ok(MeshDescription::Named(name));
         }
         asset_path(mesh)
             .map(MeshDescription::Path)
-            .ok_or_else(|| format!("mesh {:?} has no asset path and no name", mesh.id()))
+            .ok_or(Undescribable::Mesh(mesh.id()))
     }
 
-    fn material(&self, material: &Handle<StandardMaterial>) -> Result<MaterialDescription, String> {
+    fn material(
+        &self,
+        material: &Handle<StandardMaterial>,
+    ) -> Result<MaterialDescription, Undescribable> {
         if let Some(name) = self.names.material_name(material) {
             return Ok(MaterialDescription::Named(name));
         }
         asset_path(material)
             .map(MaterialDescription::Path)
-            .ok_or_else(|| format!("material {:?} has no asset path and no name", material.id()))
+            .ok_or(Undescribable::Material(material.id()))
     }
 
-    fn image(&mut self, image: &Handle<Image>) -> Result<String, String> {
+    fn image(&mut self, image: &Handle<Image>) -> Result<String, Undescribable> {
         (self.image)(image)
             .or_else(|| asset_path(image))
-            .ok_or_else(|| format!("image {:?} has no asset path", image.id()))
+            .ok_or(Undescribable::Image(image.id()))
     }
 
-    fn density(&mut self, d: &LayerDensity) -> Result<DensityDescription, String> {
+    fn density(&mut self, d: &LayerDensity) -> Result<DensityDescription, Undescribable> {
         Ok(match d {
             LayerDensity::Constant(v) => DensityDescription::Constant(*v),
             LayerDensity::Noise(n) => DensityDescription::Noise(n.params()),
@@ -160,7 +160,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
                 scale: *scale,
             },
             LayerDensity::Custom(_) => {
-                return Err("a custom density (code) has no file form".into());
+                return Err(Undescribable::CustomDensity);
             }
         })
     }
@@ -169,15 +169,14 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
     fn height(
         &mut self,
         h: &HeightSource,
-    ) -> Result<(f32, Option<HeightDescription>), LayerFileError> {
-        let not = |why: String| LayerFileError::NotDescribable(format!("the ground: {why}"));
+    ) -> Result<(f32, Option<HeightDescription>), Undescribable> {
         Ok(match h {
             HeightSource::Constant(h) => (*h, None),
             HeightSource::Function(_) => {
                 let name = self
                     .names
                     .height_name(h)
-                    .ok_or_else(|| not("a height function without a name in NamedAssets".into()))?;
+                    .ok_or(Undescribable::HeightFunction)?;
                 (0.0, Some(HeightDescription::Named(name)))
             }
             HeightSource::Image {
@@ -186,7 +185,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
                 size,
                 scale,
             } => {
-                let path = self.image(image).map_err(not)?;
+                let path = self.image(image)?;
                 let ground = HeightDescription::Image {
                     path,
                     min: (*min).into(),

@@ -35,7 +35,7 @@ impl AssetLoader for ScatterLayerLoader {
                 limit: MAX_LAYER_FILE_BYTES,
             });
         }
-        let text = std::str::from_utf8(&bytes).map_err(|e| LayerFileError::Parse(e.to_string()))?;
+        let text = std::str::from_utf8(&bytes)?;
         let description = LayerDescription::from_ron(text)?;
         // Primitive meshes and plain colours become labelled sub-assets of the layer file.
         let ctx = RefCell::new(ctx);

@@ -60,11 +60,13 @@
 //! layer built in code back into a file.
 
 mod describe;
+mod error;
 mod loader;
 mod names;
 #[cfg(test)]
 mod tests;
 
+pub use error::{InvalidLayer, LayerFileError, LayerPart, NamedKind, Undescribable};
 pub use loader::ScatterLayerLoader;
 pub use names::NamedAssets;
 
@@ -395,36 +397,6 @@ impl DensityDescription {
     }
 }
 
-/// What is wrong with a layer file.
-#[derive(Debug, thiserror::Error)]
-pub enum LayerFileError {
-    /// Not readable.
-    #[error("cannot read layer file: {0}")]
-    Io(#[from] std::io::Error),
-    /// Not valid RON for a layer.
-    #[error("invalid layer file: {0}")]
-    Parse(String),
-    /// Valid RON with values out of range.
-    #[error("invalid layer: {0}")]
-    Invalid(String),
-    /// The description could not be written as RON.
-    #[error("cannot write layer file: {0}")]
-    Write(String),
-    /// A layer built in code uses something a layer file cannot name (see
-    /// [`LayerDescription::describe`]).
-    #[error("cannot describe the layer: {0}")]
-    NotDescribable(String),
-    /// The file names a mesh, material or height function [`NamedAssets`] does not have.
-    #[error("layer file names {0}, which is not registered in NamedAssets")]
-    UnknownName(String),
-    /// The file is larger than [`MAX_LAYER_FILE_BYTES`]: not a layer description.
-    #[error("layer file is larger than {limit} bytes")]
-    TooLarge {
-        /// The limit in bytes.
-        limit: u64,
-    },
-}
-
 /// Largest layer file the loader reads (layer files are descriptions of a few kilobytes;
 /// anything larger is refused after reading this many bytes).
 pub const MAX_LAYER_FILE_BYTES: u64 = 1 << 20;
@@ -437,7 +409,7 @@ impl LayerDescription {
             ron::extensions::Extensions::IMPLICIT_SOME
                 | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES,
         );
-        ron::ser::to_string_pretty(self, config).map_err(|e| LayerFileError::Write(e.to_string()))
+        Ok(ron::ser::to_string_pretty(self, config)?)
     }
 
     /// Parses and checks a layer file.
@@ -448,31 +420,27 @@ impl LayerDescription {
             ron::extensions::Extensions::IMPLICIT_SOME
                 | ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES,
         );
-        let d: LayerDescription = options
-            .from_str(text)
-            .map_err(|e| LayerFileError::Parse(e.to_string()))?;
+        let d: LayerDescription = options.from_str(text)?;
+        d.check()?;
+        Ok(d)
+    }
+
+    /// Whether the values are in range.
+    fn check(&self) -> Result<(), InvalidLayer> {
+        let d = self;
         if d.classes.is_empty() {
-            return Err(LayerFileError::Invalid(
-                "a layer needs at least one class".into(),
-            ));
+            return Err(InvalidLayer::NoClasses);
         }
-        if !(d.tile_size.is_finite() && d.tile_size > 0.0) {
-            return Err(LayerFileError::Invalid(format!(
-                "tile_size {} must be positive",
-                d.tile_size
-            )));
-        }
-        for (name, v) in [
+        for (field, v) in [
+            ("tile_size", Some(d.tile_size)),
             ("chunk_size", d.chunk_size),
             ("load_distance", d.load_distance),
             ("unload_distance", d.unload_distance),
         ] {
-            if let Some(v) = v
-                && !(v.is_finite() && v > 0.0)
+            if let Some(value) = v
+                && !(value.is_finite() && value > 0.0)
             {
-                return Err(LayerFileError::Invalid(format!(
-                    "{name} {v} must be positive"
-                )));
+                return Err(InvalidLayer::NotPositive { field, value });
             }
         }
         let chunk = d
@@ -482,17 +450,19 @@ impl LayerDescription {
             .load_distance
             .unwrap_or(StreamingConfig::default().load_distance);
         if load / chunk > rwt_core::streaming::MAX_REACH_CHUNKS {
-            return Err(LayerFileError::Invalid(format!(
-                "load_distance {load} spans more than {} chunks of {chunk}",
-                rwt_core::streaming::MAX_REACH_CHUNKS
-            )));
+            return Err(InvalidLayer::TooFar {
+                load_distance: load,
+                chunk_size: chunk,
+                limit: rwt_core::streaming::MAX_REACH_CHUNKS,
+            });
         }
-        if let (Some(l), Some(u)) = (d.load_distance, d.unload_distance)
-            && u < l
+        if let (Some(load_distance), Some(unload_distance)) = (d.load_distance, d.unload_distance)
+            && unload_distance < load_distance
         {
-            return Err(LayerFileError::Invalid(format!(
-                "unload_distance {u} is below load_distance {l}"
-            )));
+            return Err(InvalidLayer::UnloadBelowLoad {
+                load_distance,
+                unload_distance,
+            });
         }
         for (i, c, lod) in d
             .classes
@@ -501,19 +471,17 @@ impl LayerDescription {
             .filter_map(|(i, c)| Some((i, c, c.lod.as_ref()?)))
         {
             if !(lod.distance.is_finite() && lod.distance > 0.0) {
-                return Err(LayerFileError::Invalid(format!(
-                    "class {i}: lod distance {} must be positive",
-                    lod.distance
-                )));
+                return Err(InvalidLayer::LodDistance {
+                    class: i,
+                    distance: lod.distance,
+                });
             }
             let instanced = matches!(c.material, MaterialDescription::Instanced(_));
             if instanced != matches!(lod.material, MaterialDescription::Instanced(_)) {
-                return Err(LayerFileError::Invalid(format!(
-                    "class {i}: a far material is Instanced() exactly when the class is instanced"
-                )));
+                return Err(InvalidLayer::FarMaterial { class: i });
             }
         }
-        Ok(d)
+        Ok(())
     }
 
     /// The layer, with named assets from `names` and other handles made by the given
@@ -574,7 +542,7 @@ impl LayerDescription {
             Some(HeightDescription::Named(name)) => handles
                 .names
                 .height(name)
-                .ok_or_else(|| LayerFileError::UnknownName(format!("height {name:?}")))?,
+                .ok_or_else(|| unknown(NamedKind::Height, name))?,
             Some(HeightDescription::Image {
                 path,
                 min,
@@ -587,6 +555,14 @@ impl LayerDescription {
                 scale: *scale,
             },
         })
+    }
+}
+
+/// The error for a name `NamedAssets` does not have.
+fn unknown(kind: NamedKind, name: &str) -> LayerFileError {
+    LayerFileError::UnknownName {
+        kind,
+        name: name.to_string(),
     }
 }
 
@@ -608,7 +584,7 @@ where
             MeshDescription::Named(name) => self
                 .names
                 .mesh(name)
-                .ok_or_else(|| LayerFileError::UnknownName(format!("mesh {name:?}"))),
+                .ok_or_else(|| unknown(NamedKind::Mesh, name)),
             other => Ok((self.mesh)(other)),
         }
     }
@@ -621,7 +597,7 @@ where
             MaterialDescription::Named(name) => self
                 .names
                 .material(name)
-                .ok_or_else(|| LayerFileError::UnknownName(format!("material {name:?}"))),
+                .ok_or_else(|| unknown(NamedKind::Material, name)),
             other => Ok((self.material)(other)),
         }
     }

@@ -260,7 +260,13 @@ fn what_a_file_cannot_name_is_a_typed_error() {
     let layer = code_layer(&names, &map);
     let err = LayerDescription::describe(&layer, &names, |_| None).unwrap_err();
     assert!(
-        matches!(&err, LayerFileError::NotDescribable(why) if why.contains("class 0") && why.contains("image")),
+        matches!(
+            &err,
+            LayerFileError::NotDescribable {
+                part: LayerPart::Class(0),
+                what: Undescribable::Image(_)
+            }
+        ),
         "{err}"
     );
     let mut unnamed = layer.clone();
@@ -290,7 +296,10 @@ fn what_a_file_cannot_name_is_a_typed_error() {
         );
         let err = LayerDescription::from_ron(&text).unwrap_err();
         assert!(
-            matches!(&err, LayerFileError::Invalid(why) if why.contains("far material")),
+            matches!(
+                &err,
+                LayerFileError::Invalid(InvalidLayer::FarMaterial { class: 1 })
+            ),
             "{err}"
         );
     }
@@ -306,7 +315,7 @@ fn what_a_file_cannot_name_is_a_typed_error() {
         )
         .unwrap_err();
     assert!(
-        matches!(&err, LayerFileError::UnknownName(n) if n.contains("oak")),
+        matches!(&err, LayerFileError::UnknownName { kind: NamedKind::Mesh, name } if name == "oak"),
         "{err}"
     );
 }

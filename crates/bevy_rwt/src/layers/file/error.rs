@@ -1,0 +1,162 @@
+//! What can be wrong with a layer file, or with describing a layer as one.
+
+use bevy::prelude::*;
+
+/// What is wrong with a layer file.
+#[derive(Debug, thiserror::Error)]
+pub enum LayerFileError {
+    /// Not readable.
+    #[error("cannot read layer file: {0}")]
+    Io(#[from] std::io::Error),
+    /// Not UTF-8 text.
+    #[error("layer file is not UTF-8 text: {0}")]
+    NotText(#[from] std::str::Utf8Error),
+    /// Not valid RON for a layer (the error says where).
+    #[error("invalid layer file: {0}")]
+    Parse(#[from] ron::error::SpannedError),
+    /// Valid RON with values out of range.
+    #[error("invalid layer: {0}")]
+    Invalid(#[from] InvalidLayer),
+    /// The description could not be written as RON.
+    #[error("cannot write layer file: {0}")]
+    Write(#[from] ron::Error),
+    /// A layer built in code uses something a layer file cannot name (see
+    /// [`LayerDescription::describe`](super::LayerDescription::describe)).
+    #[error("cannot describe the layer: {part}: {what}")]
+    NotDescribable {
+        /// Where in the layer.
+        part: LayerPart,
+        /// What has no file form.
+        what: Undescribable,
+    },
+    /// The file names a mesh, material or height function
+    /// [`NamedAssets`](super::NamedAssets) does not have.
+    #[error("layer file names {kind} {name:?}, which is not registered in NamedAssets")]
+    UnknownName {
+        /// What kind of asset.
+        kind: NamedKind,
+        /// The name.
+        name: String,
+    },
+    /// The file is larger than [`MAX_LAYER_FILE_BYTES`](super::MAX_LAYER_FILE_BYTES): not a
+    /// layer description.
+    #[error("layer file is larger than {limit} bytes")]
+    TooLarge {
+        /// The limit in bytes.
+        limit: u64,
+    },
+}
+
+/// A layer file's values out of range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum InvalidLayer {
+    /// No class.
+    #[error("a layer needs at least one class")]
+    NoClasses,
+    /// A size or distance that must be positive and finite is not.
+    #[error("{field} {value} must be positive")]
+    NotPositive {
+        /// The field (`tile_size`, `chunk_size`, `load_distance`, `unload_distance`).
+        field: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// The load distance reaches more chunks than streaming allows.
+    #[error("load_distance {load_distance} spans more than {limit} chunks of {chunk_size}")]
+    TooFar {
+        /// The load distance.
+        load_distance: f64,
+        /// The chunk size.
+        chunk_size: f64,
+        /// The most chunks a load distance may span
+        /// ([`MAX_REACH_CHUNKS`](rwt_core::streaming::MAX_REACH_CHUNKS)).
+        limit: f64,
+    },
+    /// Chunks would unload before they load.
+    #[error("unload_distance {unload_distance} is below load_distance {load_distance}")]
+    UnloadBelowLoad {
+        /// The load distance.
+        load_distance: f64,
+        /// The unload distance.
+        unload_distance: f64,
+    },
+    /// A class's far-mesh distance is not positive and finite.
+    #[error("class {class}: lod distance {distance} must be positive")]
+    LodDistance {
+        /// The class's index.
+        class: usize,
+        /// The distance.
+        distance: f32,
+    },
+    /// A far material is not `Instanced()` exactly when its class is instanced.
+    #[error("class {class}: a far material is Instanced() exactly when the class is instanced")]
+    FarMaterial {
+        /// The class's index.
+        class: usize,
+    },
+}
+
+/// A part of a layer, where it cannot be described.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LayerPart {
+    /// The class of this index.
+    Class(usize),
+    /// The exclusion map.
+    Exclusion,
+    /// The ground's height.
+    Ground,
+}
+
+impl std::fmt::Display for LayerPart {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Class(i) => write!(f, "class {i}"),
+            Self::Exclusion => f.write_str("the exclusion"),
+            Self::Ground => f.write_str("the ground"),
+        }
+    }
+}
+
+/// What of a layer built in code a layer file cannot name.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Undescribable {
+    /// A look made in code.
+    #[error("a custom look (code) has no file form")]
+    CustomLook,
+    /// A density made in code.
+    #[error("a custom density (code) has no file form")]
+    CustomDensity,
+    /// A mesh with neither a name in `NamedAssets` nor an asset path.
+    #[error("mesh {0:?} has no asset path and no name")]
+    Mesh(AssetId<Mesh>),
+    /// A material with neither a name in `NamedAssets` nor an asset path.
+    #[error("material {0:?} has no asset path and no name")]
+    Material(AssetId<StandardMaterial>),
+    /// An image (density map, heightmap, texture) without a path.
+    #[error("image {0:?} has no asset path")]
+    Image(AssetId<Image>),
+    /// A height function without a name in `NamedAssets`.
+    #[error("a height function without a name in NamedAssets")]
+    HeightFunction,
+}
+
+/// The kinds of assets a layer file names through `NamedAssets`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NamedKind {
+    /// A mesh.
+    Mesh,
+    /// A material.
+    Material,
+    /// A height function.
+    Height,
+}
+
+impl std::fmt::Display for NamedKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Mesh => "mesh",
+            Self::Material => "material",
+            Self::Height => "height",
+        })
+    }
+}
