@@ -69,9 +69,10 @@ impl Play {
         (self.phase == Phase::Back && f < RETURN_FRAMES).then(|| f as f32 / RETURN_FRAMES as f32)
     }
 
-    /// Whether the gameplay began (what the session counted before it is final).
+    /// Whether the gameplay began (never in a view that skips it): what the session counted
+    /// before it is final.
     pub fn started(&self) -> bool {
-        self.phase != Phase::Waiting
+        !matches!(self.phase, Phase::Waiting | Phase::Skipped)
     }
 
     /// Frames since the gameplay was reported (0 before).
