@@ -166,6 +166,26 @@ pub fn run(path: &Path, plot: Option<&Path>) -> Result<(), String> {
     Ok(())
 }
 
+/// A spectrum in the square of `panel` pixels at `(x1, y1)`, log scale from 0.01 (black) to
+/// 10 (white), as in the paper.
+fn spectrum_panel(c: &mut Canvas, s: &Spectrum, (x1, y1): (f64, f64), panel: f64) {
+    let px = panel / s.size as f64;
+    for v in 0..s.size {
+        for u in 0..s.size {
+            let p = s.power[v * s.size + u].max(1e-3);
+            let t = ((p.log10() + 2.0) / 3.0).clamp(0.0, 1.0);
+            let g = (255.0 * t) as u8;
+            c.rect(
+                x1 + u as f64 * px,
+                y1 + (s.size - 1 - v) as f64 * px,
+                x1 + (u + 1) as f64 * px,
+                y1 + (s.size - v) as f64 * px,
+                [g, g, g],
+            );
+        }
+    }
+}
+
 const COLOURS: [[u8; 3]; 4] = [[20, 20, 20], [31, 119, 180], [44, 160, 44], [214, 39, 40]];
 
 /// Points, power spectrum, radial power and anisotropy (the paper's figure 2 layout).
@@ -190,24 +210,7 @@ pub fn draw(
         let q = (*p - *o) / side;
         c.disc(x0 + q.x * panel, y0 + (1.0 - q.y) * panel, r, [0, 0, 0]);
     }
-    // Spectrum, log scale from 0.01 (black) to 10 (white), as in the paper.
-    let s = &rows[0].spectrum;
-    let (x1, y1) = (2.0 * gap + panel, gap);
-    let px = panel / s.size as f64;
-    for v in 0..s.size {
-        for u in 0..s.size {
-            let p = s.power[v * s.size + u].max(1e-3);
-            let t = ((p.log10() + 2.0) / 3.0).clamp(0.0, 1.0);
-            let g = (255.0 * t) as u8;
-            c.rect(
-                x1 + u as f64 * px,
-                y1 + (s.size - 1 - v) as f64 * px,
-                x1 + (u + 1) as f64 * px,
-                y1 + (s.size - v) as f64 * px,
-                [g, g, g],
-            );
-        }
-    }
+    spectrum_panel(&mut c, &rows[0].spectrum, (2.0 * gap + panel, gap), panel);
     // Radial mean power (0..4) and anisotropy (-20..+10 dB), every row.
     let curves =
         |c: &mut Canvas, x: f64, f: &dyn Fn(&Row) -> &Vec<f64>, lo: f64, hi: f64, guide: f64| {

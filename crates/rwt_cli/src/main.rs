@@ -154,31 +154,8 @@ enum TilesetAction {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let result = match cli.command {
-        Command::Tileset { action } => match action {
-            TilesetAction::Build {
-                out,
-                seed,
-                colors,
-                points,
-                subdivision,
-            } => tileset_cmd::build_cmd(
-                &out,
-                BuildConfig {
-                    seed,
-                    colors,
-                    points,
-                    subdivision,
-                    ..BuildConfig::default()
-                },
-            )
-            .map(|()| true),
-            TilesetAction::Check { file, min_rho } => tileset_cmd::check_cmd(&file, min_rho),
-            TilesetAction::Render { file, out } => {
-                tileset_cmd::render_cmd(&file, &out).map(|()| true)
-            }
-        },
+    let result = match Cli::parse().command {
+        Command::Tileset { action } => tileset(action),
         Command::Points {
             rect,
             density,
@@ -232,5 +209,30 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// `rwt tileset ...`: whether it succeeded (a check may fail without an error).
+fn tileset(action: TilesetAction) -> Result<bool, String> {
+    match action {
+        TilesetAction::Build {
+            out,
+            seed,
+            colors,
+            points,
+            subdivision,
+        } => tileset_cmd::build_cmd(
+            &out,
+            BuildConfig {
+                seed,
+                colors,
+                points,
+                subdivision,
+                ..BuildConfig::default()
+            },
+        )
+        .map(|()| true),
+        TilesetAction::Check { file, min_rho } => tileset_cmd::check_cmd(&file, min_rho),
+        TilesetAction::Render { file, out } => tileset_cmd::render_cmd(&file, &out).map(|()| true),
     }
 }

@@ -153,8 +153,17 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
         "  worst k in 16..{n} (quarter octaves): rho = {worst:.3} at k = {worst_k}{}",
         below_min_rho(pass)
     );
+    ok &= subdivision_prefixes_pass(&set, min_rho);
+    say!("{}", if ok { "OK" } else { "FAILED" });
+    Ok(ok)
+}
+
+/// `rwt tileset check`'s rho of each tile's first k subdivision points: whether the worst
+/// is at least `min_rho`.
+fn subdivision_prefixes_pass(set: &TileSet, min_rho: Option<f64>) -> bool {
     // Between the base level and the next, a query shows a prefix of each tile's
     // subdivision ranking: the points are nested subsets of a fixed set there.
+    let n = set.points_per_tile as usize;
     let full = set.subdivision_len() / n;
     say!("the same for each tile's first k subdivision points, k = m N (2 seeds, 4x4 tiles):");
     let mut worst = (0.0, f64::INFINITY);
@@ -162,22 +171,20 @@ pub fn check_cmd(path: &Path, min_rho: Option<f64>) -> Result<bool, String> {
     // Only multiples within this set's subdivision (a 2x2 set holds 4 N).
     for m in multiples.filter(|&m| m < full as f64).chain([full as f64]) {
         let k = (m * n as f64) as usize;
-        let rho = subdivision_prefix_rho(&set, k, 2, 4);
+        let rho = subdivision_prefix_rho(set, k, 2, 4);
         say!("  m = {m:>4}: rho = {rho:.3}");
         if rho < worst.1 {
             worst = (m, rho);
         }
     }
     let pass = min_rho.is_none_or(|m| worst.1 >= m);
-    ok &= pass;
     say!(
         "  worst: rho = {:.3} at m = {}{}",
         worst.1,
         worst.0,
         below_min_rho(pass)
     );
-    say!("{}", if ok { "OK" } else { "FAILED" });
-    Ok(ok)
+    pass
 }
 
 /// What `rwt tileset check` appends to a figure that fails `--min-rho`.
@@ -233,11 +240,22 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
     let width = grid_w + side + gap;
     let height = grid_w;
     let mut c = Canvas::new(width as u32, height as u32, [255, 255, 255]);
+    all_tiles(&mut c, &set, cols, s, gap);
+    subdivided_tile(&mut c, &set, (grid_w, gap), side);
+    corner_on_subdivision(&mut c, &set, (grid_w, 2.0 * gap + side), side);
+    c.save(out)?;
+    say!("wrote {}", out.display());
+    Ok(())
+}
+
+/// Figure 4: every tile (`s` pixels wide, `cols` a row, `gap` apart) with its seams, the
+/// origins of its points and its edge colours.
+fn all_tiles(c: &mut Canvas, set: &TileSet, cols: usize, s: f64, gap: f64) {
     for (t, tile) in set.tiles.iter().enumerate() {
         let x = gap + (t % cols) as f64 * (s + gap);
         let y = gap + (t / cols) as f64 * (s + gap);
         c.rect(x, y, x + s, y + s, [245, 245, 245]);
-        edge_bars(&mut c, &set, t, x, y, s, 5.0);
+        edge_bars(c, set, t, x, y, s, 5.0);
         for seam in &tile.seams {
             for w in seam.windows(2) {
                 let p = |q: [f32; 2]| (x + q[0] as f64 * s, y + (1.0 - q[1] as f64) * s);
@@ -252,9 +270,12 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
             c.disc(px, py, 1.3, ORIGIN_COLOURS[tile.origins[k] as usize % 5]);
         }
     }
-    // Figure 6: tile 0 and two levels of its subdivision, edge colours only.
+}
+
+/// Figure 6: tile 0 and two levels of its subdivision, edge colours only, in the square of
+/// `side` pixels at `(x0, y0)`.
+fn subdivided_tile(c: &mut Canvas, set: &TileSet, (x0, y0): (f64, f64), side: f64) {
     let n = set.subdivision as usize;
-    let (x0, y0) = (grid_w, gap);
     let t0 = 0usize;
     let level2 = side / (n * n) as f64;
     for (cell, &child) in set.tiles[t0].children.iter().enumerate() {
@@ -264,8 +285,8 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
             let gx = x0 + (a * n + a2) as f64 * level2;
             let gy = y0 + side - (b * n + b2 + 1) as f64 * level2;
             edge_bars(
-                &mut c,
-                &set,
+                c,
+                set,
                 grand as usize,
                 gx + 1.0,
                 gy + 1.0,
@@ -278,12 +299,15 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
         let (a, b) = (cell % n, cell / n);
         let cx = x0 + a as f64 * side / n as f64;
         let cy = y0 + side - (b + 1) as f64 * side / n as f64;
-        edge_bars(&mut c, &set, child as usize, cx, cy, side / n as f64, 4.0);
+        edge_bars(c, set, child as usize, cx, cy, side / n as f64, 4.0);
     }
-    edge_bars(&mut c, &set, t0, x0, y0, side, 7.0);
-    // Figure 7: the south-west quarter of tile 0, its points (filled) on its subdivision's
-    // points (rings).
-    let (x1, y1) = (grid_w, 2.0 * gap + side);
+    edge_bars(c, set, t0, x0, y0, side, 7.0);
+}
+
+/// Figure 7: the south-west quarter of tile 0, its points (filled) on its subdivision's
+/// points (rings), in the square of `side` pixels at `(x1, y1)`.
+fn corner_on_subdivision(c: &mut Canvas, set: &TileSet, (x1, y1): (f64, f64), side: f64) {
+    let t0 = 0usize;
     let zoom = side * 4.0;
     c.rect(x1, y1, x1 + side, y1 + side, [250, 250, 250]);
     let big_n = set.points_per_tile as usize;
@@ -304,9 +328,6 @@ pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
             }
         }
     }
-    c.save(out)?;
-    say!("wrote {}", out.display());
-    Ok(())
 }
 
 #[cfg(test)]

@@ -207,16 +207,7 @@ pub fn repair_prefixes(
     let (fixed, until) = (ranks.start.min(len), ranks.end.min(len));
     let radius = |k: usize| alpha / ((k + 1) as f64).sqrt();
     let affects = constrained_by(neighbours);
-    let grids: Vec<BucketGrid> = tiles
-        .iter()
-        .map(|cands| {
-            let mut grid = BucketGrid::new(DVec2::ZERO, DVec2::ONE, radius(len));
-            for (i, c) in cands.iter().enumerate() {
-                grid.insert(c.pos, i as u32);
-            }
-            grid
-        })
-        .collect();
+    let grids = candidate_grids(tiles, radius(len));
     // Clearance of every candidate, kept up to date as points are placed. A point only
     // updates candidates within the current radius, so a stored value is exact when it is
     // below the radius in force when its nearest point was placed, and at least that radius
@@ -272,13 +263,30 @@ pub fn repair_prefixes(
             place(&mut clearance, t, tiles[t][pick].pos, r);
         }
     }
-    for (t, o) in order.iter_mut().enumerate() {
-        let rest: Vec<usize> = o.iter().copied().filter(|&i| !taken[t][i]).collect();
-        let mut full = std::mem::take(&mut picked[t]);
-        full.extend(rest);
-        *o = full;
+    for ((o, picked), taken) in order.iter_mut().zip(picked).zip(&taken) {
+        *o = picks_first(o, picked, taken);
     }
     misses
+}
+
+/// Each tile's candidates in a grid of `cell`-wide buckets.
+fn candidate_grids(tiles: &[Vec<Candidate>], cell: f64) -> Vec<BucketGrid> {
+    tiles
+        .iter()
+        .map(|cands| {
+            let mut grid = BucketGrid::new(DVec2::ZERO, DVec2::ONE, cell);
+            for (i, c) in cands.iter().enumerate() {
+                grid.insert(c.pos, i as u32);
+            }
+            grid
+        })
+        .collect()
+}
+
+/// `picked` in its order, then the rest of `order` that was not taken, in theirs.
+fn picks_first(order: &[usize], mut picked: Vec<usize>, taken: &[bool]) -> Vec<usize> {
+    picked.extend(order.iter().copied().filter(|&i| !taken[i]));
+    picked
 }
 
 /// Turns thresholds into a rank order: indices sorted by `(tau, tau0, index)`.

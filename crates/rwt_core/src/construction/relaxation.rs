@@ -340,9 +340,30 @@ fn snap(
             [q(p.x), q(p.y)]
         })
         .collect();
-    let mut state = vec![0u8; total]; // 0 new, 1 on current path, 2 solved
+    solve_along_successors(&succ, apply, &mut value);
+    (0..points.len())
+        .map(|t| {
+            (0..big_n)
+                .map(|k| {
+                    let v = value[node(t, k)];
+                    [v[0] as u32, v[1] as u32]
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Makes `value[v] = apply(v, value[succ[v]])` hold at every node `v` of the functional
+/// graph `succ`: on each cycle by iterating its composed map to a fixed point, then on the
+/// paths that lead into it, from the cycle outwards.
+fn solve_along_successors(
+    succ: &[usize],
+    apply: impl Fn(usize, [u64; 2]) -> [u64; 2],
+    value: &mut [[u64; 2]],
+) {
+    let mut state = vec![0u8; succ.len()]; // 0 new, 1 on current path, 2 solved
     let mut path = Vec::new();
-    for start in 0..total {
+    for start in 0..succ.len() {
         if state[start] == 2 {
             continue;
         }
@@ -390,14 +411,4 @@ fn snap(
             state[u] = 2;
         }
     }
-    (0..points.len())
-        .map(|t| {
-            (0..big_n)
-                .map(|k| {
-                    let v = value[node(t, k)];
-                    [v[0] as u32, v[1] as u32]
-                })
-                .collect()
-        })
-        .collect()
 }
