@@ -83,7 +83,11 @@ fn main() {
 /// A headless app with one instanced grass layer.
 fn headless_app() -> App {
     let mut app = App::new();
-    app.add_plugins((MinimalPlugins, AssetPlugin::default(), RwtPlugin::default()));
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        RwtPlugins::default(),
+    ));
     app.finish();
     app.cleanup();
     let grass = ScatterClass::instanced(

@@ -67,7 +67,7 @@ fn main() {
             .disable::<PipelinedRenderingPlugin>(),
     )
     .add_plugins(
-        RwtPlugin::default()
+        RwtPlugins::default()
             .with_spawn_budget(200_000)
             .with_max_tasks(16),
     )

@@ -57,7 +57,7 @@ const WAIT: u32 = 12;
 fn main() -> AppExit {
     App::new()
         .add_plugins(example_plugins("rwt instanced_passes"))
-        .add_plugins(RwtPlugin::default())
+        .add_plugins(RwtPlugins::default())
         .init_resource::<Check>()
         .add_systems(Startup, setup)
         .add_systems(Update, run_check)

@@ -29,7 +29,7 @@ fn main() {
         .insert_resource(ClearColor(Color::srgb(0.93, 0.91, 0.85)))
         .add_plugins((
             example_plugins("rwt paint_density"),
-            RwtPlugin::default().with_spawn_budget(20_000),
+            RwtPlugins::default().with_spawn_budget(20_000),
             SmokePlugin,
             HudPlugin,
         ))

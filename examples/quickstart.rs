@@ -9,7 +9,7 @@ use rwt_examples::prelude::*;
 fn main() {
     App::new()
         .add_plugins((example_plugins("rwt quickstart"), SmokePlugin))
-        .add_plugins(RwtPlugin::default())
+        .add_plugins(RwtPlugins::default())
         .add_systems(Startup, setup)
         .add_systems(Update, orbit)
         .run();

@@ -47,9 +47,11 @@ fn main() {
         ))
         .add_plugins((
             // Five layers stream at once: more generation tasks in flight per layer.
-            RwtPlugin::default().with_max_tasks(32),
-            RwtGizmosPlugin,
-            RwtBrushPlugin,
+            RwtPlugins::default()
+                .with_max_tasks(32)
+                .build()
+                .enable::<RwtGizmosPlugin>()
+                .enable::<RwtBrushPlugin>(),
             gameplay::GameplayPlugin,
             walk::WalkPlugin,
             script::ScriptPlugin,

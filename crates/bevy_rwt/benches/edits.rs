@@ -133,7 +133,7 @@ fn load(bytes: &[u8], stamp: &EditStamp, expected: &EditSet) -> f64 {
 /// Fills the world around the start with `edits` in place, flies, and returns the median
 /// and largest frame time (ms).
 fn fly(edits: EditSet) -> (f64, f64) {
-    let (mut app, viewer) = headless_app(RwtPlugin::default().with_max_tasks(32));
+    let (mut app, viewer) = headless_app(RwtPlugins::default().with_max_tasks(32));
     let trees = ScatterClass::new(LayerDensity::Constant(DENSITIES[0]), default(), default());
     let grass = ScatterClass::instanced(
         LayerDensity::Constant(DENSITIES[1]),

@@ -28,7 +28,7 @@ fn run(speed: f32) {
 /// A headless app with one grass layer of 0.5 instances per square unit and a viewer;
 /// returns the app and the viewer.
 fn world() -> (App, Entity) {
-    let (mut app, viewer) = headless_app(RwtPlugin::default().with_max_tasks(32));
+    let (mut app, viewer) = headless_app(RwtPlugins::default().with_max_tasks(32));
     let grass = ScatterClass::new(
         LayerDensity::Constant(0.5),
         Handle::default(),

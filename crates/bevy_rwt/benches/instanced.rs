@@ -73,7 +73,7 @@ fn run(path: Path, live: f64) {
 /// [`RADIUS`] and a viewer; returns the app and the viewer.
 fn world(path: Path, density: f64) -> (App, Entity) {
     let (mut app, viewer) = headless_app(
-        RwtPlugin::default()
+        RwtPlugins::default()
             .with_max_tasks(32)
             .with_spawn_budget(20_000)
             .with_despawn_budget(40_000),

@@ -33,7 +33,7 @@
 //!     layers.iter().map(|e| e.len()).sum()
 //! }
 //! # let mut app = App::new();
-//! # app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugin::default()));
+//! # app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugins::default()));
 //! # app.add_systems(Update, (chop, count.map(drop)));
 //! # app.finish();
 //! # app.cleanup();
@@ -45,7 +45,8 @@ pub use rwt_core::edits::{Edit, EditSet, EditStamp, EditsError};
 use rwt_core::query::PointId;
 
 /// What an [`EditInstance`] does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Reflect)]
+#[reflect(Clone, Debug, PartialEq, Hash)]
 pub enum InstanceEdit {
     /// The instance leaves (and stays away).
     Remove,
@@ -57,7 +58,8 @@ pub enum InstanceEdit {
 
 /// Edits one instance of a layer. Write it with a `MessageWriter<EditInstance>`; the plugin
 /// applies it before planning, in [`crate::RwtSystems::Plan`].
-#[derive(Message, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Message, Clone, Copy, Debug, PartialEq, Eq, Hash, Reflect)]
+#[reflect(Clone, Debug, PartialEq, Hash)]
 pub struct EditInstance {
     /// The layer entity.
     pub layer: Entity,
@@ -119,7 +121,8 @@ pub enum EditError {
 /// layer is replaced or its file reloads). Read it to list or count edits; change single
 /// instances with [`EditInstance`]; insert a new `ScatterEdits` to replace them all (what a
 /// load does): every chunk that the old or the new edits touch is generated again.
-#[derive(Component, Clone, Debug, Default, PartialEq)]
+#[derive(Component, Clone, Debug, Default, PartialEq, Reflect)]
+#[reflect(Component, Clone, Debug, Default, PartialEq)]
 pub struct ScatterEdits(EditSet);
 
 impl ScatterEdits {

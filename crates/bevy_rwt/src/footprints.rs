@@ -18,7 +18,7 @@
 //!     ));
 //! }
 //! # let mut app = App::new();
-//! # app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), bevy_rwt::RwtPlugin::default()));
+//! # app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), bevy_rwt::RwtPlugins::default()));
 //! # app.add_systems(Startup, place_cabin);
 //! # app.finish();
 //! # app.cleanup();
@@ -33,7 +33,8 @@ use rwt_core::Rect;
 /// The shape of a [`Footprint`], in the ground coordinates of its entity (x and z of its
 /// `Transform` on the default plane, x and y on [`GroundPlane::Xy`]); the entity's
 /// translation, turn and scale place it in the world.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub enum FootprintShape {
     /// A disc around the entity's origin.
     Circle {
@@ -50,7 +51,8 @@ pub enum FootprintShape {
 }
 
 /// Clears every instance whose point lies under the shape or within `margin` of it.
-#[derive(Component, Clone, Debug, PartialEq)]
+#[derive(Component, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Component, Clone, Debug, PartialEq)]
 #[require(Transform)]
 pub struct Footprint {
     /// The shape.

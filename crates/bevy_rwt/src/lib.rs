@@ -1,6 +1,6 @@
 //! # bevy_rwt: blue-noise vegetation streamed around your cameras
 //!
-//! Add [`RwtPlugin`], mark cameras with [`RwtViewer`], and spawn [`ScatterLayer`]s. Each
+//! Add [`RwtPlugins`], mark cameras with [`RwtViewer`], and spawn [`ScatterLayer`]s. Each
 //! layer places instances of its classes on the ground (x, z) with recursive Wang tile blue
 //! noise ([`rwt_core`]): chunks around the viewers are generated on the async compute pool,
 //! instances are spawned and despawned within a per-frame budget and share their classes'
@@ -10,8 +10,9 @@
 //!
 //! ## How it is built
 //!
-//! [`RwtPlugin`] is a group of small plugins, each registering its own systems in one of
-//! the [`RwtSystems`] sets (in order: `Viewers`, `Plan`, `Collect`, `Apply`, `Stats`):
+//! [`RwtPlugins`] is a group of small plugins, each registering its own systems in one of
+//! the [`RwtSystems`] sets (in order: `Viewers`, `Plan`, `Collect`, `Apply`, `Stats`) of
+//! one schedule; each can be disabled or used alone (see [`RwtPlugins`]):
 //!
 //! | plugin | module | does |
 //! |---|---|---|
@@ -20,7 +21,8 @@
 //! | [`streaming::RwtStreamingPlugin`] | [`streaming`] | chunks, generation tasks, budgeted spawns, repainting |
 //! | [`diagnostics::RwtDiagnosticsPlugin`] | [`diagnostics`] | [`RwtStats`] and `rwt/` diagnostics |
 //! | [`instancing::RwtInstancingPlugin`] | [`instancing`] | instanced classes: mesh checks, one instanced draw per chunk (wind, fade-in) |
-//! | [`gizmos::RwtGizmosPlugin`] (opt-in) | [`gizmos`] | chunk and tile outlines |
+//! | [`gizmos::RwtGizmosPlugin`] (disabled) | [`gizmos`] | chunk and tile outlines |
+//! | `brush::RwtBrushPlugin` (disabled; feature `brush`) | `brush` | paints density maps; saves and loads them with the edits |
 //!
 //! The data path from a painted map to an instance: a brush writes the map (`Image`) and a
 //! [`DensityMapPainted`] message → `repaint` forgets the snapshots that read the map and
@@ -44,7 +46,7 @@
 //! use bevy_rwt::prelude::*;
 //!
 //! let mut app = App::new();
-//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugin::default()));
+//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugins::default()));
 //! app.finish();
 //! app.cleanup();
 //! app.world_mut().spawn((RwtViewer::all_around(), Transform::default(), GlobalTransform::default()));
@@ -76,7 +78,7 @@
 //! ## Names
 //!
 //! - `Rwt*`: the plugin and its parts, their resources, system sets and the viewer marker
-//!   ([`RwtPlugin`], [`RwtSettings`], [`RwtSystems`], [`RwtStats`], [`RwtViewer`]);
+//!   ([`RwtPlugins`], [`RwtSettings`], [`RwtSystems`], [`RwtStats`], [`RwtViewer`]);
 //! - `Scatter*`: components and assets that describe a layer and what it places
 //!   ([`ScatterLayer`], [`ScatterClass`], [`ScatterInstance`], [`ScatterLayerStatus`],
 //!   [`layers::file::ScatterLayerSource`]);
@@ -104,7 +106,7 @@
 //! }
 //!
 //! App::new()
-//!     .add_plugins((DefaultPlugins, RwtPlugin::default().with_spawn_budget(4_000)))
+//!     .add_plugins((DefaultPlugins, RwtPlugins::default().with_spawn_budget(4_000)))
 //!     .add_systems(Startup, setup)
 //!     .run();
 //! ```
@@ -119,7 +121,7 @@
 //! use bevy_rwt::prelude::*;
 //!
 //! let mut app = App::new();
-//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugin::default()))
+//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugins::default()))
 //!     .init_asset::<Mesh>()
 //!     .init_asset::<StandardMaterial>();
 //! app.finish();
@@ -159,13 +161,16 @@ mod settings;
 pub mod streaming;
 pub mod viewers;
 
+use bevy::app::PluginGroupBuilder;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
-pub use diagnostics::RwtStats;
+pub use diagnostics::{RwtDiagnosticsPlugin, RwtStats};
 pub use instancing::{Bender, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind};
+pub use layers::RwtLayersPlugin;
 pub use layers::{
-    AssetStatus, DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, HeightSource, LayerDensity, Promotion,
-    ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus,
+    AssetFailure, AssetProblem, AssetStatus, DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE,
+    HeightSource, LayerAsset, LayerDensity, Promotion, ScatterClass, ScatterInstance, ScatterLayer,
+    ScatterLayerStatus,
 };
 pub use look::{
     ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, InstancedShadows,
@@ -175,8 +180,9 @@ pub use rwt_core;
 use rwt_core::tileset::TileSet;
 pub use settings::{RwtSettings, RwtSystems};
 use std::sync::Arc;
+pub use streaming::RwtStreamingPlugin;
 pub use streaming::{ChunkLoaded, ChunkUnloaded, DensityMapPainted};
-pub use viewers::{RwtViewer, ViewCone};
+pub use viewers::{RwtViewer, RwtViewersPlugin, ViewCone};
 
 /// Everything a game needs.
 pub mod prelude {
@@ -191,35 +197,67 @@ pub mod prelude {
     pub use crate::picking::{PickFilter, ScatterHit, ScatterPicking};
     pub use crate::{
         AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
-        HeightSource, InstancedChunk, InstancedMaterial, InstancedShadows, LayerDensity, RwtFadeIn,
-        RwtPlugin, RwtSettings, RwtStats, RwtSystems, RwtViewer, RwtWind, ScatterClass,
-        ScatterInstance, ScatterLayer, ScatterLayerStatus, ViewCone,
+        HeightSource, InstancedChunk, InstancedMaterial, InstancedShadows, LayerDensity,
+        RwtDiagnosticsPlugin, RwtFadeIn, RwtInstancingPlugin, RwtLayersPlugin, RwtPlugins,
+        RwtSettings, RwtStats, RwtStreamingPlugin, RwtSystems, RwtViewer, RwtViewersPlugin,
+        RwtWind, ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus, ViewCone,
     };
     pub use rwt_core::streaming::{Falloff, StreamingConfig};
 }
 
-/// The plugin: viewers, layers, streaming and diagnostics. Builder-style settings.
-pub struct RwtPlugin {
+/// The plugin group: viewers, layers, streaming, diagnostics and instancing, all in one
+/// schedule (`Update` by default, or the one given to [`RwtPlugins::new`]); builder-style
+/// settings. The brush (feature `brush`) and the gizmos are in the group but disabled: enable
+/// them with [`PluginGroupBuilder::enable`].
+///
+/// Each part can be disabled (`.build().disable::<RwtDiagnosticsPlugin>()`) or used alone,
+/// built with the schedule of its systems (`RwtStreamingPlugin::new(FixedUpdate)`).
+///
+/// | part | without it |
+/// |---|---|
+/// | [`viewers::RwtViewersPlugin`] | nothing streams |
+/// | [`layers::RwtLayersPlugin`] | layer files do not load (layers made in code stream) |
+/// | [`streaming::RwtStreamingPlugin`] | nothing is placed |
+/// | [`diagnostics::RwtDiagnosticsPlugin`] | no [`RwtStats`], no `rwt/` diagnostics |
+/// | [`instancing::RwtInstancingPlugin`] | instanced classes stream and are counted, not drawn |
+/// | [`gizmos::RwtGizmosPlugin`] (disabled) | no chunk and tile outlines |
+/// | `brush::RwtBrushPlugin` (disabled; feature `brush`) | no painting |
+///
+/// ```
+/// use bevy::prelude::*;
+/// use bevy_rwt::prelude::*;
+///
+/// let mut app = App::new();
+/// app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default()))
+///     .add_plugins(
+///         RwtPlugins::new(FixedUpdate)
+///             .with_spawn_budget(2_000)
+///             .build()
+///             .disable::<RwtDiagnosticsPlugin>(),
+///     );
+/// assert!(!app.world().contains_resource::<RwtStats>());
+/// assert_eq!(app.world().resource::<RwtSettings>().spawn_budget, 2_000);
+/// ```
+pub struct RwtPlugins {
     settings: RwtSettings,
     schedule: InternedScheduleLabel,
     tile_set: Option<Arc<TileSet>>,
 }
 
-impl Default for RwtPlugin {
+impl Default for RwtPlugins {
     fn default() -> Self {
-        Self {
-            settings: RwtSettings::default(),
-            schedule: Update.intern(),
-            tile_set: None,
-        }
+        Self::new(Update)
     }
 }
 
-impl RwtPlugin {
-    /// Runs the systems in another schedule (default `Update`).
-    pub fn in_schedule(mut self, schedule: impl ScheduleLabel) -> Self {
-        self.schedule = schedule.intern();
-        self
+impl RwtPlugins {
+    /// The group, every part's systems in `schedule`.
+    pub fn new(schedule: impl ScheduleLabel) -> Self {
+        Self {
+            settings: RwtSettings::default(),
+            schedule: schedule.intern(),
+            tile_set: None,
+        }
     }
 
     /// Most instances spawned per frame.
@@ -254,30 +292,36 @@ impl RwtPlugin {
     }
 }
 
-impl Plugin for RwtPlugin {
-    fn build(&self, app: &mut App) {
+impl PluginGroup for RwtPlugins {
+    fn build(self) -> PluginGroupBuilder {
         let schedule = self.schedule;
-        app.insert_resource(self.settings.clone()).configure_sets(
-            schedule,
-            (
-                RwtSystems::Viewers,
-                RwtSystems::Plan,
-                RwtSystems::Collect,
-                RwtSystems::Apply,
-                RwtSystems::Stats,
-            )
-                .chain(),
-        );
-        let tile_set = self
-            .tile_set
-            .clone()
-            .unwrap_or_else(|| Arc::new(TileSet::embedded()));
-        app.add_plugins((
-            viewers::RwtViewersPlugin { schedule },
-            layers::RwtLayersPlugin { schedule },
-            streaming::RwtStreamingPlugin { schedule, tile_set },
-            diagnostics::RwtDiagnosticsPlugin { schedule },
-            instancing::RwtInstancingPlugin { schedule },
-        ));
+        let mut streaming = streaming::RwtStreamingPlugin::new(schedule);
+        if let Some(set) = self.tile_set {
+            streaming = streaming.with_tile_set(set);
+        }
+        let group = PluginGroupBuilder::start::<Self>()
+            .add(RwtSettingsPlugin(self.settings))
+            .add(viewers::RwtViewersPlugin::new(schedule))
+            .add(layers::RwtLayersPlugin::new(schedule))
+            .add(streaming)
+            .add(diagnostics::RwtDiagnosticsPlugin::new(schedule))
+            .add(instancing::RwtInstancingPlugin::new(schedule))
+            .add(gizmos::RwtGizmosPlugin)
+            .disable::<gizmos::RwtGizmosPlugin>();
+        #[cfg(feature = "brush")]
+        let group = group
+            .add(brush::RwtBrushPlugin::new(schedule))
+            .disable::<brush::RwtBrushPlugin>();
+        group
+    }
+}
+
+/// Inserts the group's [`RwtSettings`] (part of [`RwtPlugins`]; parts used alone get the
+/// defaults, or the resource the app inserts).
+pub struct RwtSettingsPlugin(pub RwtSettings);
+
+impl Plugin for RwtSettingsPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(self.0.clone());
     }
 }

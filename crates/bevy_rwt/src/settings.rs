@@ -1,9 +1,11 @@
 //! What every feature plugin shares: the budgets and the system sets.
 
+use bevy::ecs::schedule::InternedScheduleLabel;
 use bevy::prelude::*;
 
 /// Budgets of the streaming systems.
-#[derive(Resource, Clone, Debug)]
+#[derive(Resource, Clone, Debug, Reflect)]
+#[reflect(Resource, Clone, Debug, Default)]
 pub struct RwtSettings {
     /// Most instances spawned per frame (all layers).
     pub spawn_budget: usize,
@@ -54,3 +56,43 @@ pub enum RwtSystems {
     /// summed right after).
     Stats,
 }
+
+/// Orders the [`RwtSystems`] sets in `schedule` and gives the app default settings when it
+/// has none: every part of [`crate::RwtPlugins`] calls it, so that each works alone.
+pub(crate) fn configure_sets(app: &mut App, schedule: InternedScheduleLabel) {
+    app.register_type::<RwtSettings>()
+        .init_resource::<RwtSettings>()
+        .configure_sets(
+            schedule,
+            (
+                RwtSystems::Viewers,
+                RwtSystems::Plan,
+                RwtSystems::Collect,
+                RwtSystems::Apply,
+                RwtSystems::Stats,
+            )
+                .chain(),
+        );
+}
+
+/// `new(schedule)` and `Default` (in `Update`) for a part of [`crate::RwtPlugins`] whose
+/// only setting is the schedule of its systems.
+macro_rules! in_schedule {
+    ($part:ident) => {
+        impl $part {
+            /// The part, its systems in `schedule`.
+            pub fn new(schedule: impl bevy::ecs::schedule::ScheduleLabel) -> Self {
+                Self {
+                    schedule: bevy::ecs::schedule::ScheduleLabel::intern(&schedule),
+                }
+            }
+        }
+
+        impl Default for $part {
+            fn default() -> Self {
+                Self::new(bevy::prelude::Update)
+            }
+        }
+    };
+}
+pub(crate) use in_schedule;

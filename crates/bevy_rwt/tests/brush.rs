@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 /// instance per square unit), and the brush aimed at it.
 fn painted_app() -> (App, Handle<Image>) {
     let mut app = create_app_with(|app| {
-        app.add_plugins(RwtBrushPlugin);
+        app.add_plugins(RwtBrushPlugin::default());
     });
     spawn_viewer(&mut app, Vec3::ZERO);
     let (map, density) = bevy_rwt::brush::blank_map(
@@ -101,10 +101,10 @@ fn a_stroke_scatters_under_the_brush_only_and_undo_takes_it_back() {
     command(&mut app, BrushCommand::Undo).unwrap();
     tick_app(&mut app, 2_000);
     assert!(instances(&mut app).keys().all(|id| blank.contains_key(id)));
-    assert_eq!(
+    assert!(matches!(
         command(&mut app, BrushCommand::Undo),
         Err(BrushError::NothingToUndo)
-    );
+    ));
 }
 
 #[test]
@@ -139,10 +139,10 @@ fn dabs_that_change_nothing_leave_the_map_and_its_chunks_alone() {
     }
     assert_eq!(instances(&mut app), before);
     // Nothing to undo either.
-    assert_eq!(
+    assert!(matches!(
         command(&mut app, BrushCommand::Undo),
         Err(BrushError::NothingToUndo)
-    );
+    ));
 }
 
 #[test]
@@ -180,7 +180,7 @@ fn maps_save_and_load_into_another_world() {
     // Another game loads the saved layer file, which reads the saved map beside it.
     assert_eq!(index.layers, ["meadow.layer.ron"]);
     let mut game = app_reading_with(&dir, |app| {
-        app.add_plugins(RwtBrushPlugin);
+        app.add_plugins(RwtBrushPlugin::default());
     });
     name_marker_assets(&game);
     spawn_viewer(&mut game, Vec3::ZERO);
@@ -224,8 +224,10 @@ fn layers_a_file_cannot_name_still_save_their_maps() {
         .truncate(1);
     let err = command(&mut app, BrushCommand::Save(dir.clone())).unwrap_err();
     match &err {
-        BrushError::LayerNotSaved(why) => {
-            assert!(why.starts_with("meadow: ") && why.contains("mesh"), "{why}")
+        BrushError::LayerNotSaved { layers } => {
+            let why = err.to_string();
+            assert!(layers.len() == 1 && layers[0].name == "meadow", "{why}");
+            assert!(why.contains("meadow: ") && why.contains("mesh"), "{why}")
         }
         other => panic!("{other:?}"),
     }
@@ -256,7 +258,11 @@ fn bad_targets_and_files_are_typed_errors() {
     ] {
         stroke(&mut app, target, Vec2::ZERO, 1.0, 1);
         let last = app.world_mut().resource_mut::<DensityBrush>().last.take();
-        assert_eq!(last, Some(Err(expected)));
+        // Errors holding I/O and parser errors are not comparable: their debug forms are.
+        assert_eq!(
+            format!("{last:?}"),
+            format!("{:?}", Some(Err::<String, _>(expected)))
+        );
     }
     let missing = std::env::temp_dir().join("rwt-brush-no-such-dir");
     assert!(matches!(
@@ -307,7 +313,7 @@ fn layered(app: &mut App) -> std::collections::HashMap<(String, rwt_core::PointI
 /// `names[1]` on a 256 x 256 map of noise (from `seed`), whose PNG is large.
 fn two_map_app(names: [&str; 2], seed: u32) -> App {
     let mut app = create_app_with(|app| {
-        app.add_plugins(RwtBrushPlugin);
+        app.add_plugins(RwtBrushPlugin::default());
     });
     spawn_viewer(&mut app, Vec3::ZERO);
     let mut targets = Vec::new();
@@ -535,14 +541,12 @@ fn a_save_that_fails_part_way_changes_no_file() {
         .targets
         .push(BrushTarget::new(odd, 0, "odd"));
     let err = command(&mut app, BrushCommand::Save(dir.clone())).unwrap_err();
-    assert_eq!(
-        err,
-        BrushError::MapUnavailable {
-            target: "odd".into(),
-            why: MapAccess::NotOnCpu {
-                format: bevy::render::render_resource::TextureFormat::Bc1RgbaUnorm
-            },
-        }
+    let bc1 = MapAccess::NotOnCpu {
+        format: bevy::render::render_resource::TextureFormat::Bc1RgbaUnorm,
+    };
+    assert!(
+        matches!(&err, BrushError::MapUnavailable { target, why } if target == "odd" && *why == bc1),
+        "{err:?}"
     );
     assert_eq!(folder(&dir), before);
     std::fs::remove_dir_all(&dir).ok();
@@ -627,10 +631,10 @@ fn maps_of_colliding_names_round_trip() {
     // Two targets of one name cannot be told apart in a save: refused, nothing written.
     let mut twins = two_map_app(["same", "same"], 3);
     let other = scratch("twins");
-    assert_eq!(
+    assert!(matches!(
         command(&mut twins, BrushCommand::Save(other.clone())),
-        Err(BrushError::DuplicateTarget("same".into()))
-    );
+        Err(BrushError::DuplicateTarget { name }) if name == "same"
+    ));
     assert!(!other.exists());
     std::fs::remove_dir_all(&dir).ok();
 }

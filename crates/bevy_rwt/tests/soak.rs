@@ -111,7 +111,7 @@ impl Soak {
         app.add_plugins((
             MinimalPlugins,
             AssetPlugin::default(),
-            RwtPlugin::default()
+            RwtPlugins::default()
                 .with_spawn_budget(400)
                 .with_despawn_budget(400)
                 .with_upload_budget(3_000)

@@ -119,7 +119,14 @@ pub enum EditsError {
 
 /// Edits of one point set, by point identity (kept in identity order, so that the file of
 /// one set is always the same bytes).
+///
+/// With `bevy_reflect`, an opaque value (edited through its methods, which keep it ordered).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(
+    feature = "bevy_reflect",
+    derive(bevy_reflect::Reflect),
+    reflect(opaque, Clone, Debug, PartialEq)
+)]
 pub struct EditSet(BTreeMap<PointId, Edit>);
 
 impl EditSet {

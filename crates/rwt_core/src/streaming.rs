@@ -13,6 +13,7 @@ use std::collections::{HashMap, HashSet};
 
 /// Integer coordinates of a chunk: it covers `[x, x + 1) * size` by `[y, y + 1) * size`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "bevy_reflect", derive(bevy_reflect::Reflect))]
 pub struct ChunkCoord {
     /// Column.
     pub x: i64,
@@ -98,6 +99,7 @@ pub fn nearest_first(
 /// is generated for a band, and re-generated only when a viewer moves it into another one,
 /// so moving a little does not re-query, and every query of a band gives the same content.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "bevy_reflect", derive(bevy_reflect::Reflect))]
 pub struct Falloff {
     /// Distance up to which the density is full.
     pub near: f64,
@@ -190,6 +192,7 @@ impl Viewer {
 /// Distances that decide what is loaded. `unload_distance > load_distance` gives hysteresis:
 /// a viewer moving back and forth across the load boundary does not reload chunks.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "bevy_reflect", derive(bevy_reflect::Reflect))]
 pub struct StreamingConfig {
     /// Chunk side in world units.
     pub chunk_size: f64,

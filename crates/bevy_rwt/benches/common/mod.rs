@@ -5,7 +5,7 @@ use bevy_rwt::prelude::*;
 
 /// A headless app (`MinimalPlugins`, assets) with `plugin`, and a viewer that streams all
 /// around it; returns the app and the viewer.
-pub fn headless_app(plugin: RwtPlugin) -> (App, Entity) {
+pub fn headless_app(plugin: RwtPlugins) -> (App, Entity) {
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), plugin));
     app.finish();

@@ -30,7 +30,7 @@
 //! }
 //!
 //! App::new()
-//!     .add_plugins((DefaultPlugins, RwtPlugin::default(), RwtBrushPlugin))
+//!     .add_plugins((DefaultPlugins, RwtPlugins::default().build().enable::<RwtBrushPlugin>()))
 //!     .add_systems(Startup, setup)
 //!     .run();
 //! ```
@@ -43,7 +43,7 @@
 //! use bevy_rwt::prelude::*;
 //!
 //! let mut app = App::new();
-//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugin::default(), RwtBrushPlugin))
+//! app.add_plugins((MinimalPlugins, bevy::asset::AssetPlugin::default(), RwtPlugins::default().build().enable::<RwtBrushPlugin>()))
 //!     .init_asset::<Mesh>()
 //!     .init_asset::<StandardMaterial>();
 //! app.finish();
@@ -78,6 +78,7 @@ pub use persist::{PaintedMapEntry, PaintedMaps, SavedEdits};
 pub use plugin::RwtBrushPlugin;
 pub use ray::ground_hit;
 
+use crate::layers::file::LayerFileError;
 use bevy::prelude::*;
 use bevy::render::render_resource::TextureFormat;
 use std::path::PathBuf;
@@ -89,7 +90,8 @@ pub struct BrushSystems;
 
 /// A class whose density map the brush paints: the class `class` of the layer on `layer`,
 /// shown to the player as `name`. Its density must be a [`crate::LayerDensity::Image`].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub struct BrushTarget {
     /// The layer entity.
     pub layer: Entity,
@@ -111,7 +113,8 @@ impl BrushTarget {
 }
 
 /// The keys and buttons of the brush (`None` turns one off).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Reflect)]
+#[reflect(Clone, Debug)]
 pub struct BrushKeys {
     /// Turns the brush on and off.
     pub toggle: Option<KeyCode>,
@@ -147,7 +150,8 @@ impl Default for BrushKeys {
 }
 
 /// The brush's settings and state.
-#[derive(Resource, Clone, Debug)]
+#[derive(Resource, Debug, Reflect)]
+#[reflect(Resource, Debug)]
 pub struct DensityBrush {
     /// Whether the cursor paints (the mouse is the game's otherwise).
     pub enabled: bool,
@@ -171,7 +175,9 @@ pub struct DensityBrush {
     pub cursor: Option<Vec3>,
     /// Height of the gizmo circle above the ground (above the grass, so that it shows).
     pub circle_lift: f32,
-    /// Outcome of the last command or dab that could fail.
+    /// Outcome of the last command or dab that could fail. Reflection does not see it (the
+    /// errors hold I/O and parser errors, which are not data).
+    #[reflect(ignore)]
     pub last: Option<Result<String, BrushError>>,
 }
 
@@ -207,7 +213,8 @@ impl Default for DensityBrush {
 /// One dab of paint: adds `amount` (negative erases) at `centre` (ground x, z) of target
 /// `target`'s map, fading smoothly to nothing at `radius`. Dabs in consecutive frames make
 /// one stroke (one undo step).
-#[derive(Message, Clone, Copy, Debug, PartialEq)]
+#[derive(Message, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub struct PaintDab {
     /// Index into [`DensityBrush::targets`].
     pub target: usize,
@@ -220,7 +227,8 @@ pub struct PaintDab {
 }
 
 /// What the brush can be asked to do besides painting.
-#[derive(Message, Clone, Debug, PartialEq)]
+#[derive(Message, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub enum BrushCommand {
     /// Restores the maps as they were before the last stroke.
     Undo,
@@ -271,7 +279,7 @@ impl MapAccess {
 }
 
 /// Why the brush could not do something.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum BrushError {
     /// The target index is not in [`DensityBrush::targets`].
     #[error("no brush target {0}")]
@@ -303,12 +311,12 @@ pub enum BrushError {
     #[error(transparent)]
     File(#[from] rwt_core::files::FileError),
     /// The index or a layer file of a save is not valid.
-    #[error("{}: {reason}", file.display())]
+    #[error("{}: {error}", file.display())]
     Parse {
         /// The file.
         file: std::path::PathBuf,
-        /// What the parser said.
-        reason: String,
+        /// What is wrong with it (boxed: parser errors are large).
+        error: Box<SaveTextError>,
     },
     /// A saved map is not an image of at most the target's size.
     #[error("{}: {error}", file.display())]
@@ -329,12 +337,12 @@ pub enum BrushError {
         expected: (u32, u32),
     },
     /// A map could not be encoded as PNG.
-    #[error("target {target}: cannot encode its map: {reason}")]
+    #[error("target {target}: cannot encode its map: {error}")]
     Encode {
         /// The target.
         target: String,
-        /// The encoder's words.
-        reason: String,
+        /// The encoder's error.
+        error: image::ImageError,
     },
     /// A saved edits file is damaged, cut short, or made for another point set.
     #[error("{}: {error}", file.display())]
@@ -345,19 +353,57 @@ pub enum BrushError {
         error: rwt_core::edits::EditsError,
     },
     /// Two layers have one name: their edits could not be told apart when loaded.
-    #[error("two scatter layers are named {0:?}: names identify edits in a save")]
-    DuplicateLayer(String),
+    #[error("two scatter layers are named {name:?}: names identify edits in a save")]
+    DuplicateLayer {
+        /// The name.
+        name: String,
+    },
     /// Two targets have one name: their maps could not be told apart when loaded.
-    #[error("two brush targets are named {0:?}: names identify maps in a save")]
-    DuplicateTarget(String),
+    #[error("two brush targets are named {name:?}: names identify maps in a save")]
+    DuplicateTarget {
+        /// The name.
+        name: String,
+    },
     /// The index names a file outside its folder.
     #[error("the index names {file:?}, outside its folder")]
     OutsideFolder {
         /// The name.
         file: String,
     },
-    /// The maps were saved, but these layers (name: reason) have no layer file: they use
-    /// something a layer file cannot name (see [`crate::layers::file::NamedAssets`]).
-    #[error("maps saved; no layer file for {0}")]
-    LayerNotSaved(String),
+    /// The maps were saved, but these layers have no layer file: they use something a
+    /// layer file cannot name (see [`crate::layers::file::NamedAssets`]).
+    #[error("maps saved; no layer file for {}", join(layers))]
+    LayerNotSaved {
+        /// The layers, and why each has no file.
+        layers: Vec<UnsavedLayer>,
+    },
+}
+
+/// A layer of a save that has no layer file.
+#[derive(Debug, thiserror::Error)]
+#[error("{name}: {error}")]
+pub struct UnsavedLayer {
+    /// The layer's `Name`.
+    pub name: String,
+    /// Why it cannot be described.
+    pub error: LayerFileError,
+}
+
+fn join(layers: &[UnsavedLayer]) -> String {
+    let each: Vec<String> = layers.iter().map(ToString::to_string).collect();
+    each.join("; ")
+}
+
+/// Why a text file of a save is not what it should be.
+#[derive(Debug, thiserror::Error)]
+pub enum SaveTextError {
+    /// Not UTF-8 text.
+    #[error("not UTF-8 text: {0}")]
+    NotText(#[from] std::str::Utf8Error),
+    /// The index is not valid RON for one (the error says where).
+    #[error("invalid index: {0}")]
+    Index(#[from] ron::error::SpannedError),
+    /// A layer file is not valid.
+    #[error("{0}")]
+    Layer(#[from] LayerFileError),
 }

@@ -8,7 +8,7 @@
 //! the world only when all of it is good.
 
 use super::paint::{set_texel_luminance, target_map};
-use super::{BrushError, BrushTarget, DensityBrush, MapAccess};
+use super::{BrushError, BrushTarget, DensityBrush, MapAccess, UnsavedLayer};
 use crate::edits::{EditSet, EditStamp};
 use crate::layers::file::{LayerDescription, NamedAssets};
 use crate::layers::{ScatterLayer, texel_luminance};
@@ -75,7 +75,7 @@ impl PaintedMaps {
         let text = read_text(&path)?;
         let index: Self = ron::from_str(&text).map_err(|e| BrushError::Parse {
             file: path.clone(),
-            reason: e.to_string(),
+            error: Box::new(e.into()),
         })?;
         let edits = index.edits.iter().map(|e| &e.file);
         let names = index
@@ -100,9 +100,9 @@ impl PaintedMaps {
 /// A text file of at most [`MAX_TEXT_BYTES`].
 fn read_text(path: &Path) -> Result<String, BrushError> {
     let bytes = read_limited(path, MAX_TEXT_BYTES)?;
-    String::from_utf8(bytes).map_err(|_| BrushError::Parse {
+    String::from_utf8(bytes).map_err(|e| BrushError::Parse {
         file: path.to_path_buf(),
-        reason: "not UTF-8 text".into(),
+        error: Box::new(e.utf8_error().into()),
     })
 }
 
@@ -148,9 +148,9 @@ fn write_map(image: &Image, target: &str, w: &mut dyn Write) -> Result<(), Brush
     let png = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels)
         .ok_or_else(|| MapAccess::of(Some(image)).at(target))?;
     png.write_with_encoder(image::codecs::png::PngEncoder::new(w))
-        .map_err(|e| BrushError::Encode {
+        .map_err(|error| BrushError::Encode {
             target: target.to_string(),
-            reason: e.to_string(),
+            error,
         })
 }
 
@@ -204,11 +204,15 @@ pub(super) fn save(
 ) -> Result<String, BrushError> {
     let mut seen = HashSet::new();
     if let Some(t) = brush.targets.iter().find(|t| !seen.insert(&t.name)) {
-        return Err(BrushError::DuplicateTarget(t.name.clone()));
+        return Err(BrushError::DuplicateTarget {
+            name: t.name.clone(),
+        });
     }
     let mut seen = HashSet::new();
     if let Some(l) = from.edits.iter().find(|l| !seen.insert(&l.name)) {
-        return Err(BrushError::DuplicateLayer(l.name.clone()));
+        return Err(BrushError::DuplicateLayer {
+            name: l.name.clone(),
+        });
     }
     let mut save = SaveTransaction::begin(dir)?;
     let mut names = FileNames::default();
@@ -253,7 +257,7 @@ pub(super) fn save(
     save.write(INDEX_FILE, index.to_ron().as_bytes())?;
     save.commit()?;
     if !unwritten.is_empty() {
-        return Err(BrushError::LayerNotSaved(unwritten.join("; ")));
+        return Err(BrushError::LayerNotSaved { layers: unwritten });
     }
     Ok(format!(
         "saved {} maps, {} layer files and {edited} edits to {}",
@@ -263,8 +267,7 @@ pub(super) fn save(
     ))
 }
 
-/// Stages a layer file per target layer; returns the layers that cannot be described
-/// (`name: reason`).
+/// Stages a layer file per target layer; returns the layers that cannot be described.
 fn stage_layer_files(
     brush: &DensityBrush,
     from: &SaveSources,
@@ -272,7 +275,7 @@ fn stage_layer_files(
     names: &mut FileNames,
     save: &mut SaveTransaction,
     index: &mut PaintedMaps,
-) -> Result<Vec<String>, BrushError> {
+) -> Result<Vec<UnsavedLayer>, BrushError> {
     let mut unwritten = Vec::new();
     let mut entities: Vec<Entity> = Vec::new();
     for t in &brush.targets {
@@ -292,7 +295,7 @@ fn stage_layer_files(
                 save.write(&file, text.as_bytes())?;
                 index.layers.push(file);
             }
-            Err(e) => unwritten.push(format!("{name}: {e}")),
+            Err(error) => unwritten.push(UnsavedLayer { name, error }),
         }
     }
     Ok(unwritten)
@@ -333,7 +336,7 @@ pub(super) fn load(
         let path = dir.join(file);
         LayerDescription::from_ron(&read_text(&path)?).map_err(|e| BrushError::Parse {
             file: path,
-            reason: e.to_string(),
+            error: Box::new(e.into()),
         })?;
     }
     for (handle, name, values) in &read {

@@ -8,34 +8,46 @@ use super::{
 use crate::edits::ScatterEdits;
 use crate::layers::file::NamedAssets;
 use crate::layers::{HeightFn, ScatterLayer};
+use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use crate::streaming::DensityMapPainted;
 use crate::streaming::LayerState;
 use crate::streaming::RwtTileSet;
 use crate::viewers::RwtViewer;
+use bevy::ecs::schedule::InternedScheduleLabel;
 use bevy::ecs::system::SystemParam;
 use bevy::input::mouse::AccumulatedMouseScroll;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use std::collections::VecDeque;
 
-/// Paints density maps with the mouse (see [`crate::brush`]). Needs [`crate::RwtPlugin`];
-/// draws its circle when Bevy's gizmos are there, reads the mouse and keyboard when Bevy's
-/// input is.
-pub struct RwtBrushPlugin;
+/// Paints density maps with the mouse (see [`crate::brush`]). Part of [`crate::RwtPlugins`],
+/// disabled there (enable it, or add it alone with the group's schedule); its systems run in
+/// [`BrushSystems`], before [`RwtSystems::Viewers`](crate::RwtSystems::Viewers) in the same
+/// schedule. Draws its circle when Bevy's gizmos are there, reads the mouse and keyboard
+/// when Bevy's input is.
+pub struct RwtBrushPlugin {
+    schedule: InternedScheduleLabel,
+}
+
+in_schedule!(RwtBrushPlugin);
 
 impl Plugin for RwtBrushPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<DensityBrush>()
+        configure_sets(app, self.schedule);
+        app.register_type::<DensityBrush>()
+            .register_type::<PaintDab>()
+            .register_type::<BrushCommand>()
+            .init_resource::<DensityBrush>()
             .init_resource::<BrushHistory>()
             .add_message::<PaintDab>()
             .add_message::<BrushCommand>()
             .add_message::<DensityMapPainted>()
+            .configure_sets(self.schedule, BrushSystems.before(RwtSystems::Viewers))
             .add_systems(
-                Update,
+                self.schedule,
                 (locate_cursor, brush_input, apply_dabs, apply_commands)
                     .chain()
-                    .in_set(BrushSystems)
-                    .before(crate::settings::RwtSystems::Viewers),
+                    .in_set(BrushSystems),
             );
     }
 

@@ -11,7 +11,8 @@ use std::time::Instant;
 
 /// Live figures of the plugin, summed over layers (each layer's own are in its
 /// [`ScatterLayerStatus`]).
-#[derive(Resource, Clone, Debug, Default, PartialEq)]
+#[derive(Resource, Clone, Debug, Default, PartialEq, Reflect)]
+#[reflect(Resource, Clone, Debug, Default, PartialEq)]
 pub struct RwtStats {
     /// Entity instances alive.
     pub live_instances: usize,

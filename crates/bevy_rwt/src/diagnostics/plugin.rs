@@ -1,21 +1,24 @@
 //! The diagnostics feature plugin.
 
 use super::{FrameStart, RwtStats, paths, publish, start_timer, update_stats};
-use crate::settings::RwtSystems;
+use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use bevy::diagnostic::{Diagnostic, RegisterDiagnostic};
 use bevy::ecs::schedule::InternedScheduleLabel;
 use bevy::prelude::*;
 use std::time::Instant;
 
-/// Keeps [`RwtStats`] and the `rwt/` diagnostics (part of [`crate::RwtPlugin`]).
+/// Keeps [`RwtStats`] and the `rwt/` diagnostics (part of [`crate::RwtPlugins`]).
 pub struct RwtDiagnosticsPlugin {
-    /// Schedule of the systems.
-    pub schedule: InternedScheduleLabel,
+    schedule: InternedScheduleLabel,
 }
+
+in_schedule!(RwtDiagnosticsPlugin);
 
 impl Plugin for RwtDiagnosticsPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<RwtStats>()
+        configure_sets(app, self.schedule);
+        app.register_type::<RwtStats>()
+            .init_resource::<RwtStats>()
             .insert_resource(FrameStart(Instant::now()))
             .add_systems(self.schedule, start_timer.before(RwtSystems::Viewers))
             .add_systems(

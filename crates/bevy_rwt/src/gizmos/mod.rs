@@ -9,7 +9,8 @@ use crate::look::GroundPlane;
 use bevy::prelude::*;
 
 /// What [`RwtGizmosPlugin`] draws.
-#[derive(Resource, Clone, Copy, Debug)]
+#[derive(Resource, Clone, Copy, Debug, Reflect)]
+#[reflect(Resource, Clone, Debug)]
 pub struct RwtGizmos {
     /// Outline every loaded chunk.
     pub chunks: bool,

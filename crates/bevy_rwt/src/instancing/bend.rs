@@ -42,7 +42,8 @@ impl Default for Bender {
 
 /// How far blades lean around the main camera: per texel a lean vector on the ground
 /// (x, z), its length 0..1 (1 lays a blade flat), pointing the way the blade falls.
-#[derive(Resource, Clone, Debug)]
+#[derive(Resource, Clone, Debug, Reflect)]
+#[reflect(Resource, Clone, Debug)]
 pub struct BendField {
     /// Ground position (x, z) of the field's min corner, a multiple of [`BEND_TEXEL`].
     min: Vec2,

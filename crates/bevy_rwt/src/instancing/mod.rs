@@ -40,7 +40,8 @@ use std::sync::Arc;
 
 /// Wind for every instanced class: sway from a world-space noise field, coherent across
 /// chunk borders.
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Resource, Clone, Debug, PartialEq)]
 pub struct RwtWind {
     /// Direction on the ground (x, z); normalized by the shader.
     pub direction: Vec2,
@@ -65,7 +66,8 @@ impl Default for RwtWind {
 
 /// Whether instanced classes grow in and out with the level of detail (the default) or
 /// appear and vanish at full size: turn it off to see the popping the fade hides.
-#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq, Reflect)]
+#[reflect(Resource, Clone, Debug, PartialEq)]
 pub struct RwtFadeIn(pub bool);
 
 impl Default for RwtFadeIn {
@@ -122,7 +124,8 @@ pub struct InstanceBuffer {
 
 /// One chunk's instances of one instanced class: drawn by [`RwtInstancingPlugin`] with one
 /// instanced draw, culled by its `Aabb`.
-#[derive(Component, Clone, Debug)]
+#[derive(Component, Clone, Debug, Reflect)]
+#[reflect(Component, Clone, Debug)]
 #[require(Transform, Visibility, VisibilityClass)]
 #[component(on_add = visibility::add_visibility_class::<InstancedChunk>)]
 pub struct InstancedChunk {
@@ -146,7 +149,9 @@ pub struct InstancedChunk {
     /// Level-of-detail fall-off of the layer (`near`, `far`, `floor`), for the shader's
     /// fade; `None` when the layer has none (instances stay at full size).
     pub falloff: Option<(f32, f32, f32)>,
-    /// The instances (shared with the render world without copying).
+    /// The instances (shared with the render world without copying). Reflection does not
+    /// see them: bulk data, counted by [`InstancedChunk::len`].
+    #[reflect(ignore)]
     pub buffer: Arc<InstanceBuffer>,
 }
 

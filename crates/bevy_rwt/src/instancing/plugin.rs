@@ -3,7 +3,7 @@
 
 use super::{BendField, Bender, InstancedChunk, InstancedMeshes, RwtFadeIn, RwtWind};
 use super::{bend, far, mesh, render};
-use crate::settings::RwtSystems;
+use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use bevy::core_pipeline::core_3d::Opaque3d;
 use bevy::core_pipeline::prepass::Opaque3dPrepass;
 use bevy::ecs::schedule::InternedScheduleLabel;
@@ -15,21 +15,27 @@ use bevy::render::render_phase::AddRenderCommand;
 use bevy::render::render_resource::SpecializedMeshPipelines;
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
-/// Draws instanced classes (part of [`crate::RwtPlugin`]) and reports classes it cannot
+/// Draws instanced classes (part of [`crate::RwtPlugins`]) and reports classes it cannot
 /// draw in their layer's [`crate::ScatterLayerStatus::class_errors`]. Without a renderer
-/// (headless apps, tests) chunk buffers are still made and counted.
+/// (headless apps, tests), or without this part, chunk buffers are still made and counted.
 pub struct RwtInstancingPlugin {
-    /// Schedule of the main-world systems.
-    pub schedule: InternedScheduleLabel,
+    schedule: InternedScheduleLabel,
 }
+
+in_schedule!(RwtInstancingPlugin);
 
 impl Plugin for RwtInstancingPlugin {
     fn build(&self, app: &mut App) {
+        configure_sets(app, self.schedule);
         app.init_resource::<RwtWind>()
             .init_resource::<RwtFadeIn>()
             .init_resource::<InstancedMeshes>()
             .init_resource::<BendField>()
             .register_type::<Bender>()
+            .register_type::<BendField>()
+            .register_type::<RwtWind>()
+            .register_type::<RwtFadeIn>()
+            .register_type::<InstancedChunk>()
             .add_systems(
                 self.schedule,
                 (

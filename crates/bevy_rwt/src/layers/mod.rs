@@ -11,8 +11,10 @@ pub use image::from_bevy_image;
 pub(crate) use image::texel_luminance;
 pub(crate) use image::too_large;
 pub use plugin::RwtLayersPlugin;
-pub(crate) use plugin::{merge_missing, missing_asset, report_assets};
-pub use status::{AssetStatus, ScatterLayerStatus};
+pub(crate) use plugin::{init_image_assets, merge_missing, missing_asset, report_assets};
+pub use status::{
+    AssetFailure, AssetProblem, AssetStatus, LayerAsset, LoadFailure, ScatterLayerStatus,
+};
 
 use crate::edits::ScatterEdits;
 use crate::look::{
@@ -27,8 +29,19 @@ use std::sync::Arc;
 /// A density shared with generation tasks.
 pub(crate) type SharedDensity = Arc<dyn Density + Send + Sync>;
 
+/// What reflection puts in a [`LayerDensity::Custom`] it builds: no instances.
+fn no_density() -> SharedDensity {
+    Arc::new(Constant(0.0))
+}
+
+/// What reflection puts in a [`HeightSource::Function`] it builds: flat ground at 0.
+fn flat_ground() -> HeightFn {
+    Arc::new(|_| 0.0)
+}
+
 /// A density of a layer or class, in instances per square world unit on the ground (x, z).
-#[derive(Clone)]
+#[derive(Clone, Reflect)]
+#[reflect(Clone, Debug)]
 pub enum LayerDensity {
     /// The same everywhere.
     Constant(f64),
@@ -46,8 +59,9 @@ pub enum LayerDensity {
         /// Instances per square unit where the image is white.
         scale: f64,
     },
-    /// Any density of `rwt_core`.
-    Custom(Arc<dyn Density + Send + Sync>),
+    /// Any density of `rwt_core`. Code, not data: reflection does not see it (and makes an
+    /// empty one when it builds this variant).
+    Custom(#[reflect(ignore, default = "no_density")] Arc<dyn Density + Send + Sync>),
 }
 
 impl std::fmt::Debug for LayerDensity {
@@ -101,7 +115,8 @@ impl LayerDensity {
 
 /// One kind of instance in a layer: its own density (the layer's classes share one blue-noise
 /// point set, paper section 6.3) and how it looks.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Reflect)]
+#[reflect(Clone, Debug)]
 pub struct ScatterClass {
     /// Where and how densely this class grows.
     pub density: LayerDensity,
@@ -128,11 +143,14 @@ pub struct ScatterClass {
 /// drawn by a child with the same instance; a little beyond the distance
 /// ([`Promotion::HYSTERESIS`]) it goes back to the buffer. Both happen within one frame,
 /// so the instance is never drawn twice or missing.
-#[derive(Clone)]
+#[derive(Clone, Reflect)]
+#[reflect(Clone, Debug)]
 pub struct Promotion {
     /// Ground distance to the nearest viewer within which instances are entities.
     pub distance: f32,
-    /// What a promoted instance gets.
+    /// What a promoted instance gets. Code, not data: reflection does not see it (and
+    /// inserts nothing when it builds a promotion).
+    #[reflect(ignore, default = "crate::look::insert_nothing")]
     pub insert: InstanceInserter,
 }
 
@@ -252,12 +270,14 @@ impl ScatterClass {
 }
 
 /// Ground height under an instance.
-#[derive(Clone)]
+#[derive(Clone, Reflect)]
+#[reflect(Clone, Debug)]
 pub enum HeightSource {
     /// Flat ground at this height.
     Constant(f32),
-    /// A function of the ground position (x, z).
-    Function(Arc<dyn Fn(Vec2) -> f32 + Send + Sync>),
+    /// A function of the ground position (x, z). Code, not data: reflection does not see it
+    /// (and makes flat ground at 0 when it builds this variant).
+    Function(#[reflect(ignore, default = "flat_ground")] Arc<dyn Fn(Vec2) -> f32 + Send + Sync>),
     /// A heightmap: the image's luminance (0..1, bilinear) over `min..min + size` (x, z),
     /// times `scale`; 0 outside.
     Image {
@@ -338,7 +358,8 @@ pub(crate) fn slope(height: &HeightFn, p: Vec2, step: f32) -> f32 {
 
 /// A scatter layer: instances of its classes, streamed around every [`crate::RwtViewer`].
 /// Removing the component (or despawning its entity) despawns all its instances.
-#[derive(Component, Clone, Debug)]
+#[derive(Component, Clone, Debug, Reflect)]
+#[reflect(Component, Clone, Debug)]
 #[require(Transform, Visibility, ScatterLayerStatus, ScatterEdits)]
 pub struct ScatterLayer {
     /// Classes sharing the layer's point set.
@@ -462,7 +483,8 @@ impl ScatterLayer {
 }
 
 /// Marks an instance spawned by a layer.
-#[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Hash, Reflect)]
+#[reflect(Component, Clone, Debug, PartialEq, Hash)]
 pub struct ScatterInstance {
     /// The layer entity.
     pub layer: Entity,

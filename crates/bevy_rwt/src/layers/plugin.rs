@@ -2,34 +2,37 @@
 //! layer files applied to their entities, and the asset status of every layer.
 
 use super::file::{NamedAssets, ScatterLayerAsset, ScatterLayerLoader, ScatterLayerSource};
+use super::status::{AssetFailure, AssetProblem, LayerAsset, LoadFailure};
 use super::{AssetStatus, ScatterLayer, ScatterLayerStatus};
-use crate::settings::RwtSystems;
-use bevy::asset::{LoadState, UntypedAssetId};
+use crate::settings::{RwtSystems, configure_sets, in_schedule};
+use bevy::asset::LoadState;
 use bevy::ecs::schedule::InternedScheduleLabel;
 use bevy::prelude::*;
 
-/// Layer files and asset status (part of [`crate::RwtPlugin`]).
+/// Layer files and asset status (part of [`crate::RwtPlugins`]).
 pub struct RwtLayersPlugin {
-    /// Schedule of the systems.
-    pub schedule: InternedScheduleLabel,
+    schedule: InternedScheduleLabel,
 }
+
+in_schedule!(RwtLayersPlugin);
 
 impl Plugin for RwtLayersPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<NamedAssets>().add_systems(
-            self.schedule,
-            (apply_layer_assets, watch_layer_files)
-                .chain()
-                .in_set(RwtSystems::Viewers),
-        );
+        configure_sets(app, self.schedule);
+        app.register_type::<ScatterLayer>()
+            .register_type::<ScatterLayerSource>()
+            .register_type::<ScatterLayerStatus>()
+            .init_resource::<NamedAssets>()
+            .add_systems(
+                self.schedule,
+                (apply_layer_assets, watch_layer_files)
+                    .chain()
+                    .in_set(RwtSystems::Viewers),
+            );
     }
 
     fn finish(&self, app: &mut App) {
-        // Painted maps are `Image` assets; headless apps without the image plugin still get
-        // the asset type (registering it twice would duplicate its systems).
-        if !app.world().contains_resource::<Assets<Image>>() {
-            app.init_asset::<Image>();
-        }
+        init_image_assets(app);
         // The loader shares the registry of the resource (clones share it).
         let names = app.world().resource::<NamedAssets>().clone();
         app.init_asset::<ScatterLayerAsset>()
@@ -37,22 +40,40 @@ impl Plugin for RwtLayersPlugin {
     }
 }
 
+/// Painted maps are `Image` assets: headless apps without the image plugin still get the
+/// asset type (registering it twice would duplicate its systems).
+pub(crate) fn init_image_assets(app: &mut App) {
+    if !app.world().contains_resource::<Assets<Image>>() {
+        app.init_asset::<Image>();
+    }
+}
+
 /// Why an asset a layer reads is not there: `None` when it is loaded, else whether it is
-/// still loading or failed, named by its path (or its id for assets made in code).
-pub(crate) fn missing_asset(
-    id: UntypedAssetId,
-    path: Option<String>,
+/// still loading or failed.
+pub(crate) fn missing_asset<A: Asset>(
+    handle: &Handle<A>,
     loaded: bool,
     server: Option<&AssetServer>,
 ) -> Option<AssetStatus> {
     if loaded {
         return None;
     }
-    let name = path.unwrap_or_else(|| format!("{id:?}"));
-    Some(match server.and_then(|s| s.get_load_state(id)) {
-        Some(LoadState::Failed(err)) => AssetStatus::Failed(vec![format!("{name}: {err}")]),
-        _ => AssetStatus::Waiting(vec![name]),
+    let asset = LayerAsset::of(handle);
+    Some(match load_failure(handle, server) {
+        Some(why) => AssetStatus::Failed(vec![AssetFailure { asset, why }]),
+        None => AssetStatus::Waiting(vec![asset]),
     })
+}
+
+/// The asset server's error, when `handle`'s last load failed.
+fn load_failure<A: Asset>(
+    handle: &Handle<A>,
+    server: Option<&AssetServer>,
+) -> Option<AssetProblem> {
+    match server?.get_load_state(handle.id())? {
+        LoadState::Failed(err) => Some(AssetProblem::Load(LoadFailure(err))),
+        _ => None,
+    }
 }
 
 /// Sets a layer's asset status, logging an error naming the layer and its assets when they
@@ -62,6 +83,7 @@ pub(crate) fn report_assets(entity: Entity, status: &mut ScatterLayerStatus, ass
         return;
     }
     if let AssetStatus::Failed(failed) = &assets {
+        let failed: Vec<String> = failed.iter().map(ToString::to_string).collect();
         error!(
             "rwt: layer {entity} shows nothing: cannot load {}",
             failed.join("; ")
@@ -103,29 +125,17 @@ fn watch_layer_files(
 ) {
     for (entity, source, mut status, streaming) in &mut sources {
         let handle = &source.0;
-        let path = handle.path().map(|p| p.to_string());
         if !streaming {
-            let missing = missing_asset(
-                handle.id().untyped(),
-                path,
-                assets.contains(handle),
-                server.as_deref(),
-            );
+            let missing = missing_asset(handle, assets.contains(handle), server.as_deref());
             report_assets(entity, &mut status, missing.unwrap_or_default());
             continue;
         }
         // A file that loaded once and then failed to reload: the layer keeps its previous
         // version, and says so.
-        let failed = match server
-            .as_deref()
-            .and_then(|s| s.get_load_state(handle.id()))
-        {
-            Some(LoadState::Failed(err)) => Some(format!(
-                "{}: {err}",
-                path.unwrap_or_else(|| format!("{:?}", handle.id()))
-            )),
-            _ => None,
-        };
+        let failed = load_failure(handle, server.as_deref()).map(|why| AssetFailure {
+            asset: LayerAsset::of(handle),
+            why,
+        });
         if status.layer_file_error != failed {
             if let Some(why) = &failed {
                 error!("rwt: layer {entity} keeps its previous version: cannot reload {why}");

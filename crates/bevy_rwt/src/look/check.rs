@@ -8,7 +8,9 @@ use bevy::render::render_resource::{TextureDimension, TextureFormat, TextureSamp
 
 /// Why an instanced class cannot be drawn. Its chunks still stream and are counted; the
 /// renderer skips them until the mesh is fixed (a reloaded or edited mesh is checked again).
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+/// An opaque value to reflection (it holds `wgpu` types).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error, Reflect)]
+#[reflect(opaque, Clone, Debug, PartialEq)]
 pub enum InstancedClassError {
     /// The mesh has no `Mesh::ATTRIBUTE_POSITION`.
     #[error("the mesh has no vertex positions")]

@@ -5,7 +5,8 @@ use serde::{Deserialize, Serialize};
 
 /// Whether an instanced class casts shadows, into every shadow map (directional cascades,
 /// point and spot lights) of the lights that cast them.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, Reflect)]
+#[reflect(Clone, Debug, Default, PartialEq)]
 pub enum InstancedShadows {
     /// No shadow: the class costs nothing in shadow passes.
     Off,
@@ -34,7 +35,8 @@ pub const DEFAULT_ALPHA_CUTOFF: f32 = 0.5;
 
 /// How an instanced class is shaded: a blade-like gradient from root to tip, lit by the
 /// scene's lights, with a hashed colour variation per instance.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, Default, PartialEq)]
 pub struct InstancedMaterial {
     /// Colour at the root (the mesh's lowest point).
     pub base_color: Color,
@@ -91,7 +93,8 @@ impl Default for InstancedMaterial {
 }
 
 /// The look of an instanced class: one mesh drawn for every instance.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Reflect)]
+#[reflect(Clone, Debug)]
 pub struct InstancedLook {
     /// The mesh (positions required; normals used when present). Its local y is up: the
     /// root is its lowest point and the tip its highest.
@@ -106,7 +109,8 @@ pub struct InstancedLook {
 /// `distance` from every camera draw `mesh` instead of the class's (chosen per chunk, with
 /// [`InstancedFar::HYSTERESIS`] against flicker at the boundary). The fade-in by rank keeps
 /// growing and shrinking instances across the change.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub struct InstancedFar {
     /// The far mesh (same conventions as the class's: y up, root at its lowest point).
     pub mesh: Handle<Mesh>,

@@ -24,8 +24,14 @@ use std::sync::Arc;
 /// [`crate::ScatterInstance`]).
 pub type InstanceInserter = Arc<dyn Fn(&mut EntityCommands) + Send + Sync>;
 
+/// What reflection puts in an [`InstanceInserter`] it builds: nothing.
+pub(crate) fn insert_nothing() -> InstanceInserter {
+    Arc::new(|_| {})
+}
+
 /// How the instances of a class look.
-#[derive(Clone)]
+#[derive(Clone, Reflect)]
+#[reflect(Clone)]
 pub enum ClassLook {
     /// A mesh and a material shared by every instance, so Bevy batches them.
     Mesh {
@@ -35,8 +41,9 @@ pub enum ClassLook {
         material: Handle<StandardMaterial>,
     },
     /// Whatever the function inserts: a scene (`SceneRoot(handle.clone())`, with Bevy's
-    /// `bevy_scene` feature in the game), another material type, colliders, markers.
-    Custom(InstanceInserter),
+    /// `bevy_scene` feature in the game), another material type, colliders, markers. Code,
+    /// not data: reflection does not see it (and inserts nothing when it builds this variant).
+    Custom(#[reflect(ignore, default = "insert_nothing")] InstanceInserter),
     /// No entity per instance: each chunk's instances are packed into one GPU buffer and
     /// drawn with one instanced draw (grass, flowers, pebbles; see [`crate::instancing`]).
     /// Only on the [`GroundPlane::Xz`] plane.
@@ -61,7 +68,8 @@ impl std::fmt::Debug for ClassLook {
 /// this mesh and material instead of the class's, crossfading (Bevy's dithered
 /// [`VisibilityRange`]) over `crossfade` around `distance`. Each instance then has one child
 /// entity holding the far look.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Reflect)]
+#[reflect(Clone, Debug)]
 pub struct MeshLod {
     /// The far mesh, standing on the same origin as the near one.
     pub mesh: Handle<Mesh>,
@@ -97,7 +105,8 @@ impl MeshLod {
 
 /// How a point's instance is turned and sized: hashed from its identity, so every look of
 /// one point (an entity, an instanced copy) agrees.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub struct Pose {
     /// Turn about the plane's normal, radians in `[0, 2 pi)`.
     pub yaw: f64,
@@ -123,8 +132,9 @@ const DEPTH_SALT: u64 = 0xde97;
 /// The plane a layer lies on. Ground positions `(u, v)` of the point set and the height
 /// `h` of the [`crate::HeightSource`] become these world positions.
 #[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize, Reflect,
 )]
+#[reflect(Clone, Debug, Default, PartialEq, Hash)]
 pub enum GroundPlane {
     /// A 3-D world with y up: `(u, h, v)`, instances turned about y.
     #[default]

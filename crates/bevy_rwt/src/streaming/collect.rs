@@ -55,7 +55,7 @@ pub(super) fn collect_results(
                 // Edited while generating: the entity points take the edits now; the
                 // instance buffers are made again.
                 if let Some(current) = current {
-                    current.apply(&mut points, classes);
+                    EditSet::apply(current, &mut points, classes);
                 }
                 c.stale = true;
             }

@@ -80,7 +80,7 @@ impl Generator {
             }
         })?;
         if let Some(edits) = &changes.edits {
-            edits.apply(&mut out, self.classes);
+            EditSet::apply(edits, &mut out, self.classes);
         }
         if !changes.footprints.is_empty() {
             let cleared = |p: &Point| {

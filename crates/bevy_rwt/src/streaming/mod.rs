@@ -41,7 +41,8 @@ use rwt_core::tileset::TileSet;
 use std::sync::Arc;
 
 /// A chunk's instances were generated (or regenerated) and queued for spawning.
-#[derive(Message, Clone, Copy, Debug, PartialEq)]
+#[derive(Message, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub struct ChunkLoaded {
     /// The layer entity.
     pub layer: Entity,
@@ -52,7 +53,8 @@ pub struct ChunkLoaded {
 }
 
 /// A chunk left every viewer's unload distance; its instances are being despawned.
-#[derive(Message, Clone, Copy, Debug, PartialEq)]
+#[derive(Message, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub struct ChunkUnloaded {
     /// The layer entity.
     pub layer: Entity,
@@ -63,7 +65,8 @@ pub struct ChunkUnloaded {
 /// Tells the plugin which part of a density map a brush changed (ground coordinates of the
 /// layers that read it). When the map's `Modified` event arrives, only chunks overlapping
 /// the painted regions re-scatter; without this message, every chunk the map covers does.
-#[derive(Message, Clone, Copy, Debug, PartialEq)]
+#[derive(Message, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub struct DensityMapPainted {
     /// The map.
     pub image: AssetId<Image>,
@@ -266,13 +269,43 @@ fn on_layer_inserted(
     mut statuses: Query<&mut ScatterLayerStatus>,
     mut commands: Commands,
 ) {
-    if let Ok(old) = states.get(insert.entity) {
-        old.despawn_all(&mut commands);
+    let status = statuses.get_mut(insert.entity).ok();
+    restart(
+        insert.entity,
+        states.get(insert.entity).ok(),
+        status,
+        &mut commands,
+    );
+}
+
+/// Streams a layer changed in place (through reflection, an inspector, or a
+/// `Mut<ScatterLayer>`) anew, as a replaced one: its settings take effect at once.
+fn restart_changed_layers(
+    layers: Query<(Entity, Ref<ScatterLayer>, Option<&LayerState>)>,
+    mut statuses: Query<&mut ScatterLayerStatus>,
+    mut commands: Commands,
+) {
+    for (entity, layer, old) in &layers {
+        if layer.is_changed() && !layer.is_added() {
+            restart(entity, old, statuses.get_mut(entity).ok(), &mut commands);
+        }
     }
-    if let Ok(mut status) = statuses.get_mut(insert.entity) {
+}
+
+/// Despawns what a layer placed and gives it a fresh streaming state.
+fn restart(
+    entity: Entity,
+    old: Option<&LayerState>,
+    status: Option<impl std::ops::DerefMut<Target = ScatterLayerStatus>>,
+    commands: &mut Commands,
+) {
+    if let Some(old) = old {
+        old.despawn_all(commands);
+    }
+    if let Some(mut status) = status {
         status.loaded_chunks.clear();
     }
-    commands.entity(insert.entity).insert(LayerState::default());
+    commands.entity(entity).insert(LayerState::default());
 }
 
 /// Copies each layer's counts into its [`ScatterLayerStatus`] (its loaded chunks are

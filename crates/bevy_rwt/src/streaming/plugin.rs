@@ -7,21 +7,61 @@ use super::plan::plan_chunks;
 use super::repaint::{PaintedRegions, repaint};
 use super::spawn::apply_budget;
 use super::*;
-use crate::edits::EditInstance;
-use crate::settings::RwtSystems;
-use bevy::ecs::schedule::InternedScheduleLabel;
+use crate::edits::{EditInstance, ScatterEdits};
+use crate::footprints::Footprint;
+use crate::instancing::InstancedMeshes;
+use crate::layers::ScatterInstance;
+use crate::settings::{RwtSystems, configure_sets};
+use crate::viewers::Viewers;
+use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 
-/// Streams layers around viewers (part of [`crate::RwtPlugin`]).
+/// Streams layers around viewers (part of [`crate::RwtPlugins`]). Without
+/// [`crate::viewers::RwtViewersPlugin`] nothing streams; without
+/// [`crate::layers::RwtLayersPlugin`] layers made in code stream, layer files do not load.
 pub struct RwtStreamingPlugin {
-    /// Schedule of the systems.
-    pub schedule: InternedScheduleLabel,
-    /// The tile set the layers sample.
-    pub tile_set: Arc<TileSet>,
+    schedule: InternedScheduleLabel,
+    tile_set: Option<Arc<TileSet>>,
+}
+
+impl RwtStreamingPlugin {
+    /// The part, its systems in `schedule`, sampling the shipped tile set.
+    pub fn new(schedule: impl ScheduleLabel) -> Self {
+        Self {
+            schedule: schedule.intern(),
+            tile_set: None,
+        }
+    }
+
+    /// Samples this tile set instead of the shipped one.
+    pub fn with_tile_set(mut self, set: Arc<TileSet>) -> Self {
+        self.tile_set = Some(set);
+        self
+    }
+}
+
+impl Default for RwtStreamingPlugin {
+    fn default() -> Self {
+        Self::new(Update)
+    }
 }
 
 impl Plugin for RwtStreamingPlugin {
     fn build(&self, app: &mut App) {
-        app.insert_resource(RwtTileSet::new(self.tile_set.clone()))
+        configure_sets(app, self.schedule);
+        let tile_set = self
+            .tile_set
+            .clone()
+            .unwrap_or_else(|| Arc::new(TileSet::embedded()));
+        app.register_type::<ScatterInstance>()
+            .register_type::<ScatterEdits>()
+            .register_type::<Footprint>()
+            .register_type::<ChunkLoaded>()
+            .register_type::<ChunkUnloaded>()
+            .register_type::<DensityMapPainted>()
+            .register_type::<EditInstance>()
+            .insert_resource(RwtTileSet::new(tile_set))
+            .init_resource::<Viewers>()
+            .init_resource::<InstancedMeshes>()
             .init_resource::<PaintedRegions>()
             .init_resource::<KnownFootprints>()
             .add_message::<ChunkLoaded>()
@@ -33,7 +73,13 @@ impl Plugin for RwtStreamingPlugin {
             .add_systems(
                 self.schedule,
                 (
-                    (repaint, apply_edits, track_footprints, plan_chunks)
+                    (
+                        restart_changed_layers,
+                        repaint,
+                        apply_edits,
+                        track_footprints,
+                        plan_chunks,
+                    )
                         .chain()
                         .in_set(RwtSystems::Plan),
                     collect_results.in_set(RwtSystems::Collect),
@@ -41,5 +87,9 @@ impl Plugin for RwtStreamingPlugin {
                     update_status.in_set(RwtSystems::Stats),
                 ),
             );
+    }
+
+    fn finish(&self, app: &mut App) {
+        crate::layers::init_image_assets(app);
     }
 }

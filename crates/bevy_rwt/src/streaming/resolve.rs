@@ -1,8 +1,8 @@
 //! A layer's densities and height source as thread-safe snapshots for generation tasks.
 //! Each is made once and kept; repainting a map forgets only the snapshots that read it.
 
-use crate::layers::{AssetStatus, HeightFn, LayerDensity, ScatterLayer, SharedDensity};
-use crate::layers::{merge_missing, missing_asset, too_large};
+use crate::layers::{AssetFailure, AssetProblem, LayerAsset, merge_missing, missing_asset};
+use crate::layers::{AssetStatus, HeightFn, LayerDensity, ScatterLayer, SharedDensity, too_large};
 use bevy::prelude::*;
 use rwt_core::density::Exclude;
 use std::sync::Arc;
@@ -44,24 +44,26 @@ fn unreadable(
     images: &Assets<Image>,
     server: Option<&AssetServer>,
 ) -> AssetStatus {
-    let path = image.path().map(|p| p.to_string());
-    if let Some(missing) = missing_asset(
-        image.id().untyped(),
-        path.clone(),
-        images.contains(image),
-        server,
-    ) {
+    if let Some(missing) = missing_asset(image, images.contains(image), server) {
         return missing;
     }
-    let name = path.unwrap_or_else(|| format!("{:?}", image.id()));
-    AssetStatus::Failed(vec![match images.get(image).filter(|i| too_large(i)) {
-        Some(i) => format!(
-            "{name}: {}x{} pixels, over the limit of {} for a map (rwt_core::density::MAX_IMAGE_PIXELS)",
-            i.width(),
-            i.height(),
-            rwt_core::density::MAX_IMAGE_PIXELS
-        ),
-        None => format!("{name}: pixels not readable on the CPU (compressed or GPU-only format)"),
+    let Some(i) = images.get(image) else {
+        return AssetStatus::Waiting(vec![LayerAsset::of(image)]);
+    };
+    let why = if too_large(i) {
+        AssetProblem::TooLarge {
+            width: i.width(),
+            height: i.height(),
+            limit: rwt_core::density::MAX_IMAGE_PIXELS,
+        }
+    } else {
+        AssetProblem::NotOnCpu {
+            format: i.texture_descriptor.format,
+        }
+    };
+    AssetStatus::Failed(vec![AssetFailure {
+        asset: LayerAsset::of(image),
+        why,
     }])
 }
 

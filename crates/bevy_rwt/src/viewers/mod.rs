@@ -12,7 +12,8 @@ use glam::DVec2;
 use rwt_core::streaming::Viewer;
 
 /// Which directions a viewer streams in.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
 pub enum ViewCone {
     /// Every direction (top-down views, or to be ready for any turn).
     All,
@@ -28,7 +29,8 @@ pub enum ViewCone {
 
 /// Marks an entity (usually a camera) around which layers are streamed. Chunks near it are
 /// always loaded; farther ones where its view cone, laid on the ground, reaches them.
-#[derive(Component, Clone, Copy, Debug)]
+#[derive(Component, Clone, Copy, Debug, Reflect)]
+#[reflect(Component, Clone, Debug)]
 #[require(Transform)]
 pub struct RwtViewer {
     /// Directions streamed.

@@ -22,7 +22,7 @@ pub fn create_app_with(extra: impl FnOnce(&mut App)) -> App {
     app.add_plugins((
         MinimalPlugins,
         AssetPlugin::default(),
-        RwtPlugin::default().with_spawn_budget(50_000),
+        RwtPlugins::default().with_spawn_budget(50_000),
     ));
     extra(&mut app);
     app.finish();
@@ -45,7 +45,7 @@ pub fn app_reading_with(dir: &std::path::Path, extra: impl FnOnce(&mut App)) -> 
             ..Default::default()
         },
         bevy::image::ImagePlugin::default(),
-        RwtPlugin::default().with_spawn_budget(50_000),
+        RwtPlugins::default().with_spawn_budget(50_000),
     ))
     .init_asset::<Mesh>()
     .init_asset::<StandardMaterial>();

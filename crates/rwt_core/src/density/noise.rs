@@ -14,7 +14,14 @@ use noise::{Fbm, Perlin};
 
 /// Fractal noise: `scale * max(0, base + amplitude * fbm(p * frequency))`, with fBm of
 /// Perlin noise from the `noise` crate (values in [-1, 1]).
+///
+/// With `bevy_reflect`, an opaque value: its tables are derived from its [`NoiseParams`].
 #[derive(Clone, Debug)]
+#[cfg_attr(
+    feature = "bevy_reflect",
+    derive(bevy_reflect::Reflect),
+    reflect(opaque, Clone, Debug)
+)]
 pub struct NoiseDensity {
     octaves: Box<[Octave]>,
     /// The `noise` crate's `1 / sum of weights`, which rescales the sum into [-1, 1].
@@ -50,6 +57,7 @@ struct FbmModel {
 
 /// The parameters of a [`NoiseDensity`], as plain (serializable) data.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "bevy_reflect", derive(bevy_reflect::Reflect))]
 pub struct NoiseParams {
     /// Noise seed.
     pub seed: u32,

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 /// Stable identity of a point: the tile it first appears in and its index there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[cfg_attr(feature = "bevy_reflect", derive(bevy_reflect::Reflect))]
 pub struct PointId {
     /// Subdivision level (0 = base tiles).
     pub level: u8,

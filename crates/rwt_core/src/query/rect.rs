@@ -6,8 +6,15 @@ use serde::{Deserialize, Serialize};
 
 /// A half-open rectangle `[min, max)` in world units. Always finite with `min <= max` on
 /// both axes (it may be empty): [`Rect::new`] checks it, and so does deserializing.
+///
+/// With `bevy_reflect`, an opaque value, so that reflection cannot invert it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "Corners", into = "Corners")]
+#[cfg_attr(
+    feature = "bevy_reflect",
+    derive(bevy_reflect::Reflect),
+    reflect(opaque, Clone, Debug, PartialEq)
+)]
 pub struct Rect {
     min: DVec2,
     max: DVec2,

@@ -88,7 +88,8 @@ pub struct ScatterLayerAsset(pub ScatterLayer);
 /// Puts the layer of a `.layer.ron` asset on this entity, and updates it when the file
 /// changes. Until the file loads, the entity's [`super::ScatterLayerStatus`] says whether it
 /// is waiting for it or why it failed.
-#[derive(Component, Clone, Debug)]
+#[derive(Component, Clone, Debug, Reflect)]
+#[reflect(Component, Clone, Debug)]
 #[require(super::ScatterLayerStatus)]
 pub struct ScatterLayerSource(pub Handle<ScatterLayerAsset>);
 
