@@ -209,7 +209,7 @@ fn settle(
     cameras: Query<Entity, With<Camera3d>>,
     mut commands: Commands,
 ) {
-    let live = stats.live_instances + stats.live_instanced;
+    let live = stats.live_entities + stats.live_instanced;
     if *settled_frames == 0 && (stats.pending_tasks > 0 || stats.queued_spawns > 0 || live == 0) {
         return;
     }

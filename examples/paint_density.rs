@@ -169,12 +169,12 @@ impl Canvas {
             .zip(&self.images)
             .zip(&self.textures)
             .map(|((c, map), texture)| {
-                let density = LayerDensity::Image {
+                let density = LayerDensity::Image(GroundMap {
                     image: map.clone(),
                     min: Vec2::ZERO,
                     size: Vec2::ONE,
                     scale: c.max_density,
-                };
+                });
                 let sprite = Sprite {
                     image: texture.clone(),
                     custom_size: Some(Vec2::splat((c.size as f64 / c.max_density.sqrt()) as f32)),

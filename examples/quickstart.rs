@@ -36,12 +36,12 @@ fn setup(
         MeshMaterial3d(materials.add(Color::srgb(0.45, 0.38, 0.28))),
     ));
     // White in the map = 3 bushes per square metre, over a 100 m square.
-    let density = LayerDensity::Image {
+    let density = LayerDensity::Image(GroundMap {
         image: assets.load("images/sphere.png"),
         min: Vec2::splat(-50.0),
         size: Vec2::splat(100.0),
         scale: 3.0,
-    };
+    });
     let bush = ScatterClass::new(
         density,
         meshes.add(Sphere::new(0.35).mesh().ico(1).unwrap()),

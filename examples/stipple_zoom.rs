@@ -10,6 +10,7 @@ use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll};
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use glam::DVec2;
+use rwt_core::density::Placement;
 use rwt_core::density::{ImageDensity, Scale};
 use rwt_core::query::{PointId, Rect, Sampler};
 use rwt_core::tileset::TileSet;
@@ -70,9 +71,11 @@ fn setup(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
         &picture,
         None,
         true,
-        DVec2::ZERO,
-        DVec2::splat(SIDE),
-        DOTS_IN_VIEW / area,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::splat(SIDE),
+            scale: DOTS_IN_VIEW / area,
+        },
     )
     .expect("a valid image");
     let set = TileSet::embedded();

@@ -8,7 +8,7 @@
 use bevy::app::AppExit;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy_rwt::{RwtStats, ScatterInstance};
+use bevy_rwt::{RwtStats, ScatterEntity};
 use std::path::PathBuf;
 
 /// The smoke session's settings and frame counter.
@@ -108,7 +108,7 @@ fn count_frame(mut smoke: ResMut<Smoke>) {
 fn count_instances(
     mut live: ResMut<LiveInstances>,
     mut report: ResMut<SmokeReport>,
-    scattered: Query<(), With<ScatterInstance>>,
+    scattered: Query<(), With<ScatterEntity>>,
     counted: Query<(), With<CountedInstance>>,
     stats: Option<Res<RwtStats>>,
 ) {

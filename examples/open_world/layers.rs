@@ -73,11 +73,10 @@ pub fn setup_layers(
 /// patches about `feature` metres across) so that the world starts with meadows; the density
 /// reads `scale` instances per square metre where it is white.
 fn painted_map(images: &mut Assets<Image>, seed: u32, scale: f64, feature: f64) -> LayerDensity {
-    let min = Vec2::splat(-MAP_SIZE / 2.0);
-    let (handle, density) =
-        bevy_rwt::brush::blank_map(images, MAP_TEXELS, min, Vec2::splat(MAP_SIZE), scale);
+    let area = Rect::from_center_size(Vec2::ZERO, Vec2::splat(MAP_SIZE));
+    let map = bevy_rwt::brush::blank_map(images, MAP_TEXELS, area, scale);
     let noise = Perlin::new(seed);
-    let mut image = images.get_mut(&handle).expect("just added");
+    let mut image = images.get_mut(&map.image).expect("just added");
     let data = image.data.as_mut().expect("a CPU-side map");
     let texel = (MAP_SIZE / MAP_TEXELS as f32) as f64;
     for (i, px) in data.chunks_exact_mut(4).enumerate() {
@@ -90,7 +89,7 @@ fn painted_map(images: &mut Assets<Image>, seed: u32, scale: f64, feature: f64) 
         let byte = (v * v * 255.0) as u8;
         px.copy_from_slice(&[byte, byte, byte, 255]);
     }
-    density
+    LayerDensity::Image(map)
 }
 
 /// The tree layer's classes: the three species, then their stump.

@@ -283,7 +283,7 @@ fn hud(
     let on = |b: bool| if b { "on" } else { "off" };
     let per_layer: Vec<String> = layers
         .iter()
-        .map(|(name, s)| match (s.live_instances, s.live_instanced) {
+        .map(|(name, s)| match (s.live_entities, s.live_instanced) {
             (n, 0) => format!("{name} {n}"),
             (0, m) => format!("{name} {m} inst."),
             (n, m) => format!("{name} {n} + {m} inst."),
@@ -298,7 +298,7 @@ fn hud(
         format!("live: {}", per_layer.join(", ")),
         format!(
             "entities {}  instanced {}  chunks {}  pending tasks {}  streaming {:.2} ms  {:.0} fps",
-            stats.live_instances,
+            stats.live_entities,
             stats.live_instanced,
             stats.loaded_chunks,
             stats.pending_tasks,

@@ -103,7 +103,7 @@ pub struct Stage<'w, 's> {
     terrain: Res<'w, Terrain>,
     cabins: Res<'w, Cabins>,
     layers: Query<'w, 's, (Entity, &'static Name), With<ScatterLayer>>,
-    instances: Query<'w, 's, &'static ScatterInstance>,
+    instances: Query<'w, 's, &'static ScatterEntity>,
     camera: Query<'w, 's, &'static Transform, With<FlyCamera>>,
     walkers: Query<'w, 's, &'static Transform, (With<Walker>, Without<FlyCamera>)>,
     picking: ScatterPicking<'w, 's>,

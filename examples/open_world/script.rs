@@ -226,7 +226,7 @@ fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
 /// Live instances of the layer the stroke paints, once it has settled.
 fn painted_instances(brush: &DensityBrush, layers: &Query<&ScatterLayerStatus>) -> Option<usize> {
     let s = layers.get(brush.targets.first()?.layer).ok()?;
-    (s.pending_tasks == 0 && s.queued_spawns == 0).then_some(s.live_instances + s.live_instanced)
+    (s.pending_tasks == 0 && s.queued_spawns == 0).then_some(s.live_entities + s.live_instanced)
 }
 
 /// The scripted stroke, and its count for the smoke line.

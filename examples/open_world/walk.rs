@@ -1,7 +1,7 @@
 //! Walking on foot (K toggles): a capsule on the terrain that avian's move-and-slide keeps
 //! out of tree trunks, stumps and rocks, and that grass parts around (a `Bender`); the camera rides at eye height and looks with the
 //! mouse as the fly camera does. Trunks and rocks get static colliders as `bevy_rwt`
-//! spawns them (an observer on `ScatterInstance`): the plugin knows nothing of physics.
+//! spawns them (an observer on `ScatterEntity`): the plugin knows nothing of physics.
 
 use crate::layers::{STUMP, TREE_SPECIES};
 use avian3d::prelude::*;
@@ -54,8 +54,8 @@ fn collider_of(layer: &str, class: u16) -> Option<Collider> {
 }
 
 fn add_colliders(
-    add: On<Add, ScatterInstance>,
-    instances: Query<&ScatterInstance>,
+    add: On<Add, ScatterEntity>,
+    instances: Query<&ScatterEntity>,
     names: Query<&Name>,
     mut commands: Commands,
 ) {

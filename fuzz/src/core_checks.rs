@@ -4,6 +4,7 @@
 //! millisecond and a run reaches millions of inputs.
 
 use glam::DVec2;
+use rwt_core::density::Placement;
 use rwt_core::density::{
     Constant, Density, DistanceFalloff, ImageDensity, NoiseDensity, NoiseParams, Product, Scale,
     Sum, from_fn, sanitize,
@@ -120,7 +121,15 @@ pub fn image_density(data: &[u8]) -> bool {
         DVec2::new(b.number(), b.number()),
         b.number(),
     );
-    let Ok(d) = ImageDensity::from_bytes(b.0, invert, origin, size, scale) else {
+    let Ok(d) = ImageDensity::from_bytes(
+        b.0,
+        invert,
+        Placement {
+            min: origin,
+            size,
+            scale,
+        },
+    ) else {
         return false;
     };
     let rect = Rect::new(DVec2::splat(-2.0), DVec2::splat(2.0)).unwrap();
@@ -157,7 +166,16 @@ fn density(b: &mut Bytes, depth: u32) -> Box<dyn Density + Send + Sync> {
                 DVec2::new(b.number(), b.number()),
                 DVec2::new(b.number(), b.number()),
             );
-            match ImageDensity::from_values(w, h, &values, origin, size, b.number()) {
+            match ImageDensity::from_values(
+                w,
+                h,
+                &values,
+                Placement {
+                    min: origin,
+                    size,
+                    scale: b.number(),
+                },
+            ) {
                 Ok(d) => Box::new(d),
                 Err(_) => Box::new(Constant(0.0)),
             }

@@ -168,7 +168,7 @@ fn settle(app: &mut App) {
     for _ in 0..100_000 {
         app.update();
         let s = app.world().resource::<RwtStats>();
-        if s.pending_tasks == 0 && s.queued_spawns == 0 && s.live_instances > 0 {
+        if s.pending_tasks == 0 && s.queued_spawns == 0 && s.live_entities > 0 {
             return;
         }
     }

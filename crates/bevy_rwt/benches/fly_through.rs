@@ -56,14 +56,14 @@ fn fill(app: &mut App) {
         app.update();
         frames += 1;
         let s = app.world().resource::<RwtStats>();
-        if s.pending_tasks == 0 && s.queued_spawns == 0 && s.live_instances > 0 {
+        if s.pending_tasks == 0 && s.queued_spawns == 0 && s.live_entities > 0 {
             break;
         }
         if frames > 100_000 {
             panic!("the world did not fill");
         }
     }
-    let live = app.world().resource::<RwtStats>().live_instances;
+    let live = app.world().resource::<RwtStats>().live_entities;
     println!(
         "filled {live} instances in {frames} frames, {:.2} s",
         started.elapsed().as_secs_f64()
@@ -78,7 +78,7 @@ fn fly(app: &mut App, viewer: Entity, speed: f32) {
     let mut previous: std::collections::HashSet<Entity> = std::collections::HashSet::new();
     let mut q = app
         .world_mut()
-        .query_filtered::<Entity, With<ScatterInstance>>();
+        .query_filtered::<Entity, With<ScatterEntity>>();
     previous.extend(q.iter(app.world()));
     let fly = Instant::now();
     for f in 0..600 {
@@ -100,7 +100,7 @@ fn fly(app: &mut App, viewer: Entity, speed: f32) {
     let stats = app.world().resource::<RwtStats>().clone();
     println!(
         "fly-through: 600 frames, live instances between {least} and {most} (now {})",
-        stats.live_instances
+        stats.live_entities
     );
     println!(
         "frame time: median {:.2} ms, 95th percentile {:.2} ms, max {:.2} ms",

@@ -15,7 +15,12 @@ fn main() {
         Default::default(),
     );
     let t = std::time::Instant::now();
-    let d = bevy_rwt::layers::from_bevy_image(&img, Vec2::ZERO, Vec2::splat(100.0), 1.0).unwrap();
+    let at = bevy_rwt::rwt_core::density::Placement {
+        min: glam::DVec2::ZERO,
+        size: glam::DVec2::splat(100.0),
+        scale: 1.0,
+    };
+    let d = bevy_rwt::layers::from_bevy_image(&img, at).unwrap();
     println!(
         "1024^2 conversion: {:.1} ms ({:?})",
         t.elapsed().as_secs_f64() * 1e3,

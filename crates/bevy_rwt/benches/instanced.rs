@@ -107,7 +107,7 @@ fn world(path: Path, density: f64) -> (App, Entity) {
 /// All live instances, entity or instanced.
 fn live(app: &App) -> usize {
     let s = app.world().resource::<RwtStats>();
-    s.live_instances + s.live_instanced
+    s.live_entities + s.live_instanced
 }
 
 /// Runs frames until the world around the start is filled.

@@ -18,7 +18,7 @@
 //! /// Chops every tree the player clicked this frame (found by picking, or by a collider on
 //! /// the instance entity): the tree leaves and never comes back.
 //! fn chop(
-//!     clicked: Query<&ScatterInstance, With<Chopped>>,
+//!     clicked: Query<&ScatterEntity, With<Chopped>>,
 //!     mut edits: MessageWriter<EditInstance>,
 //! ) {
 //!     for instance in &clicked {

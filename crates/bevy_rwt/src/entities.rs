@@ -4,7 +4,7 @@
 //! entities appear, stay or go is decided here, by point identity: existing instances never
 //! move.
 
-use crate::layers::{HeightFn, ScatterInstance, ScatterLayer};
+use crate::layers::{HeightFn, ScatterEntity, ScatterLayer};
 use crate::look::{ClassLook, Pose};
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
@@ -174,7 +174,7 @@ fn spawn_instance(commands: &mut Commands, spawner: &Spawner, p: &Point) -> Enti
     let transform = layer
         .plane
         .place(p, (spawner.height)(ground), pose, layer.seed);
-    let instance = ScatterInstance {
+    let instance = ScatterEntity {
         layer: spawner.entity,
         id: p.id,
         class: p.class,

@@ -57,7 +57,7 @@
 //!     for _ in 0..500 {
 //!         app.update();
 //!         let stats = app.world().resource::<RwtStats>();
-//!         if stats.live_instances > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
+//!         if stats.live_entities > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
 //!             break;
 //!         }
 //!         std::thread::sleep(std::time::Duration::from_millis(2));
@@ -65,12 +65,12 @@
 //! };
 //! settle(&mut app);
 //! // Chop a tree: a stump (class 1) takes its place, now and whenever its chunk comes back.
-//! let tree = *app.world_mut().query::<&ScatterInstance>().iter(app.world()).next().unwrap();
+//! let tree = *app.world_mut().query::<&ScatterEntity>().iter(app.world()).next().unwrap();
 //! app.world_mut().write_message(EditInstance::reclass(layer, tree.id, 1));
 //! settle(&mut app);
 //! let edits = app.world().get::<ScatterEdits>(layer).unwrap();
 //! assert_eq!(edits.len(), 1);
-//! let now = app.world_mut().query::<&ScatterInstance>().iter(app.world())
+//! let now = app.world_mut().query::<&ScatterEntity>().iter(app.world())
 //!     .find(|i| i.id == tree.id).copied().unwrap();
 //! assert_eq!(now.class, 1);
 //! ```
@@ -80,7 +80,7 @@
 //! - `Rwt*`: the plugin and its parts, their resources, system sets and the viewer marker
 //!   ([`RwtPlugins`], [`RwtSettings`], [`RwtSystems`], [`RwtStats`], [`RwtViewer`]);
 //! - `Scatter*`: components and assets that describe a layer and what it places
-//!   ([`ScatterLayer`], [`ScatterClass`], [`ScatterInstance`], [`ScatterLayerStatus`],
+//!   ([`ScatterLayer`], [`ScatterClass`], [`ScatterEntity`], [`ScatterLayerStatus`],
 //!   [`layers::file::ScatterLayerSource`]);
 //! - plain names for the values inside them and for messages ([`LayerDensity`],
 //!   [`HeightSource`], [`ClassLook`], [`GroundPlane`], [`ViewCone`], [`ChunkLoaded`]).
@@ -135,14 +135,14 @@
 //! for _ in 0..10_000 {
 //!     app.update();
 //!     let stats = app.world().resource::<RwtStats>();
-//!     if stats.live_instances > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
+//!     if stats.live_entities > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
 //!         break;
 //!     }
 //!     std::thread::sleep(std::time::Duration::from_millis(1));
 //! }
 //! let stats = app.world().resource::<RwtStats>();
 //! // About 0.5 stones (entities) and 20 blades (instanced, no entities) per square unit.
-//! let ratio = stats.live_instanced as f64 / stats.live_instances as f64;
+//! let ratio = stats.live_instanced as f64 / stats.live_entities as f64;
 //! assert!((ratio - 40.0).abs() < 4.0, "{stats:?}");
 //! ```
 
@@ -168,8 +168,8 @@ pub use diagnostics::{RwtDiagnosticsPlugin, RwtStats};
 pub use instancing::{Bender, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind};
 pub use layers::RwtLayersPlugin;
 pub use layers::{
-    AssetFailure, AssetProblem, AssetStatus, DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE,
-    HeightSource, LayerAsset, LayerDensity, Promotion, ScatterClass, ScatterInstance, ScatterLayer,
+    AssetFailure, AssetProblem, AssetStatus, DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap,
+    HeightSource, LayerAsset, LayerDensity, Promotion, ScatterClass, ScatterEntity, ScatterLayer,
     ScatterLayerStatus,
 };
 pub use look::{
@@ -196,11 +196,12 @@ pub mod prelude {
     pub use crate::layers::file::{NamedAssets, ScatterLayerAsset, ScatterLayerSource};
     pub use crate::picking::{PickFilter, ScatterHit, ScatterPicking};
     pub use crate::{
-        AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundPlane,
-        HeightSource, InstancedChunk, InstancedMaterial, InstancedShadows, LayerDensity,
-        RwtDiagnosticsPlugin, RwtFadeIn, RwtInstancingPlugin, RwtLayersPlugin, RwtPlugins,
-        RwtSettings, RwtStats, RwtStreamingPlugin, RwtSystems, RwtViewer, RwtViewersPlugin,
-        RwtWind, ScatterClass, ScatterInstance, ScatterLayer, ScatterLayerStatus, ViewCone,
+        AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundMap,
+        GroundPlane, HeightSource, InstancedChunk, InstancedMaterial, InstancedShadows,
+        LayerDensity, RwtDiagnosticsPlugin, RwtFadeIn, RwtInstancingPlugin, RwtLayersPlugin,
+        RwtPlugins, RwtSettings, RwtStats, RwtStreamingPlugin, RwtSystems, RwtViewer,
+        RwtViewersPlugin, RwtWind, ScatterClass, ScatterEntity, ScatterLayer, ScatterLayerStatus,
+        ViewCone,
     };
     pub use rwt_core::streaming::{Falloff, StreamingConfig};
 }

@@ -19,13 +19,14 @@ fn painted_app() -> (App, Handle<Image>) {
         app.add_plugins(RwtBrushPlugin::default());
     });
     spawn_viewer(&mut app, Vec3::ZERO);
-    let (map, density) = bevy_rwt::brush::blank_map(
+    let map = bevy_rwt::brush::blank_map(
         &mut app.world_mut().resource_mut::<Assets<Image>>(),
         64,
-        Vec2::splat(-64.0),
-        Vec2::splat(128.0),
+        Rect::from_center_size(Vec2::ZERO, Vec2::splat(128.0)),
         1.0,
     );
+    let density = LayerDensity::Image(map.clone());
+    let map = map.image;
     let meadow = app
         .world_mut()
         .spawn((Name::new("meadow"), layer(density)))
@@ -167,7 +168,7 @@ fn maps_save_and_load_into_another_world() {
     let index = PaintedMaps::read(&dir).unwrap();
     assert_eq!(index.maps.len(), 1);
     assert_eq!(
-        (index.maps[0].min, index.maps[0].scale),
+        (index.maps[0].map.min, index.maps[0].map.scale),
         ((-64.0, -64.0), 1.0)
     );
 
@@ -233,7 +234,7 @@ fn layers_a_file_cannot_name_still_save_their_maps() {
     }
     let index = PaintedMaps::read(&dir).unwrap();
     assert_eq!((index.maps.len(), index.layers.len()), (1, 0));
-    assert!(dir.join(&index.maps[0].file).exists());
+    assert!(dir.join(&index.maps[0].map.path).exists());
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -303,7 +304,7 @@ fn layered(app: &mut App) -> std::collections::HashMap<(String, rwt_core::PointI
         .iter(app.world())
         .map(|(e, n)| (e, n.to_string()))
         .collect();
-    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
     q.iter(app.world())
         .map(|(i, t)| ((names[&i.layer].clone(), i.id), t.translation))
         .collect()
@@ -319,13 +320,14 @@ fn two_map_app(names: [&str; 2], seed: u32) -> App {
     let mut targets = Vec::new();
     for (k, (name, size)) in names.into_iter().zip([64, 256]).enumerate() {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let (map, density) = bevy_rwt::brush::blank_map(
+        let map = bevy_rwt::brush::blank_map(
             &mut images,
             size,
-            Vec2::splat(-64.0),
-            Vec2::splat(128.0),
+            Rect::from_center_size(Vec2::ZERO, Vec2::splat(128.0)),
             1.0,
         );
+        let density = LayerDensity::Image(map.clone());
+        let map = map.image;
         if k == 1 {
             let mut image = images.get_mut(&map).unwrap();
             let mut state = seed.wrapping_mul(2_654_435_761) | 1;
@@ -359,8 +361,8 @@ fn two_map_app(names: [&str; 2], seed: u32) -> App {
 /// Removes every `every`-th instance of every layer (per-instance edits), and runs until
 /// streaming settles.
 fn chop_some(app: &mut App, every: usize) {
-    let mut q = app.world_mut().query::<&ScatterInstance>();
-    let mut all: Vec<ScatterInstance> = q.iter(app.world()).copied().collect();
+    let mut q = app.world_mut().query::<&ScatterEntity>();
+    let mut all: Vec<ScatterEntity> = q.iter(app.world()).copied().collect();
     all.sort_by_key(|i| (i.layer, i.id));
     let chop = all.iter().step_by(every);
     let messages: Vec<_> = chop.map(|i| EditInstance::remove(i.layer, i.id)).collect();
@@ -524,7 +526,9 @@ fn a_save_that_fails_part_way_changes_no_file() {
     let layer = app.world().resource::<DensityBrush>().targets[0].layer;
     let unreadable = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let (map, density) = bevy_rwt::brush::blank_map(&mut images, 8, Vec2::ZERO, Vec2::ONE, 1.0);
+        let map = bevy_rwt::brush::blank_map(&mut images, 8, Rect::new(0.0, 0.0, 1.0, 1.0), 1.0);
+        let density = LayerDensity::Image(map.clone());
+        let map = map.image;
         images.get_mut(&map).unwrap().texture_descriptor.format =
             bevy::render::render_resource::TextureFormat::Bc1RgbaUnorm;
         density
@@ -622,7 +626,7 @@ fn maps_of_colliding_names_round_trip() {
     let painted = layered(&mut app);
     command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
     let index = PaintedMaps::read(&dir).unwrap();
-    let files: Vec<&str> = index.maps.iter().map(|m| m.file.as_str()).collect();
+    let files: Vec<&str> = index.maps.iter().map(|m| m.map.path.as_str()).collect();
     assert_eq!(files, ["red_flowers.png", "red_flowers-2.png"]);
     let mut fresh = two_map_app(["red flowers", "red_flowers"], 9);
     command(&mut fresh, BrushCommand::Load(dir.clone())).unwrap();

@@ -266,7 +266,7 @@ fn chunks_over_the_point_budget_are_refused_and_counted() {
     assert_eq!(status.live_instanced, 0);
     let fine = app.world().get::<ScatterLayerStatus>(sparse).unwrap();
     assert_eq!(fine.refused_chunks, 0);
-    assert!(fine.live_instances > 100);
+    assert!(fine.live_entities > 100);
 }
 
 #[test]

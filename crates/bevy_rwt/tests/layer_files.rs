@@ -77,12 +77,12 @@ fn a_missing_density_map_is_reported_not_silently_empty() {
         .world()
         .resource::<AssetServer>()
         .load("maps/nowhere.png");
-    let density = LayerDensity::Image {
+    let density = LayerDensity::Image(GroundMap {
         image: missing,
         min: Vec2::splat(-64.0),
         size: Vec2::splat(128.0),
         scale: 1.0,
-    };
+    });
     let painted = app.world_mut().spawn(layer(density)).id();
     let fine = app
         .world_mut()
@@ -99,12 +99,12 @@ fn a_missing_density_map_is_reported_not_silently_empty() {
         }
         other => panic!("{other:?}"),
     }
-    assert_eq!(status.live_instances, 0);
+    assert_eq!(status.live_entities, 0);
     // The other layer streams as usual.
     tick_app(&mut app, 2_000);
     let ok = app.world().get::<ScatterLayerStatus>(fine).unwrap();
     assert_eq!(ok.assets, AssetStatus::Ready);
-    assert!(ok.live_instances > 100);
+    assert!(ok.live_entities > 100);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -144,18 +144,18 @@ fn a_layer_waits_for_its_map_and_streams_once_it_is_there() {
     spawn_viewer(&mut app, Vec3::ZERO);
     // A handle to an image that is not in the assets yet (what a loading map looks like).
     let handle: Handle<Image> = Handle::from(bevy::asset::uuid::Uuid::from_u128(0x5ca7));
-    let density = LayerDensity::Image {
+    let density = LayerDensity::Image(GroundMap {
         image: handle.clone(),
         min: Vec2::splat(-64.0),
         size: Vec2::splat(128.0),
         scale: 0.5,
-    };
+    });
     let l = app.world_mut().spawn(layer(density)).id();
     for _ in 0..5 {
         app.update();
     }
     let stats = app.world().resource::<RwtStats>().clone();
-    assert_eq!((stats.layers_waiting, stats.live_instances), (1, 0));
+    assert_eq!((stats.layers_waiting, stats.live_entities), (1, 0));
     app.world_mut()
         .resource_mut::<Assets<Image>>()
         .insert(&handle, solid_image(16, [255, 255, 255, 255]))
@@ -163,7 +163,7 @@ fn a_layer_waits_for_its_map_and_streams_once_it_is_there() {
     tick_app(&mut app, 2_000);
     let status = app.world().get::<ScatterLayerStatus>(l).unwrap();
     assert_eq!(status.assets, AssetStatus::Ready);
-    assert!(status.live_instances > 1_000, "{status:?}");
+    assert!(status.live_entities > 1_000, "{status:?}");
     assert_eq!(app.world().resource::<RwtStats>().layers_waiting, 0);
 }
 

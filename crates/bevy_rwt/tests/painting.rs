@@ -128,7 +128,7 @@ fn repainting_one_class_map_keeps_the_others_snapshots() {
     );
     tick_app(&mut app, 2_000);
     let class_of = |app: &mut App| {
-        let mut q = app.world_mut().query::<&ScatterInstance>();
+        let mut q = app.world_mut().query::<&ScatterEntity>();
         q.iter(app.world())
             .map(|i| (i.id, i.class))
             .collect::<std::collections::HashMap<_, _>>()

@@ -52,7 +52,7 @@ fn enter(ray: Ray3d, t: &Transform, (lo, hi): (Vec3, Vec3)) -> Option<f32> {
 /// Every live instance as drawn: (point, class, transform).
 fn live(app: &mut App) -> Vec<(PointId, u16, Transform)> {
     let mut out = Vec::new();
-    let mut entities = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut entities = app.world_mut().query::<(&ScatterEntity, &Transform)>();
     out.extend(entities.iter(app.world()).map(|(i, t)| (i.id, i.class, *t)));
     let mut chunks = app
         .world_mut()

@@ -24,7 +24,7 @@ fn headless<M>(plugins: impl bevy::app::Plugins<M>) -> App {
 
 fn entity_instances(app: &mut App) -> usize {
     app.world_mut()
-        .query::<&ScatterInstance>()
+        .query::<&ScatterEntity>()
         .iter(app.world())
         .count()
 }
@@ -66,13 +66,14 @@ fn every_part_runs_in_the_schedule_it_is_given_the_brush_first() {
             .enable::<RwtBrushPlugin>(),
     );
     spawn_viewer(&mut app, Vec3::ZERO);
-    let (map, density) = bevy_rwt::brush::blank_map(
+    let map = bevy_rwt::brush::blank_map(
         &mut app.world_mut().resource_mut::<Assets<Image>>(),
         64,
-        Vec2::splat(-64.0),
-        Vec2::splat(128.0),
+        Rect::from_center_size(Vec2::ZERO, Vec2::splat(128.0)),
         1.0,
     );
+    let density = LayerDensity::Image(map.clone());
+    let map = map.image;
     let meadow = app.world_mut().spawn(layer(density)).id();
     app.world_mut().spawn(layer(LayerDensity::Constant(0.2)));
     app.world_mut().resource_mut::<DensityBrush>().targets =
@@ -98,7 +99,7 @@ fn every_part_runs_in_the_schedule_it_is_given_the_brush_first() {
     assert_eq!(entity_instances(&mut app), 0);
     assert!(!painted(&app));
     run(&mut app, 2_000, Some(Streamed));
-    let live = app.world().resource::<RwtStats>().live_instances;
+    let live = app.world().resource::<RwtStats>().live_entities;
     assert!(live > 100, "{live}");
     assert_eq!(entity_instances(&mut app), live);
     app.world_mut().write_message(dab);

@@ -37,7 +37,7 @@ fn orchard(app: &mut App) -> Entity {
 fn promoted(app: &mut App) -> HashMap<PointId, (Transform, bool)> {
     let mut q = app
         .world_mut()
-        .query_filtered::<(&ScatterInstance, &Transform, Has<Trunk>), With<PromotedInstance>>();
+        .query_filtered::<(&ScatterEntity, &Transform, Has<Trunk>), With<PromotedInstance>>();
     q.iter(app.world())
         .map(|(i, t, trunk)| (i.id, (*t, trunk)))
         .collect()

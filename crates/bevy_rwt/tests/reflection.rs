@@ -32,7 +32,7 @@ fn components_resources_and_messages_are_registered() {
         TypeId::of::<ScatterLayer>(),
         TypeId::of::<ScatterLayerSource>(),
         TypeId::of::<ScatterLayerStatus>(),
-        TypeId::of::<ScatterInstance>(),
+        TypeId::of::<ScatterEntity>(),
         TypeId::of::<ScatterEdits>(),
         TypeId::of::<Footprint>(),
         TypeId::of::<RwtViewer>(),
@@ -66,7 +66,7 @@ fn components_resources_and_messages_are_registered() {
 }
 
 fn instances(app: &mut App) -> BTreeMap<PointId, Vec3> {
-    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
     q.iter(app.world())
         .map(|(i, t)| (i.id, t.translation))
         .collect()

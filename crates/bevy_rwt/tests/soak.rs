@@ -29,7 +29,7 @@ fn instances(app: &mut App) -> HashMap<(u64, PointId), Vec3> {
             "two live instances of layer {seed} share {id:?}"
         );
     };
-    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
     for (i, t) in q.iter(app.world()) {
         insert(seeds[&i.layer], i.id, t.translation);
     }
@@ -128,12 +128,12 @@ impl Soak {
             .world_mut()
             .resource_mut::<Assets<Image>>()
             .add(original.clone());
-        let painted = layer(LayerDensity::Image {
+        let painted = layer(LayerDensity::Image(GroundMap {
             image: map.clone(),
             min: Vec2::splat(-200.0),
             size: Vec2::splat(400.0),
             scale: 0.6,
-        })
+        }))
         .with_seed(5)
         .with_falloff(20.0, 48.0);
         app.world_mut().spawn(painted);
@@ -204,7 +204,7 @@ impl Soak {
         let live = now.len();
         *before = now;
         let stats = app.world().resource::<RwtStats>().clone();
-        assert_eq!(live, stats.live_instances + stats.live_instanced);
+        assert_eq!(live, stats.live_entities + stats.live_instanced);
         let mut solid = app.world_mut().query_filtered::<(), With<Solid>>();
         let promoted: usize = app
             .world_mut()
@@ -214,7 +214,7 @@ impl Soak {
             .sum();
         assert_eq!(solid.iter(app.world()).count(), promoted);
         peaks.promoted = peaks.promoted.max(promoted);
-        peaks.live = peaks.live.max(stats.live_instances);
+        peaks.live = peaks.live.max(stats.live_entities);
         peaks.live_instanced = peaks.live_instanced.max(stats.live_instanced);
         peaks.buffer_bytes = peaks.buffer_bytes.max(buffer_bytes(app));
         peaks.entities = peaks.entities.max(entity_count(app));
@@ -356,7 +356,7 @@ fn a_long_random_walk_with_painting_and_layer_changes() {
 
 /// Entities that are neither instances nor instanced chunks.
 fn other_entities(app: &mut App) -> usize {
-    let mut instances = app.world_mut().query::<&ScatterInstance>();
+    let mut instances = app.world_mut().query::<&ScatterEntity>();
     let mut chunks = app.world_mut().query::<&InstancedChunk>();
     entity_count(app) - instances.iter(app.world()).count() - chunks.iter(app.world()).count()
 }

@@ -15,7 +15,7 @@ fn streams_around_a_viewer_without_duplicates() {
     tick_app(&mut app, 2_000);
     let live = instances(&mut app);
     let stats = app.world().resource::<RwtStats>().clone();
-    assert_eq!(live.len(), stats.live_instances);
+    assert_eq!(live.len(), stats.live_entities);
     // About 0.5 per square unit over the loaded chunks.
     let area = stats.loaded_chunks as f64 * 16.0 * 16.0;
     assert!(
@@ -159,7 +159,7 @@ fn removing_the_viewer_unloads_everything() {
     tick_app(&mut app, 2_000);
     assert!(instances(&mut app).is_empty());
     let stats = app.world().resource::<RwtStats>();
-    assert_eq!((stats.live_instances, stats.loaded_chunks), (0, 0));
+    assert_eq!((stats.live_entities, stats.loaded_chunks), (0, 0));
 }
 
 #[test]
@@ -191,12 +191,12 @@ fn a_heightmap_image_lifts_instances() {
     spawn_viewer(&mut app, Vec3::ZERO);
     let white = solid_image(4, [255, 255, 255, 255]);
     let handle = app.world_mut().resource_mut::<Assets<Image>>().add(white);
-    let height = HeightSource::Image {
+    let height = HeightSource::Image(GroundMap {
         image: handle,
         min: Vec2::splat(-100.0),
         size: Vec2::splat(200.0),
         scale: 7.5,
-    };
+    });
     app.world_mut()
         .spawn(layer(LayerDensity::Constant(0.3)).with_height(height));
     tick_app(&mut app, 2_000);
@@ -228,7 +228,7 @@ fn replacing_a_layer_restreams_it() {
     assert!((ratio - 3.0).abs() < 0.2, "{sparse} -> {}", dense.len());
     let stats = app.world().resource::<RwtStats>();
     assert_eq!(
-        stats.live_instances,
+        stats.live_entities,
         dense.len(),
         "no leftovers of the old layer"
     );
@@ -286,7 +286,7 @@ fn the_plugin_has_no_system_ambiguities() {
     spawn_viewer(&mut app, Vec3::ZERO);
     app.world_mut().spawn(layer(LayerDensity::Constant(0.2)));
     tick_app(&mut app, 2_000);
-    assert!(app.world().resource::<RwtStats>().live_instances > 0);
+    assert!(app.world().resource::<RwtStats>().live_entities > 0);
 }
 
 #[test]
@@ -311,7 +311,7 @@ fn a_custom_class_inserts_its_own_components() {
     tick_app(&mut app, 2_000);
     let mut q = app
         .world_mut()
-        .query::<(&ScatterInstance, Has<Mesh3d>, Option<&Tree>)>();
+        .query::<(&ScatterEntity, Has<Mesh3d>, Option<&Tree>)>();
     let (mut mesh_count, mut tree_count) = (0, 0);
     for (instance, has_mesh, tree) in q.iter(app.world()) {
         match instance.class {
@@ -354,7 +354,7 @@ fn a_class_with_a_far_look_crossfades_between_its_two_meshes() {
     tick_app(&mut app, 2_000);
     let mut q = app
         .world_mut()
-        .query::<(&ScatterInstance, &VisibilityRange, &Children)>();
+        .query::<(&ScatterEntity, &VisibilityRange, &Children)>();
     let near: Vec<(VisibilityRange, Entity)> = q
         .iter(app.world())
         .map(|(_, r, c)| {
@@ -380,7 +380,7 @@ fn a_class_with_a_far_look_crossfades_between_its_two_meshes() {
         );
         assert!(far.end_margin.start > 1e6);
         assert!(
-            app.world().get::<ScatterInstance>(child).is_none(),
+            app.world().get::<ScatterEntity>(child).is_none(),
             "counted once"
         );
     }
@@ -396,7 +396,7 @@ fn a_class_with_a_far_look_crossfades_between_its_two_meshes() {
     tick_app(&mut app, 2_000);
     let far_left = app
         .world_mut()
-        .query_filtered::<(), (With<VisibilityRange>, Without<ScatterInstance>)>()
+        .query_filtered::<(), (With<VisibilityRange>, Without<ScatterEntity>)>()
         .iter(app.world())
         .count();
     let live = instances(&mut app).len();

@@ -3,6 +3,7 @@
 
 use fast_poisson::Poisson2D;
 use glam::DVec2;
+use rwt_core::density::Placement;
 use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity, NoiseParams};
 use rwt_core::query::{Point, Rect, Sampler};
 use rwt_core::rng::Rng;
@@ -125,9 +126,17 @@ impl Bench {
         let map = synthetic_map(1024);
         let mean_map = map.iter().map(|&v| v as f64).sum::<f64>() / map.len() as f64;
         let scale = d_uniform / mean_map;
-        let image =
-            ImageDensity::from_values(1024, 1024, &map, DVec2::ZERO, DVec2::splat(tiles), scale)
-                .map_err(|e| e.to_string())?;
+        let image = ImageDensity::from_values(
+            1024,
+            1024,
+            &map,
+            Placement {
+                min: DVec2::ZERO,
+                size: DVec2::splat(tiles),
+                scale,
+            },
+        )
+        .map_err(|e| e.to_string())?;
         let noise = bench_noise(d_uniform);
         let rows = vec![
             self.measure("uniform", &Constant(d_uniform)),

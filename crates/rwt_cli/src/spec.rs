@@ -8,6 +8,7 @@
 //! fields than it names.
 
 use glam::DVec2;
+use rwt_core::density::Placement;
 use rwt_core::density::{
     Constant, Density, ImageDensity, ImageDensityError, NoiseDensity, NoiseParams, open_image,
 };
@@ -136,9 +137,11 @@ pub fn parse(spec: &str, rect: (DVec2, DVec2)) -> Result<BoxedDensity, SpecError
                 &img,
                 None,
                 kind == "dark",
-                rect.0,
-                rect.1 - rect.0,
-                scale,
+                Placement {
+                    min: rect.0,
+                    size: rect.1 - rect.0,
+                    scale,
+                },
             )
             .map_err(image_err)?;
             Ok(Box::new(d))

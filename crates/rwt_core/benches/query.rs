@@ -3,6 +3,7 @@
 
 use divan::{Bencher, black_box};
 use glam::DVec2;
+use rwt_core::density::Placement;
 use rwt_core::density::{Constant, ImageDensity, NoiseDensity, NoiseParams};
 use rwt_core::query::{Point, Rect, Sampler};
 use rwt_core::tileset::TileSet;
@@ -45,9 +46,11 @@ fn image(b: Bencher) {
         size,
         size,
         &map,
-        DVec2::ZERO,
-        DVec2::splat(TILES),
-        POINTS / (TILES * TILES) / mean,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::splat(TILES),
+            scale: POINTS / (TILES * TILES) / mean,
+        },
     )
     .unwrap();
     b.bench_local(|| {

@@ -99,7 +99,7 @@ pub mod wang;
 
 pub use density::{
     Constant, Density, DistanceFalloff, Exclude, FnDensity, ImageDensity, LocalModel, Mask,
-    NoiseDensity, NoiseParams, Product, Scale, Sum, SumOf,
+    NoiseDensity, NoiseParams, Placement, Product, Scale, Sum, SumOf,
 };
 pub use query::{Point, PointId, QueryError, Rect, Sampler};
 pub use tileset::{TileSet, TileSetError};

@@ -3,6 +3,7 @@
 
 use glam::DVec2;
 use rwt_core::analysis::{Spectrum, reference, rho};
+use rwt_core::density::Placement;
 use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity, NoiseParams, Sum, from_fn};
 use rwt_core::query::{Point, QueryError, Rect, Sampler};
 use rwt_core::tileset::TileSet;
@@ -452,8 +453,17 @@ fn a_thin_painted_stroke_is_never_missed() {
         values[(y * w + 100) as usize] = 1.0;
     }
     // 256 px over 64 units: the stroke is 0.25 units wide, in tiles 64 units... of 8 units.
-    let img =
-        ImageDensity::from_values(w, h, &values, DVec2::ZERO, DVec2::splat(64.0), 400.0).unwrap();
+    let img = ImageDensity::from_values(
+        w,
+        h,
+        &values,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::splat(64.0),
+            scale: 400.0,
+        },
+    )
+    .unwrap();
     let s = sampler(3).with_tile_size(8.0);
     let mut out = Vec::new();
     s.query(square(0.0, 64.0), &img, &mut out).unwrap();
@@ -576,9 +586,11 @@ fn lower_bounds_skip_evaluations_without_changing_any_point() {
         w as u32,
         h as u32,
         &values,
-        DVec2::ZERO,
-        DVec2::splat(6.0),
-        3.0 * n,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::splat(6.0),
+            scale: 3.0 * n,
+        },
     )
     .unwrap();
     let noise = NoiseDensity::new(NoiseParams {

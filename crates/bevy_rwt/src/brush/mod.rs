@@ -19,12 +19,12 @@
 //!
 //! fn setup(mut commands: Commands, mut images: ResMut<Assets<Image>>, mut brush: ResMut<DensityBrush>) {
 //!     // A blank 512 x 512 map over 512 x 512 m: flowers grow where it is painted.
-//!     let (map, density) = bevy_rwt::brush::blank_map(&mut images, 512, Vec2::splat(-256.0), Vec2::splat(512.0), 4.0);
+//!     let map = bevy_rwt::brush::blank_map(&mut images, 512, Rect::from_center_size(Vec2::ZERO, Vec2::splat(512.0)), 4.0);
+//!     let density = LayerDensity::Image(map);
 //!     let flowers = commands.spawn((
 //!         Name::new("flowers"),
 //!         ScatterLayer::new(vec![ScatterClass::instanced(density, Handle::default(), InstancedMaterial::default())]),
 //!     )).id();
-//!     let _ = map;
 //!     brush.targets.push(BrushTarget::new(flowers, 0, "flowers"));
 //!     brush.enabled = true;
 //! }
@@ -49,14 +49,15 @@
 //! app.finish();
 //! app.cleanup();
 //! let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-//! let (_, density) = bevy_rwt::brush::blank_map(&mut images, 64, Vec2::splat(-32.0), Vec2::splat(64.0), 2.0);
+//! let map = bevy_rwt::brush::blank_map(&mut images, 64, Rect::from_center_size(Vec2::ZERO, Vec2::splat(64.0)), 2.0);
+//! let density = LayerDensity::Image(map);
 //! let class = ScatterClass::new(density, Handle::default(), Handle::default());
 //! let layer = app.world_mut().spawn(ScatterLayer::new(vec![class])).id();
 //! app.world_mut().spawn((RwtViewer::all_around(), Transform::default(), GlobalTransform::default()));
 //! app.world_mut().resource_mut::<DensityBrush>().targets.push(BrushTarget::new(layer, 0, "meadow"));
 //! // One dab of 5 m at full strength: about 2 instances per square metre within it.
 //! app.world_mut().write_message(PaintDab { target: 0, centre: Vec2::ZERO, radius: 5.0, amount: 1.0 });
-//! let live = |app: &App| app.world().resource::<RwtStats>().live_instances;
+//! let live = |app: &App| app.world().resource::<RwtStats>().live_entities;
 //! for _ in 0..10_000 {
 //!     app.update();
 //!     let stats = app.world().resource::<RwtStats>();

@@ -1,27 +1,27 @@
 //! Dabs of paint on a map's texels, and what a stroke needs to be undone.
 
 use super::{BrushError, DensityBrush, MapAccess};
-use crate::layers::{LayerDensity, ScatterLayer, ground_rect, texel_luminance};
+use crate::layers::{GroundMap, LayerDensity, ScatterLayer, texel_luminance};
 use bevy::asset::RenderAssetUsages;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use rwt_core::Rect;
 
-/// A black `size x size` map over the ground rectangle `min..min + size_world` and the
-/// density that reads it (`scale` instances per square unit where it is white): a canvas for
-/// the brush. The map is linear 8-bit RGBA, kept on the CPU so that it can be painted.
+/// A black map of `texels x texels` over the ground rectangle `area`, a value of 1 meaning
+/// `scale` (for a density: instances per square unit where it is white): a canvas for the
+/// brush (`LayerDensity::Image(map)`). The image is linear 8-bit RGBA, kept on the CPU so
+/// that it can be painted.
 pub fn blank_map(
     images: &mut Assets<Image>,
-    size: u32,
-    min: Vec2,
-    size_world: Vec2,
+    texels: u32,
+    area: bevy::math::Rect,
     scale: f64,
-) -> (Handle<Image>, LayerDensity) {
+) -> GroundMap {
     let image = Image::new_fill(
         Extent3d {
-            width: size.max(1),
-            height: size.max(1),
+            width: texels.max(1),
+            height: texels.max(1),
             depth_or_array_layers: 1,
         },
         TextureDimension::D2,
@@ -29,28 +29,20 @@ pub fn blank_map(
         TextureFormat::Rgba8Unorm,
         RenderAssetUsages::MAIN_WORLD | RenderAssetUsages::RENDER_WORLD,
     );
-    let handle = images.add(image);
-    let density = LayerDensity::Image {
-        image: handle.clone(),
-        min,
-        size: size_world,
+    GroundMap {
+        image: images.add(image),
+        min: area.min,
+        size: area.size(),
         scale,
-    };
-    (handle, density)
+    }
 }
 
-/// A target's map and where it lies.
-pub(super) struct TargetMap {
-    pub(super) image: Handle<Image>,
-    pub(super) at: MapPlacement,
-    pub(super) scale: f64,
-}
-
+/// The map a target paints.
 pub(super) fn target_map(
     brush: &DensityBrush,
     index: usize,
     layers: &Query<&ScatterLayer>,
-) -> Result<TargetMap, BrushError> {
+) -> Result<GroundMap, BrushError> {
     let target = brush
         .targets
         .get(index)
@@ -64,41 +56,14 @@ pub(super) fn target_map(
             target: target.name.clone(),
         })?;
     match density {
-        LayerDensity::Image {
-            image,
-            min,
-            size,
-            scale,
-        } => Ok(TargetMap {
-            image: image.clone(),
-            at: MapPlacement {
-                min: *min,
-                size: *size,
-            },
-            scale: *scale,
-        }),
+        LayerDensity::Image(map) => Ok(map.clone()),
         _ => Err(BrushError::NotPaintable {
             target: target.name.clone(),
         }),
     }
 }
 
-/// Where a map lies on the ground.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct MapPlacement {
-    pub min: Vec2,
-    pub size: Vec2,
-}
-
-impl MapPlacement {
-    /// Ground position of the centre of texel `(x, y)` of a `w x h` map (row 0 at max z).
-    fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> Vec2 {
-        Vec2::new(
-            self.min.x + (x as f32 + 0.5) / w as f32 * self.size.x,
-            self.min.y + self.size.y - (y as f32 + 0.5) / h as f32 * self.size.y,
-        )
-    }
-
+impl GroundMap {
     /// Texel columns and rows whose centres may lie within `radius` of `centre`.
     fn texel_span(&self, centre: Vec2, radius: f32, w: u32, h: u32) -> (u32, u32, u32, u32) {
         let to_x = |g: f32| (g - self.min.x) / self.size.x * w as f32;
@@ -170,7 +135,7 @@ pub(super) struct Dab {
 /// texels cannot be read on the CPU.
 pub(super) fn dab(
     image: &Image,
-    at: MapPlacement,
+    at: &GroundMap,
     centre: Vec2,
     radius: f32,
     amount: f32,
@@ -193,7 +158,8 @@ pub(super) fn dab(
             }
         }
     }
-    let region = ground_rect(centre - Vec2::splat(radius), Vec2::splat(2.0 * radius));
+    let (lo, hi) = (centre - radius, centre + radius);
+    let region = Rect::new(lo.as_dvec2(), hi.as_dvec2()).ok();
     Ok(Dab { changes, region })
 }
 
@@ -259,7 +225,7 @@ mod tests {
     fn paint(
         image: &mut Image,
         id: AssetId<Image>,
-        at: MapPlacement,
+        at: &GroundMap,
         centre: Vec2,
         radius: f32,
         amount: f32,
@@ -270,9 +236,11 @@ mod tests {
 
     #[test]
     fn a_dab_paints_a_smooth_disc_and_a_stroke_restores() {
-        let at = MapPlacement {
+        let at = &GroundMap {
+            image: Handle::default(),
             min: Vec2::ZERO,
             size: Vec2::splat(32.0),
+            scale: 1.0,
         };
         for format in [
             TextureFormat::Rgba8Unorm,
@@ -303,9 +271,11 @@ mod tests {
 
     #[test]
     fn dabs_off_the_map_change_nothing() {
-        let at = MapPlacement {
+        let at = &GroundMap {
+            image: Handle::default(),
             min: Vec2::ZERO,
             size: Vec2::splat(32.0),
+            scale: 1.0,
         };
         let mut image = canvas(TextureFormat::Rgba8Unorm);
         let mut record = StrokeRecord::default();

@@ -10,7 +10,7 @@
 use super::paint::{set_texel_luminance, target_map};
 use super::{BrushError, BrushTarget, DensityBrush, MapAccess, UnsavedLayer};
 use crate::edits::{EditSet, EditStamp};
-use crate::layers::file::{LayerDescription, NamedAssets};
+use crate::layers::file::{LayerDescription, MapDescription, NamedAssets};
 use crate::layers::{ScatterLayer, texel_luminance};
 use bevy::prelude::*;
 use rwt_core::edits::MAX_EDITS_FILE_BYTES;
@@ -31,14 +31,8 @@ const MAX_TEXT_BYTES: u64 = 1 << 20;
 pub struct PaintedMapEntry {
     /// The target's name ([`super::BrushTarget::name`]).
     pub name: String,
-    /// The PNG file, relative to the index.
-    pub file: String,
-    /// Ground position of the map's bottom-left corner (x, z).
-    pub min: (f32, f32),
-    /// Ground size of the map (x, z).
-    pub size: (f32, f32),
-    /// Instances per square unit where the map is white.
-    pub scale: f64,
+    /// The map as a layer file writes it, its path the PNG file relative to the index.
+    pub map: MapDescription,
 }
 
 /// The index of a folder of saved maps (`painted.ron`): what a layer file or another game
@@ -81,7 +75,7 @@ impl PaintedMaps {
         let names = index
             .maps
             .iter()
-            .map(|m| &m.file)
+            .map(|m| &m.map.path)
             .chain(&index.layers)
             .chain(edits);
         if let Some(bad) = names.into_iter().find(|f| !is_plain_name(f)) {
@@ -237,10 +231,7 @@ pub(super) fn save(
         saved.insert(map.image.id(), format!("./{file}"));
         index.maps.push(PaintedMapEntry {
             name: name.clone(),
-            file,
-            min: map.at.min.into(),
-            size: map.at.size.into(),
-            scale: map.scale,
+            map: MapDescription::of(&map, file),
         });
     }
     let unwritten = stage_layer_files(brush, from, &saved, &mut names, &mut save, &mut index)?;
@@ -329,7 +320,7 @@ pub(super) fn load(
         let image = image
             .filter(|image| texel_luminance(image, 0, 0).is_some())
             .ok_or_else(|| MapAccess::of(image).at(&entry.name))?;
-        let values = read_map(&dir.join(&entry.file), image.width(), image.height())?;
+        let values = read_map(&dir.join(&entry.map.path), image.width(), image.height())?;
         read.push((map.image, entry.name.clone(), values));
     }
     for file in &index.layers {

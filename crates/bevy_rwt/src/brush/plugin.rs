@@ -224,7 +224,7 @@ fn apply_dabs(
         let planned = images
             .get(&map.image)
             .ok_or(MapAccess::NotLoaded)
-            .and_then(|image| dab(image, map.at, d.centre, d.radius, d.amount));
+            .and_then(|image| dab(image, &map, d.centre, d.radius, d.amount));
         let written = match planned {
             Ok(planned) if planned.is_empty() => Ok(None),
             Ok(planned) => match images.get_mut(&map.image) {

@@ -14,8 +14,9 @@ use std::time::Instant;
 #[derive(Resource, Clone, Debug, Default, PartialEq, Reflect)]
 #[reflect(Resource, Clone, Debug, Default, PartialEq)]
 pub struct RwtStats {
-    /// Entity instances alive.
-    pub live_instances: usize,
+    /// Instances of entity classes alive: one entity each (promoted instances of
+    /// instanced classes are counted in `live_instanced`).
+    pub live_entities: usize,
     /// Instances of instanced classes alive (drawn from chunk buffers, no entity each).
     pub live_instanced: usize,
     /// Chunks loaded.
@@ -37,7 +38,7 @@ pub struct RwtStats {
 pub mod paths {
     use super::DiagnosticPath;
     /// Live instances.
-    pub const LIVE_INSTANCES: DiagnosticPath = DiagnosticPath::const_new("rwt/live_instances");
+    pub const LIVE_ENTITIES: DiagnosticPath = DiagnosticPath::const_new("rwt/live_entities");
     /// Live instances of instanced classes.
     pub const LIVE_INSTANCED: DiagnosticPath = DiagnosticPath::const_new("rwt/live_instanced");
     /// Loaded chunks.
@@ -48,7 +49,7 @@ pub mod paths {
     pub const STREAMING_MS: DiagnosticPath = DiagnosticPath::const_new("rwt/streaming_ms");
     /// Every path.
     pub const ALL: [DiagnosticPath; 5] = [
-        LIVE_INSTANCES,
+        LIVE_ENTITIES,
         LIVE_INSTANCED,
         LOADED_CHUNKS,
         PENDING_TASKS,
@@ -67,7 +68,7 @@ fn start_timer(mut start: ResMut<FrameStart>) {
 /// Sums the layers' figures into [`RwtStats`].
 fn update_stats(layers: Query<&ScatterLayerStatus>, mut stats: ResMut<RwtStats>) {
     let sum = |f: fn(&ScatterLayerStatus) -> usize| layers.iter().map(f).sum::<usize>();
-    stats.live_instances = sum(|s| s.live_instances);
+    stats.live_entities = sum(|s| s.live_entities);
     stats.live_instanced = sum(|s| s.live_instanced);
     stats.loaded_chunks = sum(|s| s.loaded_chunks.len());
     stats.pending_tasks = sum(|s| s.pending_tasks);
@@ -79,7 +80,7 @@ fn update_stats(layers: Query<&ScatterLayerStatus>, mut stats: ResMut<RwtStats>)
 fn publish(mut stats: ResMut<RwtStats>, start: Res<FrameStart>, mut diagnostics: Diagnostics) {
     stats.streaming_ms = start.0.elapsed().as_secs_f64() * 1e3;
     let s = stats.clone();
-    diagnostics.add_measurement(&paths::LIVE_INSTANCES, || s.live_instances as f64);
+    diagnostics.add_measurement(&paths::LIVE_ENTITIES, || s.live_entities as f64);
     diagnostics.add_measurement(&paths::LIVE_INSTANCED, || s.live_instanced as f64);
     diagnostics.add_measurement(&paths::LOADED_CHUNKS, || s.loaded_chunks as f64);
     diagnostics.add_measurement(&paths::PENDING_TASKS, || s.pending_tasks as f64);

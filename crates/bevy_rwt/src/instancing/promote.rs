@@ -1,12 +1,12 @@
 //! Promotion: instances of a promoted class within its distance of a viewer leave their
-//! chunk's buffer for an entity (a [`ScatterInstance`] with the class's inserted
+//! chunk's buffer for an entity (a [`ScatterEntity`] with the class's inserted
 //! components, at the transform the buffer drew it with, and a child that draws the same
 //! instance), and go back beyond it. The buffer change and the entity are commands of one
 //! system, applied together: no frame draws an instance twice or misses it.
 
 use super::queue::{ClassBuffer, InstancedQueue, Target, Upload};
 use super::{GpuInstance, InstanceBuffer};
-use crate::layers::{Promotion, ScatterInstance, ScatterLayer};
+use crate::layers::{Promotion, ScatterEntity, ScatterLayer};
 use bevy::prelude::*;
 use glam::DVec2;
 use rwt_core::query::PointId;
@@ -148,7 +148,7 @@ impl Moved<'_> {
             rotation: rotation.inverse(),
             scale: Vec3::splat(1.0 / scale.abs().max(1e-6)),
         };
-        let instance = ScatterInstance {
+        let instance = ScatterEntity {
             layer: self.target.entity,
             id,
             class: self.class,

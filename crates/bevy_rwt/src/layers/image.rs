@@ -1,7 +1,8 @@
-//! Bevy images as densities.
+//! Bevy images over the ground: densities and heightmaps.
 
 use bevy::prelude::*;
 use glam::DVec2;
+use rwt_core::density::Placement;
 use rwt_core::density::{ImageDensity, MAX_IMAGE_PIXELS};
 
 /// Whether a map has more pixels than a density or heightmap is made from.
@@ -9,12 +10,63 @@ pub(crate) fn too_large(image: &Image) -> bool {
     image.width() as u64 * image.height() as u64 > MAX_IMAGE_PIXELS
 }
 
+/// An image over a ground rectangle, times a scale: the one form of every image the plugin
+/// reads (a class's or an exclusion's painted density map, a heightmap, the brush's
+/// canvas). The image's luminance times alpha (0..1, bilinear; a transparent texel is
+/// empty) covers `min..min + size` on the layer's plane (x, z on the ground of a 3-D world,
+/// x, y on a 2-D plane), its top row along the far edge (max z, or max y); a value of 1 is
+/// `scale` (instances per square unit for a density, the height for a heightmap).
+#[derive(Clone, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
+pub struct GroundMap {
+    /// The image.
+    pub image: Handle<Image>,
+    /// Ground position of the image's bottom-left corner.
+    pub min: Vec2,
+    /// Ground size of the image.
+    pub size: Vec2,
+    /// What a white texel means.
+    pub scale: f64,
+}
+
+impl GroundMap {
+    /// Where its values lie, for `rwt_core`.
+    pub fn placement(&self) -> Placement {
+        Placement {
+            min: DVec2::new(self.min.x as f64, self.min.y as f64),
+            size: DVec2::new(self.size.x as f64, self.size.y as f64),
+            scale: self.scale,
+        }
+    }
+
+    /// The ground rectangle it covers, when it is finite and not inverted.
+    pub fn rect(&self) -> Option<rwt_core::Rect> {
+        let at = self.placement();
+        rwt_core::Rect::new(at.min, at.min + at.size).ok()
+    }
+
+    /// Its density, from its image in `images`; `None` while the image is not loaded, or
+    /// when it cannot be read (see [`from_bevy_image`]).
+    pub fn density(&self, images: &Assets<Image>) -> Option<ImageDensity> {
+        from_bevy_image(images.get(&self.image)?, self.placement())
+    }
+
+    /// Ground position of the centre of texel `(x, y)` of its `w x h` image (row 0 at the
+    /// far edge).
+    pub(crate) fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> Vec2 {
+        Vec2::new(
+            self.min.x + (x as f32 + 0.5) / w as f32 * self.size.x,
+            self.min.y + self.size.y - (y as f32 + 0.5) / h as f32 * self.size.y,
+        )
+    }
+}
+
 /// The luminance times alpha of a Bevy image (row 0 at the top, as Bevy stores it; a
-/// transparent texel is empty) over the ground
-/// rectangle `min..min + size` (x, z), times `scale`. `None` for images whose pixels cannot be
-/// read on the CPU (compressed formats, GPU-only images) and for images of more than
-/// [`MAX_IMAGE_PIXELS`] pixels (a density takes about 16 bytes a pixel).
-pub fn from_bevy_image(image: &Image, min: Vec2, size: Vec2, scale: f64) -> Option<ImageDensity> {
+/// transparent texel is empty) placed `at` (its top row along the max-y edge). `None` for
+/// images whose pixels cannot be read on the CPU (compressed formats, GPU-only images) and
+/// for images of more than [`MAX_IMAGE_PIXELS`] pixels (a density takes about 16 bytes a
+/// pixel).
+pub fn from_bevy_image(image: &Image, at: Placement) -> Option<ImageDensity> {
     let (w, h) = (image.width(), image.height());
     if too_large(image) {
         return None;
@@ -28,16 +80,7 @@ pub fn from_bevy_image(image: &Image, min: Vec2, size: Vec2, scale: f64) -> Opti
         }
         Some(values)
     })?;
-    // rwt's y axis is the ground's z: the image's top row lies along the max-z edge.
-    ImageDensity::from_values(
-        w,
-        h,
-        &values,
-        DVec2::new(min.x as f64, min.y as f64),
-        DVec2::new(size.x as f64, size.y as f64),
-        scale,
-    )
-    .ok()
+    ImageDensity::from_values(w, h, &values, at).ok()
 }
 
 /// The value a layer reads from texel `(x, y)`: its linear luminance times its alpha, so a

@@ -6,10 +6,10 @@ mod image;
 mod plugin;
 mod status;
 
-pub use image::from_bevy_image;
 #[cfg(feature = "brush")]
 pub(crate) use image::texel_luminance;
 pub(crate) use image::too_large;
+pub use image::{GroundMap, from_bevy_image};
 pub use plugin::RwtLayersPlugin;
 pub(crate) use plugin::{init_image_assets, merge_missing, missing_asset, report_assets};
 pub use status::{
@@ -47,18 +47,9 @@ pub enum LayerDensity {
     Constant(f64),
     /// Fractal noise (`rwt_core`'s fBm density).
     Noise(NoiseDensity),
-    /// A painted map: the image's luminance (0..1) over the ground rectangle `min..min + size`
-    /// (x, z), times `scale`. Repainting the image re-queries the chunks it covers.
-    Image {
-        /// The map.
-        image: Handle<Image>,
-        /// Ground position of the image's bottom-left corner (x, z).
-        min: Vec2,
-        /// Ground size of the image (x, z).
-        size: Vec2,
-        /// Instances per square unit where the image is white.
-        scale: f64,
-    },
+    /// A painted map: its scale is the instances per square unit where it is white.
+    /// Repainting the image re-queries the chunks it covers.
+    Image(GroundMap),
     /// Any density of `rwt_core`. Code, not data: reflection does not see it (and makes an
     /// empty one when it builds this variant).
     Custom(#[reflect(ignore, default = "no_density")] Arc<dyn Density + Send + Sync>),
@@ -69,8 +60,8 @@ impl std::fmt::Debug for LayerDensity {
         match self {
             LayerDensity::Constant(v) => write!(f, "Constant({v})"),
             LayerDensity::Noise(n) => write!(f, "{n:?}"),
-            LayerDensity::Image { image, scale, .. } => {
-                write!(f, "Image {{ {image:?}, scale: {scale}, .. }}")
+            LayerDensity::Image(map) => {
+                write!(f, "Image {{ {:?}, scale: {}, .. }}", map.image, map.scale)
             }
             LayerDensity::Custom(_) => write!(f, "Custom(..)"),
         }
@@ -81,7 +72,7 @@ impl LayerDensity {
     /// The image this density reads, if any.
     pub fn image(&self) -> Option<&Handle<Image>> {
         match self {
-            LayerDensity::Image { image, .. } => Some(image),
+            LayerDensity::Image(map) => Some(&map.image),
             _ => None,
         }
     }
@@ -89,7 +80,7 @@ impl LayerDensity {
     /// The ground rectangle a painted map covers, if this density is one.
     pub(crate) fn image_rect(&self) -> Option<rwt_core::Rect> {
         match self {
-            LayerDensity::Image { min, size, .. } => ground_rect(*min, *size),
+            LayerDensity::Image(map) => map.rect(),
             _ => None,
         }
     }
@@ -99,15 +90,7 @@ impl LayerDensity {
         Some(match self {
             LayerDensity::Constant(v) => Arc::new(Constant(*v)),
             LayerDensity::Noise(n) => Arc::new(n.clone()),
-            LayerDensity::Image {
-                image,
-                min,
-                size,
-                scale,
-            } => {
-                let img = images.get(image)?;
-                Arc::new(image::from_bevy_image(img, *min, *size, *scale)?)
-            }
+            LayerDensity::Image(map) => Arc::new(map.density(images)?),
             LayerDensity::Custom(d) => d.clone(),
         })
     }
@@ -139,7 +122,7 @@ pub struct ScatterClass {
 
 /// Near instances of an instanced class become entities: within `distance` (on the ground)
 /// of any viewer, an instance leaves its chunk's buffer for an entity with a
-/// [`ScatterInstance`], its `Transform` as drawn and what `insert` puts on it (a collider),
+/// [`ScatterEntity`], its `Transform` as drawn and what `insert` puts on it (a collider),
 /// drawn by a child with the same instance; a little beyond the distance
 /// ([`Promotion::HYSTERESIS`]) it goes back to the buffer. Both happen within one frame,
 /// so the instance is never drawn twice or missing.
@@ -278,18 +261,8 @@ pub enum HeightSource {
     /// A function of the ground position (x, z). Code, not data: reflection does not see it
     /// (and makes flat ground at 0 when it builds this variant).
     Function(#[reflect(ignore, default = "flat_ground")] Arc<dyn Fn(Vec2) -> f32 + Send + Sync>),
-    /// A heightmap: the image's luminance (0..1, bilinear) over `min..min + size` (x, z),
-    /// times `scale`; 0 outside.
-    Image {
-        /// The heightmap.
-        image: Handle<Image>,
-        /// Ground position of the image's bottom-left corner (x, z).
-        min: Vec2,
-        /// Ground size of the image (x, z).
-        size: Vec2,
-        /// Height where the image is white.
-        scale: f32,
-    },
+    /// A heightmap: its scale is the height where it is white; 0 outside.
+    Image(GroundMap),
 }
 
 /// A thread-safe height function, as generation tasks use it.
@@ -300,27 +273,18 @@ impl std::fmt::Debug for HeightSource {
         match self {
             HeightSource::Constant(h) => write!(f, "Constant({h})"),
             HeightSource::Function(_) => write!(f, "Function(..)"),
-            HeightSource::Image { image, scale, .. } => {
-                write!(f, "Image {{ {image:?}, scale: {scale}, .. }}")
+            HeightSource::Image(map) => {
+                write!(f, "Image {{ {:?}, scale: {}, .. }}", map.image, map.scale)
             }
         }
     }
-}
-
-/// The ground rectangle `min..min + size`, when it is finite and not inverted.
-pub(crate) fn ground_rect(min: Vec2, size: Vec2) -> Option<rwt_core::Rect> {
-    let min = glam::DVec2::new(min.x as f64, min.y as f64);
-    let size = glam::DVec2::new(size.x as f64, size.y as f64);
-    rwt_core::Rect::new(min, min + size).ok()
 }
 
 impl HeightSource {
     /// The image this height source reads, with the ground rectangle it covers.
     pub(crate) fn image(&self) -> Option<(&Handle<Image>, Option<rwt_core::Rect>)> {
         match self {
-            HeightSource::Image {
-                image, min, size, ..
-            } => Some((image, ground_rect(*min, *size))),
+            HeightSource::Image(map) => Some((&map.image, map.rect())),
             _ => None,
         }
     }
@@ -333,16 +297,12 @@ impl HeightSource {
                 Arc::new(move |_| h)
             }
             HeightSource::Function(f) => f.clone(),
-            HeightSource::Image {
-                image,
-                min,
-                size,
-                scale,
-            } => {
-                let map = image::from_bevy_image(images.get(image)?, *min, *size, 1.0)?;
-                let scale = *scale;
+            HeightSource::Image(map) => {
+                let density = map.density(images)?;
+                let scale = map.scale as f32;
+                // `value` is the image's own value, before the density's scale.
                 Arc::new(move |p: Vec2| {
-                    map.value(glam::DVec2::new(p.x as f64, p.y as f64)) as f32 * scale
+                    density.value(glam::DVec2::new(p.x as f64, p.y as f64)) as f32 * scale
                 })
             }
         })
@@ -482,10 +442,12 @@ impl ScatterLayer {
     }
 }
 
-/// Marks an instance spawned by a layer.
+/// Marks an instance that is an entity: spawned by a layer's entity class, or promoted from
+/// an instanced class near a viewer (see [`Promotion`]). Instances drawn from chunk buffers
+/// have none.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Hash, Reflect)]
 #[reflect(Component, Clone, Debug, PartialEq, Hash)]
-pub struct ScatterInstance {
+pub struct ScatterEntity {
     /// The layer entity.
     pub layer: Entity,
     /// Stable identity of the point the instance stands on.

@@ -114,8 +114,8 @@ pub struct ScatterLayerStatus {
     pub assets: AssetStatus,
     /// Chunks loaded.
     pub loaded_chunks: HashSet<ChunkCoord>,
-    /// Entity instances alive (spawned and not yet despawned).
-    pub live_instances: usize,
+    /// Instances of entity classes alive (spawned and not yet despawned): one entity each.
+    pub live_entities: usize,
     /// Instances of instanced classes alive (in chunk buffers, no entity each, or
     /// promoted to entities near a viewer).
     pub live_instanced: usize,

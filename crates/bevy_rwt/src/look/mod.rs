@@ -21,7 +21,7 @@ use rwt_core::query::{Point, PointId};
 use std::sync::Arc;
 
 /// Inserts a class's own components into every instance it spawns (after `Transform` and
-/// [`crate::ScatterInstance`]).
+/// [`crate::ScatterEntity`]).
 pub type InstanceInserter = Arc<dyn Fn(&mut EntityCommands) + Send + Sync>;
 
 /// What reflection puts in an [`InstanceInserter`] it builds: nothing.
@@ -145,39 +145,27 @@ pub enum GroundPlane {
 }
 
 impl GroundPlane {
-    /// An instance's transform: at ground position `ground` and height `height`, turned by
-    /// `yaw` about the plane's normal, scaled by `scale`.
-    pub fn transform(
-        self,
-        ground: Vec2,
-        height: f32,
-        yaw: f32,
-        scale: f32,
-        depth: f32,
-    ) -> Transform {
+    /// Where an instance of `p` stands: its ground position at `height`, in `pose`, with
+    /// the sprite depth of the x-y plane hashed from its identity in a layer of `seed`.
+    pub fn place(self, p: &Point, height: f32, pose: Pose, seed: u64) -> Transform {
+        let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+        let yaw = pose.yaw as f32;
         let (translation, rotation) = match self {
             GroundPlane::Xz => (
                 Vec3::new(ground.x, height, ground.y),
                 Quat::from_rotation_y(yaw),
             ),
-            GroundPlane::Xy => (
-                Vec3::new(ground.x, ground.y, height + depth * 1e-3),
-                Quat::from_rotation_z(yaw),
-            ),
+            GroundPlane::Xy => {
+                // Sprites of one height are ordered by a depth hashed from their identity.
+                let depth = p.id.unit(seed, DEPTH_SALT) as f32;
+                (
+                    Vec3::new(ground.x, ground.y, height + depth * 1e-3),
+                    Quat::from_rotation_z(yaw),
+                )
+            }
         };
         Transform::from_translation(translation)
             .with_rotation(rotation)
-            .with_scale(Vec3::splat(scale))
-    }
-
-    /// Where an instance of `p` stands: its ground position at `height`, in `pose`, with
-    /// the sprite depth of the x-y plane hashed from its identity in a layer of `seed`.
-    pub fn place(self, p: &Point, height: f32, pose: Pose, seed: u64) -> Transform {
-        let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
-        let depth = match self {
-            GroundPlane::Xy => p.id.unit(seed, DEPTH_SALT) as f32,
-            GroundPlane::Xz => 0.0,
-        };
-        self.transform(ground, height, pose.yaw as f32, pose.scale, depth)
+            .with_scale(Vec3::splat(pose.scale))
     }
 }

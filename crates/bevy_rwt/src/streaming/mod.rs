@@ -313,7 +313,7 @@ fn restart(
 fn update_status(mut layers: Query<(&LayerState, &mut ScatterLayerStatus)>) {
     for (state, mut status) in &mut layers {
         let status = status.bypass_change_detection();
-        status.live_instances = state.entities.live();
+        status.live_entities = state.entities.live();
         status.live_instanced = state.instanced.live();
         status.promoted_instances = state.instanced.promoted();
         status.pending_tasks = state.pending();

@@ -10,7 +10,7 @@ use super::*;
 use crate::edits::{EditInstance, ScatterEdits};
 use crate::footprints::Footprint;
 use crate::instancing::InstancedMeshes;
-use crate::layers::ScatterInstance;
+use crate::layers::ScatterEntity;
 use crate::settings::{RwtSystems, configure_sets};
 use crate::viewers::Viewers;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
@@ -52,7 +52,7 @@ impl Plugin for RwtStreamingPlugin {
             .tile_set
             .clone()
             .unwrap_or_else(|| Arc::new(TileSet::embedded()));
-        app.register_type::<ScatterInstance>()
+        app.register_type::<ScatterEntity>()
             .register_type::<ScatterEdits>()
             .register_type::<Footprint>()
             .register_type::<ChunkLoaded>()

@@ -155,7 +155,7 @@ pub fn move_viewer(app: &mut App, viewer: Entity, at: Vec3) {
 }
 
 pub fn instances(app: &mut App) -> HashMap<PointId, Vec3> {
-    let mut q = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
     let mut out = HashMap::new();
     for (i, t) in q.iter(app.world()) {
         assert!(
@@ -180,12 +180,12 @@ pub fn solid_map(app: &mut App, rgba: [u8; 4], scale: f64) -> (Handle<Image>, La
         .world_mut()
         .resource_mut::<Assets<Image>>()
         .add(solid_image(64, rgba));
-    let density = LayerDensity::Image {
+    let density = LayerDensity::Image(GroundMap {
         image: handle.clone(),
         min: Vec2::splat(-64.0),
         size: Vec2::splat(128.0),
         scale,
-    };
+    });
     (handle, density)
 }
 
@@ -210,7 +210,7 @@ pub fn instanced_app() -> App {
 /// Every live instance of either path, by identity.
 pub fn placed(app: &mut App) -> HashMap<PointId, Placed> {
     let mut out = HashMap::new();
-    let mut entities = app.world_mut().query::<(&ScatterInstance, &Transform)>();
+    let mut entities = app.world_mut().query::<(&ScatterEntity, &Transform)>();
     for (i, t) in entities.iter(app.world()) {
         let (yaw, _, _) = t.rotation.to_euler(EulerRot::YXZ);
         let p = Placed {

@@ -128,6 +128,29 @@ fn decode_limited<R: BufRead + Seek>(
     r.decode().map_err(decode_err)
 }
 
+/// Where an image's values lie and what they mean: over the rectangle `min..min + size`
+/// (row 0 of the image at max y), a value of 1 is `scale` points per unit area.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    /// The rectangle's corner at its smallest x and y.
+    pub min: DVec2,
+    /// Its size (positive and finite).
+    pub size: DVec2,
+    /// Points per unit area where a value is 1.
+    pub scale: f64,
+}
+
+impl Placement {
+    /// Over `rect`, a value of 1 meaning `scale` points per unit area.
+    pub fn over(rect: crate::query::Rect, scale: f64) -> Self {
+        Self {
+            min: rect.min(),
+            size: rect.max() - rect.min(),
+            scale,
+        }
+    }
+}
+
 impl ImageDensity {
     /// From row-major values (row 0 at the *top*, as images are stored) in `[0, 1]`; other
     /// values are clamped, NaN counts as 0.
@@ -135,10 +158,13 @@ impl ImageDensity {
         width: u32,
         height: u32,
         values: &[f32],
-        origin: DVec2,
-        size: DVec2,
-        scale: f64,
+        at: Placement,
     ) -> Result<Self, ImageDensityError> {
+        let Placement {
+            min: origin,
+            size,
+            scale,
+        } = at;
         if width == 0
             || height == 0
             || width > 32_768
@@ -182,9 +208,7 @@ impl ImageDensity {
         image: &image::DynamicImage,
         channel: Option<usize>,
         invert: bool,
-        origin: DVec2,
-        size: DVec2,
-        scale: f64,
+        at: Placement,
     ) -> Result<Self, ImageDensityError> {
         let (w, h) = (image.width(), image.height());
         if w == 0 || h == 0 || w > 32_768 || h > 32_768 {
@@ -209,7 +233,7 @@ impl ImageDensity {
                 .map(|p| tone(p.0[c.min(3)]))
                 .collect(),
         };
-        Self::from_values(w, h, &values, origin, size, scale)
+        Self::from_values(w, h, &values, at)
     }
 
     /// Decodes image bytes (any format this build of `image` supports, at most
@@ -217,12 +241,10 @@ impl ImageDensity {
     pub fn from_bytes(
         bytes: &[u8],
         invert: bool,
-        origin: DVec2,
-        size: DVec2,
-        scale: f64,
+        at: Placement,
     ) -> Result<Self, ImageDensityError> {
         let img = decode_image(bytes)?;
-        Self::from_image(&img, None, invert, origin, size, scale)
+        Self::from_image(&img, None, invert, at)
     }
 
     /// Image width and height in pixels.

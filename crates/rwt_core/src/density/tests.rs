@@ -1,6 +1,7 @@
 //! Bounds and sanitizing of every shipped density.
 
 use super::*;
+use crate::density::Placement;
 use crate::rng::Rng;
 
 /// Upper bounds hold within rounding; lower bounds exactly (queries take points below
@@ -59,9 +60,11 @@ fn image_maximum_is_conservative_and_sees_thin_strokes() {
         w,
         h,
         &values,
-        DVec2::new(-3.0, 2.0),
-        DVec2::new(6.4, 4.8),
-        100.0,
+        Placement {
+            min: DVec2::new(-3.0, 2.0),
+            size: DVec2::new(6.4, 4.8),
+            scale: 100.0,
+        },
     )
     .unwrap();
     let useful = check_bound(&d, &mut rng, 6.0);
@@ -105,9 +108,11 @@ fn combinators_keep_bounds() {
         2,
         2,
         &[0.0, 1.0, 0.5, 0.25],
-        DVec2::ZERO,
-        DVec2::splat(10.0),
-        20.0,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::splat(10.0),
+            scale: 20.0,
+        },
     )
     .unwrap();
     let noise = NoiseDensity::new(NoiseParams {
@@ -180,20 +185,57 @@ fn bad_values_are_sanitized_or_rejected() {
     assert_eq!(sanitize(f64::NAN), 0.0);
     assert_eq!(sanitize(-3.0), 0.0);
     assert_eq!(sanitize(f64::INFINITY), f64::INFINITY);
-    let d =
-        ImageDensity::from_values(2, 1, &[f32::NAN, 7.0], DVec2::ZERO, DVec2::ONE, 1.0).unwrap();
+    let d = ImageDensity::from_values(
+        2,
+        1,
+        &[f32::NAN, 7.0],
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::ONE,
+            scale: 1.0,
+        },
+    )
+    .unwrap();
     assert!(d.max_over(DVec2::ZERO, DVec2::ONE) <= 1.0);
     assert_eq!(
-        ImageDensity::from_values(0, 1, &[], DVec2::ZERO, DVec2::ONE, 1.0).unwrap_err(),
+        ImageDensity::from_values(
+            0,
+            1,
+            &[],
+            Placement {
+                min: DVec2::ZERO,
+                size: DVec2::ONE,
+                scale: 1.0
+            }
+        )
+        .unwrap_err(),
         ImageDensityError::Size(0, 1)
     );
     assert_eq!(
-        ImageDensity::from_values(1, 1, &[0.5], DVec2::ZERO, DVec2::new(f64::NAN, 1.0), 1.0)
-            .unwrap_err(),
+        ImageDensity::from_values(
+            1,
+            1,
+            &[0.5],
+            Placement {
+                min: DVec2::ZERO,
+                size: DVec2::new(f64::NAN, 1.0),
+                scale: 1.0
+            }
+        )
+        .unwrap_err(),
         ImageDensityError::Rect
     );
     assert!(
-        ImageDensity::from_bytes(b"not an image", false, DVec2::ZERO, DVec2::ONE, 1.0).is_err()
+        ImageDensity::from_bytes(
+            b"not an image",
+            false,
+            Placement {
+                min: DVec2::ZERO,
+                size: DVec2::ONE,
+                scale: 1.0
+            }
+        )
+        .is_err()
     );
 }
 
@@ -234,7 +276,16 @@ fn png_header(width: u32, height: u32) -> Vec<u8> {
 #[test]
 fn images_over_the_pixel_limit_are_refused_from_their_header() {
     let huge = png_header(20_000, 20_000);
-    let e = ImageDensity::from_bytes(&huge, false, DVec2::ZERO, DVec2::ONE, 1.0).unwrap_err();
+    let e = ImageDensity::from_bytes(
+        &huge,
+        false,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::ONE,
+            scale: 1.0,
+        },
+    )
+    .unwrap_err();
     assert_eq!(
         e,
         ImageDensityError::TooManyPixels {
@@ -271,21 +322,47 @@ fn transparent_pixels_have_no_density() {
     }
     let img = ::image::DynamicImage::ImageRgba8(rgba);
     let at = |d: &ImageDensity, x: f64| d.value(DVec2::new(x + 0.5, 0.5));
-    let light = ImageDensity::from_image(&img, None, false, DVec2::ZERO, DVec2::new(4.0, 1.0), 1.0)
-        .unwrap();
+    let light = ImageDensity::from_image(
+        &img,
+        None,
+        false,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::new(4.0, 1.0),
+            scale: 1.0,
+        },
+    )
+    .unwrap();
     assert!((at(&light, 0.0) - 1.0).abs() < 1e-6);
     assert_eq!(at(&light, 1.0), 0.0);
     assert!((at(&light, 2.0) - 128.0 / 255.0).abs() < 1e-6);
     assert_eq!(at(&light, 3.0), 0.0);
     // Dark pixels dense (`dark:`), transparent ones still empty.
-    let dark =
-        ImageDensity::from_image(&img, None, true, DVec2::ZERO, DVec2::new(4.0, 1.0), 1.0).unwrap();
+    let dark = ImageDensity::from_image(
+        &img,
+        None,
+        true,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::new(4.0, 1.0),
+            scale: 1.0,
+        },
+    )
+    .unwrap();
     assert_eq!(at(&dark, 1.0), 0.0);
     assert!((at(&dark, 3.0) - 1.0).abs() < 1e-6);
     // An explicit channel is that channel: the alpha channel itself here.
-    let alpha =
-        ImageDensity::from_image(&img, Some(3), false, DVec2::ZERO, DVec2::new(4.0, 1.0), 1.0)
-            .unwrap();
+    let alpha = ImageDensity::from_image(
+        &img,
+        Some(3),
+        false,
+        Placement {
+            min: DVec2::ZERO,
+            size: DVec2::new(4.0, 1.0),
+            scale: 1.0,
+        },
+    )
+    .unwrap();
     assert_eq!(at(&alpha, 1.0), 0.0);
     assert!((at(&alpha, 0.0) - 1.0).abs() < 1e-6);
 }

@@ -28,6 +28,7 @@ pub use limits::{DEFAULT_MAX_DOTS, DEFAULT_MAX_RASTER_PIXELS, StippleLimits};
 pub use raster::Grey;
 pub use tone::{CoverageCurve, Patch, ToneError};
 
+use crate::density::Placement;
 use crate::density::{ImageDensity, ImageDensityError};
 use crate::query::{QueryError, Rect, Sampler};
 use crate::rng::Rng;
@@ -351,9 +352,11 @@ impl Plan {
             image.width as u32,
             image.height as u32,
             &unit,
-            DVec2::ZERO,
-            size,
-            scale,
+            Placement {
+                min: DVec2::ZERO,
+                size,
+                scale,
+            },
         )?;
         let expected = self.nominal_ink() / (PI * radius * radius);
         limits.dots(expected)?;

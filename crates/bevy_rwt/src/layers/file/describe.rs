@@ -2,8 +2,8 @@
 
 use super::{
     ClassDescription, DensityDescription, HeightDescription, InstancedMaterialDescription,
-    LayerDescription, LayerFileError, LayerPart, LodDescription, MaterialDescription,
-    MeshDescription, NamedAssets, Undescribable,
+    LayerDescription, LayerFileError, LayerPart, LodDescription, MapDescription,
+    MaterialDescription, MeshDescription, NamedAssets, Undescribable,
 };
 use crate::layers::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
 use crate::look::ClassLook;
@@ -148,17 +148,9 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
         Ok(match d {
             LayerDensity::Constant(v) => DensityDescription::Constant(*v),
             LayerDensity::Noise(n) => DensityDescription::Noise(n.params()),
-            LayerDensity::Image {
-                image,
-                min,
-                size,
-                scale,
-            } => DensityDescription::Image {
-                path: self.image(image)?,
-                min: (*min).into(),
-                size: (*size).into(),
-                scale: *scale,
-            },
+            LayerDensity::Image(map) => {
+                DensityDescription::Image(MapDescription::of(map, self.image(&map.image)?))
+            }
             LayerDensity::Custom(_) => {
                 return Err(Undescribable::CustomDensity);
             }
@@ -179,20 +171,9 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
                     .ok_or(Undescribable::HeightFunction)?;
                 (0.0, Some(HeightDescription::Named(name)))
             }
-            HeightSource::Image {
-                image,
-                min,
-                size,
-                scale,
-            } => {
-                let path = self.image(image)?;
-                let ground = HeightDescription::Image {
-                    path,
-                    min: (*min).into(),
-                    size: (*size).into(),
-                    scale: *scale,
-                };
-                (0.0, Some(ground))
+            HeightSource::Image(map) => {
+                let ground = MapDescription::of(map, self.image(&map.image)?);
+                (0.0, Some(HeightDescription::Image(ground)))
             }
         })
     }

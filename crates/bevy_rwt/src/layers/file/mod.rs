@@ -71,8 +71,8 @@ pub use loader::ScatterLayerLoader;
 pub use names::NamedAssets;
 
 use super::{
-    DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, HeightSource, LayerDensity, ScatterClass,
-    ScatterLayer,
+    DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap, HeightSource, LayerDensity,
+    ScatterClass, ScatterLayer,
 };
 use crate::look::{GroundPlane, InstancedMaterial, InstancedShadows, MeshLod, blade_mesh};
 use bevy::prelude::*;
@@ -100,17 +100,44 @@ pub enum DensityDescription {
     Constant(f64),
     /// Fractal noise (see [`NoiseDensity`]).
     Noise(NoiseParams),
-    /// A painted map (asset path), over the ground rectangle `min..min + size` (x, z).
-    Image {
-        /// Asset path of the image.
-        path: String,
-        /// Ground position of the image's bottom-left corner.
-        min: (f32, f32),
-        /// Ground size of the image.
-        size: (f32, f32),
-        /// Instances per square unit where the image is white.
-        scale: f64,
-    },
+    /// A painted map: its scale is the instances per square unit where it is white.
+    Image(MapDescription),
+}
+
+/// An image over a ground rectangle in a layer file (a [`GroundMap`]), written
+/// `Image(path: "maps/flowers.png", min: (-128.0, -128.0), size: (256.0, 256.0), scale: 2.0)`.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct MapDescription {
+    /// Asset path of the image.
+    pub path: String,
+    /// Ground position of the image's bottom-left corner.
+    pub min: (f32, f32),
+    /// Ground size of the image.
+    pub size: (f32, f32),
+    /// What a white texel means.
+    pub scale: f64,
+}
+
+impl MapDescription {
+    /// The map, its image handle made by `image`.
+    fn to_map(&self, image: impl FnOnce(&str) -> Handle<Image>) -> GroundMap {
+        GroundMap {
+            image: image(&self.path),
+            min: Vec2::new(self.min.0, self.min.1),
+            size: Vec2::new(self.size.0, self.size.1),
+            scale: self.scale,
+        }
+    }
+
+    /// The description of `map`, whose image loads from `path`.
+    pub(crate) fn of(map: &GroundMap, path: String) -> Self {
+        Self {
+            path,
+            min: map.min.into(),
+            size: map.size.into(),
+            scale: map.scale,
+        }
+    }
 }
 
 /// A mesh in a layer file: an asset path or a primitive.
@@ -311,17 +338,8 @@ pub struct LodDescription {
 pub enum HeightDescription {
     /// A height function the game registered in [`NamedAssets`].
     Named(String),
-    /// A heightmap (see [`HeightSource::Image`]).
-    Image {
-        /// Asset path of the image.
-        path: String,
-        /// Ground position of the image's bottom-left corner.
-        min: (f32, f32),
-        /// Ground size of the image.
-        size: (f32, f32),
-        /// Height where the image is white.
-        scale: f32,
-    },
+    /// A heightmap (see [`HeightSource::Image`]): its scale is the height where it is white.
+    Image(MapDescription),
 }
 
 fn default_tile() -> f64 {
@@ -383,17 +401,7 @@ impl DensityDescription {
         match self {
             DensityDescription::Constant(v) => LayerDensity::Constant(*v),
             DensityDescription::Noise(params) => LayerDensity::Noise(NoiseDensity::new(*params)),
-            DensityDescription::Image {
-                path,
-                min,
-                size,
-                scale,
-            } => LayerDensity::Image {
-                image: image(path),
-                min: Vec2::new(min.0, min.1),
-                size: Vec2::new(size.0, size.1),
-                scale: *scale,
-            },
+            DensityDescription::Image(map) => LayerDensity::Image(map.to_map(image)),
         }
     }
 }
@@ -544,17 +552,9 @@ impl LayerDescription {
                 .names
                 .height(name)
                 .ok_or_else(|| unknown(NamedKind::Height, name))?,
-            Some(HeightDescription::Image {
-                path,
-                min,
-                size,
-                scale,
-            }) => HeightSource::Image {
-                image: (handles.image)(path),
-                min: Vec2::new(min.0, min.1),
-                size: Vec2::new(size.0, size.1),
-                scale: *scale,
-            },
+            Some(HeightDescription::Image(map)) => {
+                HeightSource::Image(map.to_map(&mut handles.image))
+            }
         })
     }
 }

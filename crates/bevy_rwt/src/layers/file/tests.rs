@@ -96,7 +96,7 @@ fn parses_a_layer_file() {
             },
         )
         .unwrap();
-    assert!(matches!(layer.exclusion, Some(LayerDensity::Image { .. })));
+    assert!(matches!(layer.exclusion, Some(LayerDensity::Image(_))));
     assert_eq!(loads, ["roads.png"]);
 }
 
@@ -173,12 +173,12 @@ fn code_layer(names: &NamedAssets, map: &Handle<Image>) -> ScatterLayer {
     names.insert_material("leaf", leaf.clone());
     let ground = HeightSource::Function(std::sync::Arc::new(|p: Vec2| 0.1 * p.x));
     names.insert_height("terrain", &ground);
-    let painted = LayerDensity::Image {
+    let painted = LayerDensity::Image(GroundMap {
         image: map.clone(),
         min: Vec2::splat(-8.0),
         size: Vec2::splat(16.0),
         scale: 3.0,
-    };
+    });
     let noise = rwt_core::density::NoiseParams {
         seed: 4,
         frequency: 0.1,
