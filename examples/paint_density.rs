@@ -1,35 +1,34 @@
 //! Texton painting (paper figure 10): paint a density map per texton class and watch the
 //! textons appear as one blue-noise set shared by all classes, each with a rotation hashed
-//! from its point's identity. The maps are Bevy images read by one `bevy_rwt` layer on the
-//! 2-D plane: a stroke tells the plugin its region (`DensityMapPainted`), so only the
-//! chunks under it re-scatter and textons elsewhere never move.
+//! from its point's identity. The maps are `GroundMap`s read by one `bevy_rwt` layer on the
+//! 2-D plane and painted by the library's brush (`RwtBrushPlugin`, the one open_world uses):
+//! a stroke re-scatters only the chunks under it, so textons elsewhere never move, and the
+//! maps save in the brush's format (`painted.ron` and a PNG per class).
 //!
 //! `cargo run --release --example paint_density`
-//! - left mouse: paint the selected class, right mouse: erase it; 1-4 select the class,
-//!   E erases every class under the brush instead;
-//! - `[` / `]` brush size, Up / Down strength, C clears, Space compares with random placement;
-//! - S saves the maps (PNG) and the setup (RON) to `painted/` (or `RWT_PAINT_DIR`), L loads.
+//! - left mouse: paint the selected class, right mouse: erase it; 1-4 select the class;
+//! - wheel or `[` / `]` brush size, Up / Down strength, Z undo, C clears, Space compares with
+//!   random placement;
+//! - S saves the maps to `painted/` (or `RWT_PAINT_DIR`), L loads them.
 
-use bevy::asset::RenderAssetUsages;
 use bevy::camera::ScalingMode;
 use bevy::prelude::*;
-use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use bevy_rwt::brush::BrushKeys;
 use bevy_rwt::prelude::*;
 use glam::DVec2;
-use rwt_core::density::open_image;
-use rwt_core::files::{SaveTransaction, recover};
-use rwt_core::query::Rect;
 use rwt_core::rng::{hash_words, unit_f64};
 use rwt_examples::prelude::*;
-use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn main() {
     App::new()
         .insert_resource(ClearColor(Color::srgb(0.93, 0.91, 0.85)))
         .add_plugins((
             example_plugins("rwt paint_density"),
-            RwtPlugins::default().with_spawn_budget(20_000),
+            RwtPlugins::default()
+                .with_spawn_budget(20_000)
+                .build()
+                .enable::<RwtBrushPlugin>(),
             SmokePlugin,
             HudPlugin,
         ))
@@ -38,23 +37,20 @@ fn main() {
             Update,
             (
                 paint_script.run_if(|s: Res<Smoke>| s.active()),
-                paint_input.run_if(|s: Res<Smoke>| !s.active()),
-                upload_maps,
+                paint_keys.run_if(|s: Res<Smoke>| !s.active()),
                 compare_with_random,
                 show_maps,
                 hud,
             )
-                .chain(),
+                .chain()
+                .before(BrushSystems),
         )
         .run();
 }
 
 /// One texton class: its picture and how dense it is where its map is 1.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-struct ClassSetup {
-    name: String,
-    /// File in `assets/textons/`.
-    texton: String,
+struct TextonClass {
+    name: &'static str,
     /// Textons per unit area where the map is white (the canvas is 1 x 1).
     max_density: f64,
     /// Texton size relative to the spacing at `max_density`.
@@ -63,124 +59,66 @@ struct ClassSetup {
     tint: [f32; 3],
 }
 
-/// What `S` saves next to the maps: enough to paint on where you left off.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-struct PaintSetup {
-    seed: u64,
-    /// Map resolution (square).
-    map_size: usize,
-    classes: Vec<ClassSetup>,
-}
+const CLASSES: [TextonClass; 4] = [
+    TextonClass {
+        name: "leaf",
+        max_density: 1400.0,
+        size: 1.5,
+        tint: [0.3, 0.6, 0.25],
+    },
+    TextonClass {
+        name: "pebble",
+        max_density: 900.0,
+        size: 1.25,
+        tint: [0.55, 0.55, 0.55],
+    },
+    TextonClass {
+        name: "flower",
+        max_density: 700.0,
+        size: 1.3,
+        tint: [0.85, 0.4, 0.6],
+    },
+    TextonClass {
+        name: "starfish",
+        max_density: 500.0,
+        size: 1.3,
+        tint: [0.9, 0.5, 0.2],
+    },
+];
 
-impl Default for PaintSetup {
-    fn default() -> Self {
-        let class = |name: &str, max_density, size, tint| ClassSetup {
-            name: name.into(),
-            texton: format!("{name}.png"),
-            max_density,
-            size,
-            tint,
-        };
-        Self {
-            seed: 10,
-            map_size: 192,
-            classes: vec![
-                class("leaf", 1400.0, 1.5, [0.3, 0.6, 0.25]),
-                class("pebble", 900.0, 1.25, [0.55, 0.55, 0.55]),
-                class("flower", 700.0, 1.3, [0.85, 0.4, 0.6]),
-                class("starfish", 500.0, 1.3, [0.9, 0.5, 0.2]),
-            ],
-        }
-    }
-}
+/// Texels along each side of a class map.
+const MAP_TEXELS: u32 = 192;
+/// The tiling seed.
+const SEED: u64 = 10;
 
 #[derive(Resource)]
 struct Canvas {
-    setup: PaintSetup,
-    /// One map per class, row 0 at the top, values in [0, 1]; uploaded to `images`.
-    maps: Vec<Vec<f32>>,
-    /// The Bevy images the layer reads, one per class.
-    images: Vec<Handle<Image>>,
-    /// World rectangle painted since the last upload.
-    dirty: Option<Rect>,
-    /// Show white-noise placement instead of blue noise.
-    random: bool,
+    /// One map per class, over the unit square.
+    maps: Vec<GroundMap>,
     textures: Vec<Handle<Image>>,
     overlay: Handle<Image>,
     /// The entity holding the texton layer.
     layer: Entity,
+    /// Show white-noise placement instead of blue noise.
+    random: bool,
     random_live: Vec<Entity>,
-    status: String,
 }
 
 impl Canvas {
-    fn clear(&mut self) {
-        let n = self.setup.map_size;
-        self.maps = vec![vec![0.0; n * n]; self.setup.classes.len()];
-        self.dirty = Some(whole());
-    }
-
-    /// Adds `amount` (negative erases) with a smooth fall-off inside `radius` of `centre`.
-    fn brush(&mut self, class: Option<usize>, centre: DVec2, radius: f64, amount: f32) {
-        let n = self.setup.map_size;
-        let texel = 1.0 / n as f64;
-        let (x0, x1) = (
-            ((centre.x - radius) / texel).floor().max(0.0) as usize,
-            (((centre.x + radius) / texel).ceil().max(0.0) as usize).min(n),
-        );
-        let (y0, y1) = (
-            ((1.0 - centre.y - radius) / texel).floor().max(0.0) as usize,
-            (((1.0 - centre.y + radius) / texel).ceil().max(0.0) as usize).min(n),
-        );
-        for (c, map) in self.maps.iter_mut().enumerate() {
-            if class.is_some_and(|k| k != c) {
-                continue;
-            }
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let p = DVec2::new((x as f64 + 0.5) * texel, 1.0 - (y as f64 + 0.5) * texel);
-                    let d = p.distance(centre) / radius;
-                    if d < 1.0 {
-                        let w = (1.0 - d * d) as f32;
-                        let v = &mut map[y * n + x];
-                        *v = (*v + amount * w).clamp(0.0, 1.0);
-                    }
-                }
-            }
-        }
-        let r = Rect::new(
-            (centre - radius - texel).max(DVec2::ZERO),
-            (centre + radius + texel).min(DVec2::ONE),
-        )
-        .unwrap_or(Rect::EMPTY);
-        self.dirty = Some(match self.dirty {
-            Some(d) => Rect::new(d.min().min(r.min()), d.max().max(r.max())).unwrap_or(d),
-            None => r,
-        });
-    }
-
     /// The layer: one class per texton, each reading its map over the unit canvas on the
     /// 2-D plane, with a rotation and a size hashed from each point's identity.
     fn layer(&self) -> ScatterLayer {
-        let classes = self
-            .setup
-            .classes
+        let classes = CLASSES
             .iter()
-            .zip(&self.images)
+            .zip(&self.maps)
             .zip(&self.textures)
             .map(|((c, map), texture)| {
-                let density = LayerDensity::Image(GroundMap {
-                    image: map.clone(),
-                    min: Vec2::ZERO,
-                    size: Vec2::ONE,
-                    scale: c.max_density,
-                });
                 let sprite = Sprite {
                     image: texture.clone(),
                     custom_size: Some(Vec2::splat((c.size as f64 / c.max_density.sqrt()) as f32)),
                     ..default()
                 };
-                let mut class = ScatterClass::custom(density, move |e| {
+                let mut class = ScatterClass::custom(LayerDensity::Image(map.clone()), move |e| {
                     e.insert(sprite.clone());
                 });
                 class.scale_variation = 0.15;
@@ -189,7 +127,7 @@ impl Canvas {
             .collect();
         ScatterLayer::new(classes)
             .on_plane(GroundPlane::Xy)
-            .with_seed(self.setup.seed)
+            .with_seed(SEED)
             .with_tile_size(1.0)
             .with_streaming(StreamingConfig {
                 chunk_size: 0.125,
@@ -198,137 +136,65 @@ impl Canvas {
                 near_distance: 2.0,
             })
     }
-
-    /// Writes the maps and the setup together, all or nothing (a failure keeps the
-    /// previous save).
-    fn save(&self, dir: &Path) -> Result<(), String> {
-        let mut save = SaveTransaction::begin(dir).map_err(|e| e.to_string())?;
-        let n = self.setup.map_size as u32;
-        for (c, map) in self.setup.classes.iter().zip(&self.maps) {
-            let bytes: Vec<u8> = map.iter().map(|v| (v * 255.0).round() as u8).collect();
-            let img = image::GrayImage::from_raw(n, n, bytes).ok_or("map size mismatch")?;
-            save.write_with(&format!("{}.png", c.name), |w| {
-                img.write_with_encoder(image::codecs::png::PngEncoder::new(w))
-                    .map_err(std::io::Error::other)
-            })
-            .map_err(|e| e.to_string())?;
-        }
-        let ron = ron::ser::to_string_pretty(&self.setup, ron::ser::PrettyConfig::default())
-            .map_err(|e| e.to_string())?;
-        save.write("layer.ron", ron.as_bytes())
-            .and_then(|()| save.commit())
-            .map_err(|e| e.to_string())
-    }
-
-    fn load(&mut self, dir: &Path) -> Result<(), String> {
-        recover(dir).map_err(|e| e.to_string())?;
-        let text = std::fs::read_to_string(dir.join("layer.ron"))
-            .map_err(|e| format!("{}: {e}", dir.join("layer.ron").display()))?;
-        let setup: PaintSetup = ron::from_str(&text).map_err(|e| format!("layer.ron: {e}"))?;
-        if setup.classes.len() != self.setup.classes.len() || setup.map_size == 0 {
-            return Err("layer.ron: class list differs from this example's textons".into());
-        }
-        let mut maps = Vec::new();
-        for c in &setup.classes {
-            let path = dir.join(format!("{}.png", c.name));
-            let img = open_image(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let img = img
-                .resize_exact(
-                    setup.map_size as u32,
-                    setup.map_size as u32,
-                    image::imageops::FilterType::Triangle,
-                )
-                .to_luma8();
-            maps.push(img.pixels().map(|p| p[0] as f32 / 255.0).collect());
-        }
-        self.setup = setup;
-        self.maps = maps;
-        self.dirty = Some(whole());
-        Ok(())
-    }
 }
 
-fn whole() -> Rect {
-    Rect::new(DVec2::ZERO, DVec2::ONE).expect("ordered")
-}
-
-/// A brush per class (its own size and strength), one of them selected.
-#[derive(Resource)]
-struct Brush {
-    class: usize,
-    erase_all: bool,
-    radius: Vec<f64>,
-    strength: Vec<f32>,
-}
-
-impl Brush {
-    fn radius(&mut self) -> &mut f64 {
-        &mut self.radius[self.class]
-    }
-
-    fn strength(&mut self) -> &mut f32 {
-        &mut self.strength[self.class]
-    }
+/// The value of every texel of a map painted by the brush (linear grey), row 0 at the top.
+fn map_values(image: &Image) -> Option<Vec<f32>> {
+    let data = image.data.as_ref()?;
+    Some(data.chunks_exact(4).map(|p| p[0] as f32 / 255.0).collect())
 }
 
 fn save_dir() -> PathBuf {
     std::env::var_os("RWT_PAINT_DIR").map_or_else(|| PathBuf::from("painted"), PathBuf::from)
 }
 
-/// A `n x n` single-channel image for a class map.
-fn map_image(n: usize) -> Image {
-    Image::new_fill(
-        Extent3d {
-            width: n as u32,
-            height: n as u32,
-            depth_or_array_layers: 1,
-        },
-        TextureDimension::D2,
-        &[0],
-        TextureFormat::R8Unorm,
-        RenderAssetUsages::default(),
-    )
-}
-
-fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<Assets<Image>>) {
-    let setup = PaintSetup::default();
-    let n = setup.map_size;
-    let textures = setup
-        .classes
+fn setup(
+    mut commands: Commands,
+    assets: Res<AssetServer>,
+    mut images: ResMut<Assets<Image>>,
+    mut brush: ResMut<DensityBrush>,
+) {
+    let canvas_rect = Rect::new(0.0, 0.0, 1.0, 1.0);
+    let maps: Vec<GroundMap> = CLASSES
         .iter()
-        .map(|c| assets.load(format!("textons/{}", c.texton)))
+        .map(|c| bevy_rwt::brush::blank_map(&mut images, MAP_TEXELS, canvas_rect, c.max_density))
         .collect();
-    let maps = setup
-        .classes
+    let textures = CLASSES
         .iter()
-        .map(|_| images.add(map_image(n)))
+        .map(|c| assets.load(format!("textons/{}.png", c.name)))
         .collect();
-    let mut overlay = map_image(n);
-    overlay.texture_descriptor.format = TextureFormat::Rgba8UnormSrgb;
-    overlay.data = Some(vec![255; n * n * 4]);
-    let overlay = images.add(overlay);
+    let overlay = bevy_rwt::brush::blank_map(&mut images, MAP_TEXELS, canvas_rect, 1.0).image;
     let mut canvas = Canvas {
-        maps: Vec::new(),
-        images: maps,
-        setup,
-        dirty: None,
-        random: false,
+        maps,
         textures,
         overlay: overlay.clone(),
         layer: Entity::PLACEHOLDER,
+        random: false,
         random_live: Vec::new(),
-        status: String::new(),
     };
-    canvas.clear();
-    canvas.layer = commands.spawn(canvas.layer()).id();
-    let classes = canvas.setup.classes.len();
+    canvas.layer = commands.spawn((Name::new("textons"), canvas.layer())).id();
+    *brush = DensityBrush {
+        enabled: true,
+        targets: (0..CLASSES.len())
+            .map(|i| BrushTarget::new(canvas.layer, i, CLASSES[i].name))
+            .collect(),
+        radius: 0.06,
+        radius_range: (0.005, 0.5),
+        strength: 2.0,
+        save_dir: save_dir(),
+        // Sprites made in code have no layer file: the maps and the index are saved.
+        layer_files: false,
+        keys: BrushKeys {
+            toggle: None,
+            strength: None,
+            save: Some(KeyCode::KeyS),
+            load: Some(KeyCode::KeyL),
+            ..default()
+        },
+        circle_lift: 1.0,
+        ..default()
+    };
     commands.insert_resource(canvas);
-    commands.insert_resource(Brush {
-        class: 0,
-        erase_all: false,
-        radius: vec![0.06; classes],
-        strength: vec![2.0; classes],
-    });
     // The unit canvas fills 92 % of the window's height; the layer streams around the
     // camera, which sees all of it.
     commands.spawn((
@@ -343,7 +209,6 @@ fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<As
         RwtViewer::all_around(),
     ));
     commands.spawn((
-        MapOverlay,
         Sprite {
             image: overlay,
             custom_size: Some(Vec2::ONE),
@@ -353,156 +218,111 @@ fn setup(mut commands: Commands, assets: Res<AssetServer>, mut images: ResMut<As
     ));
 }
 
-#[derive(Component)]
-struct MapOverlay;
+/// A dab for every class at once that empties the canvas (one stroke: Z undoes it).
+fn clear_all(dabs: &mut MessageWriter<PaintDab>) {
+    for target in 0..CLASSES.len() {
+        dabs.write(PaintDab {
+            target,
+            centre: Vec2::splat(0.5),
+            radius: 10.0,
+            amount: -10.0,
+        });
+    }
+}
 
 /// The smoke session: a stroke per class, an eraser stroke, then a save, a clear and a load
 /// (so that the screenshot shows the maps read back from disk, once their chunks have
 /// re-scattered).
+#[allow(clippy::too_many_arguments)] // one system a script: its messages and its report
 fn paint_script(
     smoke: Res<Smoke>,
-    mut canvas: ResMut<Canvas>,
-    mut done: Local<bool>,
+    mut step: Local<u8>,
+    brush: Res<DensityBrush>,
+    mut dabs: MessageWriter<PaintDab>,
+    mut commands: MessageWriter<BrushCommand>,
     mut exit: MessageWriter<AppExit>,
     mut report: ResMut<SmokeReport>,
     stats: Res<RwtStats>,
 ) {
-    report.hold = !*done || stats.pending_tasks > 0 || stats.queued_spawns > 0;
-    let t = smoke.progress() as f64;
-    let classes = canvas.setup.classes.len();
-    let span = 0.7 / classes as f64;
+    report.hold = *step < 4 || stats.pending_tasks > 0 || stats.queued_spawns > 0;
+    let t = smoke.progress();
+    let classes = CLASSES.len();
+    let span = 0.7 / classes as f32;
     let class = ((t / span) as usize).min(classes);
+    let mut dab = |target, centre, radius, amount| {
+        dabs.write(PaintDab {
+            target,
+            centre,
+            radius,
+            amount,
+        });
+    };
     if class < classes {
-        let s = (t - class as f64 * span) / span;
-        let y = 0.16 + 0.23 * class as f64 + 0.05 * (s * 9.0).sin();
-        canvas.brush(Some(class), DVec2::new(0.08 + 0.84 * s, y), 0.09, 0.35);
+        let s = (t - class as f32 * span) / span;
+        let y = 0.16 + 0.23 * class as f32 + 0.05 * (s * 9.0).sin();
+        dab(class, Vec2::new(0.08 + 0.84 * s, y), 0.09, 0.5);
         // A second, fainter pass of the next class overlapping this one: mixed regions.
-        canvas.brush(
-            Some((class + 1) % classes),
-            DVec2::new(0.9 - 0.8 * s, y + 0.1),
-            0.05,
-            0.15,
-        );
-    } else if t < 0.8 {
+        let next = Vec2::new(0.9 - 0.8 * s, y + 0.1);
+        dab((class + 1) % classes, next, 0.05, 0.22);
+        return;
+    }
+    if t < 0.8 {
         let s = (t - 0.7) / 0.1;
-        canvas.brush(None, DVec2::new(0.5 + 0.1 * s, 0.1 + 0.8 * s), 0.035, -1.0);
-    } else if !*done {
-        *done = true;
-        let dir = save_dir();
-        let saved = canvas.save(&dir);
-        canvas.clear();
-        let loaded = canvas.load(&dir);
-        if let Err(e) = saved.and(loaded) {
-            eprintln!("rwt-smoke: save and load in {}: {e}", dir.display());
-            exit.write(AppExit::error());
-            return;
+        for target in 0..classes {
+            dab(target, Vec2::new(0.5 + 0.1 * s, 0.1 + 0.8 * s), 0.035, -1.0);
         }
-        println!(
+        return;
+    }
+    // Save, clear, load: a step a frame, the brush's outcome checked before the next.
+    if *step > 0 && *step < 4 && !matches!(brush.last, Some(Ok(_))) {
+        eprintln!("rwt-smoke: painted maps, step {}: {:?}", *step, brush.last);
+        exit.write(AppExit::error());
+        return;
+    }
+    let dir = save_dir();
+    match *step {
+        0 => {
+            commands.write(BrushCommand::Save(dir));
+        }
+        1 => clear_all(&mut dabs),
+        2 => {
+            commands.write(BrushCommand::Load(dir));
+        }
+        3 => println!(
             "rwt-smoke: painted maps saved to and loaded from {}",
             dir.display()
-        );
+        ),
+        _ => return,
     }
+    *step += 1;
 }
 
-fn paint_input(
+/// The example's own keys: size, strength, clearing (the brush reads the mouse, the class
+/// digits, undo, save and load).
+fn paint_keys(
     keys: Res<ButtonInput<KeyCode>>,
-    buttons: Res<ButtonInput<MouseButton>>,
-    time: Res<Time>,
-    windows: Query<&Window>,
-    cameras: Query<(&Camera, &GlobalTransform)>,
+    mut brush: ResMut<DensityBrush>,
+    mut dabs: MessageWriter<PaintDab>,
     mut canvas: ResMut<Canvas>,
-    mut brush: ResMut<Brush>,
 ) {
-    for (i, key) in [
-        KeyCode::Digit1,
-        KeyCode::Digit2,
-        KeyCode::Digit3,
-        KeyCode::Digit4,
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        if keys.just_pressed(key) && i < canvas.setup.classes.len() {
-            brush.class = i;
-            brush.erase_all = false;
-        }
-    }
-    if keys.just_pressed(KeyCode::KeyE) {
-        brush.erase_all = !brush.erase_all;
-    }
+    let (lo, hi) = brush.radius_range;
     if keys.just_pressed(KeyCode::BracketLeft) {
-        *brush.radius() = (*brush.radius() / 1.25).max(0.005);
+        brush.radius = (brush.radius / 1.25).max(lo);
     }
     if keys.just_pressed(KeyCode::BracketRight) {
-        *brush.radius() = (*brush.radius() * 1.25).min(0.5);
+        brush.radius = (brush.radius * 1.25).min(hi);
     }
     if keys.just_pressed(KeyCode::ArrowUp) {
-        *brush.strength() = (*brush.strength() * 1.5).min(20.0);
+        brush.strength = (brush.strength * 1.5).min(20.0);
     }
     if keys.just_pressed(KeyCode::ArrowDown) {
-        *brush.strength() = (*brush.strength() / 1.5).max(0.05);
+        brush.strength = (brush.strength / 1.5).max(0.05);
     }
     if keys.just_pressed(KeyCode::KeyC) {
-        canvas.clear();
+        clear_all(&mut dabs);
     }
-    if keys.just_pressed(KeyCode::KeyS) {
-        let dir = save_dir();
-        canvas.status = match canvas.save(&dir) {
-            Ok(()) => format!("saved to {}", dir.display()),
-            Err(e) => format!("save failed: {e}"),
-        };
-    }
-    if keys.just_pressed(KeyCode::KeyL) {
-        let dir = save_dir();
-        canvas.status = match canvas.load(&dir) {
-            Ok(()) => format!("loaded from {}", dir.display()),
-            Err(e) => format!("load failed: {e}"),
-        };
-    }
-    let Some(p) = cursor_on_canvas(&windows, &cameras) else {
-        return;
-    };
-    let p = p.as_dvec2();
-    let amount = *brush.strength() * time.delta_secs();
-    let radius = *brush.radius();
-    let target = (!brush.erase_all).then_some(brush.class);
-    if buttons.pressed(MouseButton::Left) {
-        let sign = if brush.erase_all { -1.0 } else { 1.0 };
-        canvas.brush(target, p, radius, sign * amount);
-    } else if buttons.pressed(MouseButton::Right) {
-        canvas.brush(target, p, radius, -amount);
-    }
-}
-
-/// Where the cursor points on the canvas (world units), if it is over the window.
-fn cursor_on_canvas(
-    windows: &Query<&Window>,
-    cameras: &Query<(&Camera, &GlobalTransform)>,
-) -> Option<Vec2> {
-    let cursor = windows.single().ok()?.cursor_position()?;
-    let (camera, at) = cameras.single().ok()?;
-    camera.viewport_to_world_2d(at, cursor).ok()
-}
-
-/// Uploads the painted maps into the images the layer reads, and tells the plugin which
-/// region changed: only the chunks under it re-scatter.
-fn upload_maps(
-    mut canvas: ResMut<Canvas>,
-    mut images: ResMut<Assets<Image>>,
-    mut painted: MessageWriter<DensityMapPainted>,
-) {
-    let Some(region) = canvas.dirty.take() else {
-        return;
-    };
-    for (map, handle) in canvas.maps.iter().zip(&canvas.images) {
-        let Some(mut image) = images.get_mut(handle) else {
-            continue;
-        };
-        image.data = Some(map.iter().map(|v| (v * 255.0).round() as u8).collect());
-        painted.write(DensityMapPainted {
-            image: handle.id(),
-            region,
-        });
+    if keys.just_pressed(KeyCode::Space) {
+        canvas.random = !canvas.random;
     }
 }
 
@@ -510,13 +330,12 @@ fn upload_maps(
 fn compare_with_random(
     mut commands: Commands,
     mut canvas: ResMut<Canvas>,
-    keys: Res<ButtonInput<KeyCode>>,
+    images: Res<Assets<Image>>,
+    mut events: MessageReader<AssetEvent<Image>>,
     mut shown: Local<bool>,
 ) {
-    if keys.just_pressed(KeyCode::Space) {
-        canvas.random = !canvas.random;
-    }
-    if canvas.random == *shown && !(canvas.random && canvas.is_changed()) {
+    let repainted = maps_changed(&canvas, &mut events);
+    if canvas.random == *shown && !(canvas.random && repainted) {
         return;
     }
     *shown = canvas.random;
@@ -529,15 +348,26 @@ fn compare_with_random(
         return;
     }
     commands.entity(canvas.layer).remove::<ScatterLayer>();
-    let total: f64 = canvas.setup.classes.iter().map(|c| c.max_density).sum();
-    let n = canvas.setup.map_size;
+    let maps: Vec<Vec<f32>> = canvas
+        .maps
+        .iter()
+        .map(|m| {
+            images
+                .get(&m.image)
+                .and_then(map_values)
+                .unwrap_or_default()
+        })
+        .collect();
+    let total: f64 = CLASSES.iter().map(|c| c.max_density).sum();
+    let n = MAP_TEXELS as usize;
     for k in 0..total as u64 {
-        let h = |salt| unit_f64(hash_words(canvas.setup.seed, &[k, salt]));
+        let h = |salt| unit_f64(hash_words(SEED, &[k, salt]));
         let p = DVec2::new(h(1), h(2));
-        let texel = ((1.0 - p.y) * n as f64) as usize * n + (p.x * n as f64) as usize;
+        let texel =
+            (((1.0 - p.y) * n as f64) as usize * n + (p.x * n as f64) as usize).min(n * n - 1);
         let mut u = h(3) * total;
-        for (class, c) in canvas.setup.classes.iter().enumerate() {
-            let v = canvas.maps[class][texel.min(n * n - 1)] as f64 * c.max_density;
+        for (class, c) in CLASSES.iter().enumerate() {
+            let v = maps[class].get(texel).copied().unwrap_or(0.0) as f64 * c.max_density;
             if u < v {
                 let size = (c.size as f64 / c.max_density.sqrt()) as f32;
                 let e = commands.spawn((
@@ -558,28 +388,53 @@ fn compare_with_random(
     }
 }
 
+/// Whether a class map changed (a dab, an undo, a load) since the system last looked.
+fn maps_changed(canvas: &Canvas, events: &mut MessageReader<AssetEvent<Image>>) -> bool {
+    let maps: Vec<AssetId<Image>> = canvas.maps.iter().map(|m| m.image.id()).collect();
+    events
+        .read()
+        .filter(|e| maps.iter().any(|id| e.is_modified(*id) || e.is_added(*id)))
+        .count()
+        > 0
+}
+
 /// The maps, tinted by class over white, behind the textons.
-fn show_maps(canvas: Res<Canvas>, mut images: ResMut<Assets<Image>>) {
-    if !canvas.is_changed() {
+fn show_maps(
+    canvas: Res<Canvas>,
+    mut events: MessageReader<AssetEvent<Image>>,
+    mut images: ResMut<Assets<Image>>,
+) {
+    if !maps_changed(&canvas, &mut events) {
         return;
     }
-    let Some(mut image) = images.get_mut(&canvas.overlay) else {
+    let maps: Vec<Vec<f32>> = canvas
+        .maps
+        .iter()
+        .map(|m| {
+            images
+                .get(&m.image)
+                .and_then(map_values)
+                .unwrap_or_default()
+        })
+        .collect();
+    let Some(mut overlay) = images.get_mut(&canvas.overlay) else {
         return;
     };
-    let Some(data) = image.data.as_mut() else {
+    let Some(data) = overlay.data.as_mut() else {
         return;
     };
-    let n = canvas.setup.map_size;
-    for (i, px) in data.chunks_exact_mut(4).enumerate().take(n * n) {
+    for (i, px) in data.chunks_exact_mut(4).enumerate() {
         let mut rgb = Vec3::splat(1.0);
-        for (c, map) in canvas.setup.classes.iter().zip(&canvas.maps) {
-            let w = map[i] * 0.45;
+        for (c, map) in CLASSES.iter().zip(&maps) {
+            let w = map.get(i).copied().unwrap_or(0.0) * 0.45;
             rgb = rgb.lerp(Vec3::from_array(c.tint), w);
         }
+        // The overlay's texels are linear: the tints are given in sRGB.
+        let linear = Color::srgb(rgb.x, rgb.y, rgb.z).to_linear();
         px.copy_from_slice(&[
-            (rgb.x * 255.0) as u8,
-            (rgb.y * 255.0) as u8,
-            (rgb.z * 255.0) as u8,
+            (linear.red * 255.0) as u8,
+            (linear.green * 255.0) as u8,
+            (linear.blue * 255.0) as u8,
             255,
         ]);
     }
@@ -587,46 +442,37 @@ fn show_maps(canvas: Res<Canvas>, mut images: ResMut<Assets<Image>>) {
 
 fn hud(
     canvas: Res<Canvas>,
-    brush: Res<Brush>,
+    brush: Res<DensityBrush>,
     live: Res<LiveInstances>,
-    windows: Query<&Window>,
-    cameras: Query<(&Camera, &GlobalTransform)>,
-    mut gizmos: Gizmos,
     mut hud: ResMut<Hud>,
 ) {
-    let names: Vec<String> = canvas
-        .setup
-        .classes
+    let names: Vec<String> = brush
+        .targets
         .iter()
         .enumerate()
-        .map(|(i, c)| {
-            let mark = if i == brush.class && !brush.erase_all {
-                ">"
-            } else {
-                " "
-            };
-            format!("{mark}{} {}", i + 1, c.name)
+        .map(|(i, t)| {
+            let mark = if i == brush.selected { ">" } else { " " };
+            format!("{mark}{} {}", i + 1, t.name)
         })
         .collect();
+    let last = match &brush.last {
+        Some(Ok(done)) => done.clone(),
+        Some(Err(e)) => format!("failed: {e}"),
+        None => String::new(),
+    };
     hud.lines = vec![
-        "rwt paint_density: left paint, right erase, 1-4 class, E erase all, [ ] size, Up/Down strength".into(),
-        "Space random/blue noise, C clear, S save, L load".into(),
+        "rwt paint_density: left paint, right erase, 1-4 class, wheel or [ ] size, Up/Down strength".into(),
+        "Z undo, C clear, Space random/blue noise, S save, L load".into(),
         format!(
-            "{}   brush {:.3}, strength {:.2}{}",
+            "{}   brush {:.3}, strength {:.2}",
             names.join("  "),
-            brush.radius[brush.class],
-            brush.strength[brush.class],
-            if brush.erase_all { ", ERASER" } else { "" }
+            brush.radius,
+            brush.strength,
         ),
         format!(
-            "{}: {} textons   {}",
+            "{}: {} textons   {last}",
             if canvas.random { "random (white noise)" } else { "blue noise (rwt)" },
             live.0,
-            canvas.status
         ),
     ];
-    if let Some(at) = cursor_on_canvas(&windows, &cameras) {
-        let radius = brush.radius[brush.class] as f32;
-        gizmos.circle_2d(at, radius, Color::srgb(0.2, 0.2, 0.2));
-    }
 }

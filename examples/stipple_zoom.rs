@@ -9,12 +9,14 @@ use bevy::asset::RenderAssetUsages;
 use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll};
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use glam::DVec2;
 use rwt_core::density::Placement;
 use rwt_core::density::{ImageDensity, Scale};
 use rwt_core::query::{PointId, Rect, Sampler};
 use rwt_core::tileset::TileSet;
 use rwt_examples::prelude::*;
+use rwt_examples::smoke::{BLANK_VARIANCE, luminance_variance};
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -24,13 +26,18 @@ const SIDE: f64 = 1.0;
 const DOTS_IN_VIEW: f64 = 16_000.0;
 /// Dot diameter in pixels.
 const DOT_PIXELS: f32 = 3.2;
-/// The smoke session zooms towards this point (mid-grey, near the highlight).
-const FOCUS: DVec2 = DVec2::new(0.52, 0.53);
+/// The smoke session zooms towards this point: the sphere's shadowed edge, where its dark
+/// side meets the light background between texels 327 and 328 of row 200 of the image. At
+/// 1000x the view spans less than a texel and still shows the edge, as a gradient.
+const FOCUS: DVec2 = DVec2::new(328.0 / 384.0, 1.0 - 200.5 / 384.0);
+/// The zooms the smoke session photographs (the last one is the harness's screenshot).
+const SHOTS: [(f64, &str); 3] = [(1.0, "1x"), (30.0, "30x"), (1000.0, "1000x")];
 
 fn main() {
     App::new()
         .insert_resource(ClearColor(Color::WHITE))
         .add_plugins((example_plugins("rwt stipple_zoom"), SmokePlugin, HudPlugin))
+        .init_resource::<ZoomScript>()
         .add_systems(Startup, setup)
         .add_systems(
             Update,
@@ -61,6 +68,9 @@ struct Stipple {
     live: HashMap<PointId, Entity>,
     /// Points produced by the last query and its duration.
     last_query: (usize, f64),
+    /// Dots that left while their point was still in view: none, since a higher density
+    /// only ever adds points (the smoke session reports it).
+    lost_in_view: usize,
 }
 
 fn setup(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
@@ -87,6 +97,7 @@ fn setup(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
         dot: images.add(disk(32)),
         live: HashMap::new(),
         last_query: (0, 0.0),
+        lost_in_view: 0,
     });
     commands.insert_resource(View {
         centre: DVec2::splat(SIDE / 2.0),
@@ -119,11 +130,80 @@ fn disk(size: u32) -> Image {
     )
 }
 
-/// The smoke session: 1x to 1000x towards `FOCUS`.
-fn zoom_script(smoke: Res<Smoke>, mut view: ResMut<View>) {
-    let t = smoke.progress() as f64;
-    view.zoom = 1000f64.powf(t);
-    view.centre = DVec2::splat(SIDE / 2.0).lerp(FOCUS, (t * 4.0).min(1.0));
+/// The smoke session: the whole image at 1x, then towards `FOCUS` to 30x and on to 1000x,
+/// each zoom of [`SHOTS`] held until its screenshot has dots on it (`<screenshot>_1x.png`,
+/// `_30x.png`; the harness takes the 1000x one).
+fn zoom_script(
+    smoke: Res<Smoke>,
+    mut view: ResMut<View>,
+    stipple: Res<Stipple>,
+    live: Res<LiveInstances>,
+    mut script: ResMut<ZoomScript>,
+    mut report: ResMut<SmokeReport>,
+    mut commands: Commands,
+) {
+    let shot = script.captured.min(SHOTS.len() - 1);
+    let (to, label) = SHOTS[shot];
+    let from = if shot == 0 { 1.0 } else { SHOTS[shot - 1].0 };
+    let s = ((smoke.frame - script.phase_start) as f64 / ZOOM_FRAMES as f64).min(1.0);
+    view.zoom = from * (to / from).powf(s);
+    // The centre reaches the focus at 30x and stays on it.
+    let toward = (view.zoom.ln() / 30f64.ln()).min(1.0);
+    view.centre = DVec2::splat(SIDE / 2.0).lerp(FOCUS, toward);
+    let last = script.captured == SHOTS.len() - 1;
+    // The harness takes the last screenshot once the zoom has reached it.
+    report.hold = !last || s < 1.0;
+    if s < 1.0 || script.requested {
+        return;
+    }
+    println!(
+        "rwt-smoke: zoom {label}: {} dots in view, {} left while in view",
+        live.0, stipple.lost_in_view
+    );
+    if last {
+        script.requested = true;
+        return;
+    }
+    let Some(path) = &smoke.screenshot else {
+        return;
+    };
+    let file = path.with_file_name(format!(
+        "{}_{label}.png",
+        path.file_stem().unwrap_or_default().to_string_lossy()
+    ));
+    script.requested = true;
+    commands.spawn(Screenshot::primary_window()).observe(
+        move |captured: On<ScreenshotCaptured>,
+              smoke: Res<Smoke>,
+              mut script: ResMut<ZoomScript>| {
+            script.requested = false;
+            let Ok(image) = captured.image.clone().try_into_dynamic() else {
+                return;
+            };
+            let rgb = image.to_rgb8();
+            // A software renderer shows nothing while it compiles pipelines: look again.
+            if luminance_variance(&rgb) < BLANK_VARIANCE {
+                return;
+            }
+            if let Err(e) = rgb.save(&file) {
+                eprintln!("rwt-smoke: cannot write {}: {e}", file.display());
+            }
+            script.captured += 1;
+            script.phase_start = smoke.frame;
+        },
+    );
+}
+
+/// Frames the smoke session takes from one photographed zoom to the next.
+const ZOOM_FRAMES: u32 = 40;
+
+/// Where the smoke session is: the zooms photographed so far, whether a screenshot is on its
+/// way, and the frame the current zoom began.
+#[derive(Resource, Default)]
+struct ZoomScript {
+    captured: usize,
+    requested: bool,
+    phase_start: u32,
 }
 
 fn navigate(
@@ -182,6 +262,7 @@ fn place(
     windows: Query<&Window>,
     mut stipple: ResMut<Stipple>,
     mut dots: Query<(&PointPos, &mut Transform)>,
+    mut last_zoom: Local<f64>,
 ) {
     let Ok(window) = windows.single() else {
         return;
@@ -201,13 +282,21 @@ fn place(
     stipple.last_query = (points.len(), started.elapsed().as_secs_f64());
     let wanted: HashMap<PointId, DVec2> = points.iter().map(|p| (p.id, p.position)).collect();
     let stipple = &mut *stipple;
+    // Zooming in only ever adds points: a dot whose point is still in view stays (zooming
+    // out thins the view, and dots go).
+    let zooming_in = view.zoom >= *last_zoom;
+    *last_zoom = view.zoom;
+    let mut lost = 0;
     stipple.live.retain(|id, entity| {
         let keep = wanted.contains_key(id);
         if !keep {
+            let in_view = dots.get(*entity).is_ok_and(|(p, _)| rect.contains(p.0));
+            lost += usize::from(zooming_in && in_view);
             commands.entity(*entity).despawn();
         }
         keep
     });
+    stipple.lost_in_view += lost;
     for (id, pos) in wanted {
         stipple.live.entry(id).or_insert_with(|| {
             commands

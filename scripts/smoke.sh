@@ -6,7 +6,8 @@
 # or its scripted brush stroke changed no instance (`painted 0`) or its brush did not save
 # the painted maps and layer files, or (its `eye` view) the trees it chopped and the ground
 # its cabin cleared did not persist through a flight 3 km away and back, or its walker on
-# foot did not stop at a tree's trunk; and runs instanced_passes, which fails unless
+# foot did not stop at a tree's trunk, or stipple_zoom lost a dot in view while zooming in
+# (or took fewer than its three screenshots, 1x, 30x and 1000x); and runs instanced_passes, which fails unless
 # instanced grass receives and casts shadows and is drawn with the prepasses, TAA and SSAO.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
@@ -116,12 +117,28 @@ for run in "${runs[@]}"; do
             echo "FAIL $name: the brush did not save the painted maps and layer files"; failed=1
         fi
     fi
+    if [ "$ex" = stipple_zoom ]; then
+        # Figure 1's story: the image at 1x, its shadowed edge at 30x and inside one texel
+        # at 1000x, and no dot that was in view ever left while zooming in.
+        grep -E '^rwt-smoke: zoom' "$out/$name.log" || true
+        for shot in 1x 30x; do
+            [ -s "$out/${name}_$shot.png" ] || { echo "FAIL $name: no $shot screenshot"; failed=1; }
+        done
+        if grep -E '^rwt-smoke: zoom' "$out/$name.log" | grep -vqE ', 0 left while in view$' \
+            || [ "$(grep -cE '^rwt-smoke: zoom' "$out/$name.log")" -ne 3 ]; then
+            echo "FAIL $name: dots in view left while zooming in"; failed=1
+        fi
+    fi
     if [ $docs = 1 ] && [ $failed = 0 ]; then
         mkdir -p docs/screenshots
         if [ "$ex" = open_world ]; then
             cp "$png" "docs/screenshots/$name.png"
         else
             python3 scripts/png_stats.py "$png" --half "docs/screenshots/$name.png" >/dev/null
+            for extra in "$out/${name}"_*x.png; do
+                [ -s "$extra" ] || continue
+                python3 scripts/png_stats.py "$extra" --half "docs/screenshots/$(basename "$extra")" >/dev/null
+            done
         fi
     fi
 done

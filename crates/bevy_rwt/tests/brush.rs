@@ -642,3 +642,54 @@ fn maps_of_colliding_names_round_trip() {
     assert!(!other.exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_layer_on_the_2d_plane_is_painted_saved_and_loaded() {
+    let mut app = create_app_with(|app| {
+        app.add_plugins(RwtBrushPlugin::default());
+    });
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let map = bevy_rwt::brush::blank_map(
+        &mut app.world_mut().resource_mut::<Assets<Image>>(),
+        64,
+        Rect::from_center_size(Vec2::ZERO, Vec2::splat(128.0)),
+        1.0,
+    );
+    let sprites = app
+        .world_mut()
+        .spawn(layer(LayerDensity::Image(map)).on_plane(GroundPlane::Xy))
+        .id();
+    {
+        let mut brush = app.world_mut().resource_mut::<DensityBrush>();
+        brush.targets = vec![BrushTarget::new(sprites, 0, "sprites")];
+        brush.layer_files = false;
+    }
+    tick_app(&mut app, 2_000);
+    assert!(instances(&mut app).is_empty());
+    let centre = Vec2::new(20.0, -10.0);
+    stroke(&mut app, 0, centre, 0.5, 2);
+    tick_app(&mut app, 2_000);
+    let painted = instances(&mut app);
+    assert!(painted.len() > 50, "{}", painted.len());
+    // The instances stand on the x-y plane, within the dab around (x, y) = centre.
+    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
+    for (_, t) in q.iter(app.world()) {
+        assert!(
+            t.translation.xy().distance(centre) < 8.5,
+            "{}",
+            t.translation
+        );
+        assert!(t.translation.z.abs() < 0.01);
+    }
+    // Saved without layer files (sprites made in code have none), cleared, loaded back.
+    let dir = scratch("plane-xy");
+    let saved = command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
+    assert!(saved.starts_with("saved 1 maps, 0 layer files"), "{saved}");
+    stroke(&mut app, 0, centre, -20.0, 1);
+    tick_app(&mut app, 2_000);
+    assert!(instances(&mut app).is_empty());
+    command(&mut app, BrushCommand::Load(dir.clone())).unwrap();
+    tick_app(&mut app, 2_000);
+    assert_eq!(instances(&mut app), painted);
+    std::fs::remove_dir_all(&dir).ok();
+}

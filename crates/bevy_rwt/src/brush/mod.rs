@@ -170,6 +170,10 @@ pub struct DensityBrush {
     pub undo_depth: usize,
     /// Where [`BrushCommand::Save`] and [`BrushCommand::Load`] from the keys go.
     pub save_dir: PathBuf,
+    /// Whether a save writes the layer file of every target's layer beside its maps (turn
+    /// it off for layers a file cannot describe, e.g. classes made of sprites in code: the
+    /// maps and the index are saved alone, without an error).
+    pub layer_files: bool,
     /// Key bindings.
     pub keys: BrushKeys,
     /// The ground point under the cursor (updated while enabled).
@@ -203,6 +207,7 @@ impl Default for DensityBrush {
             strength: 1.0,
             undo_depth: 32,
             save_dir: PathBuf::from("painted"),
+            layer_files: true,
             keys: BrushKeys::default(),
             cursor: None,
             circle_lift: 0.8,

@@ -234,7 +234,11 @@ pub(super) fn save(
             map: MapDescription::of(&map, file),
         });
     }
-    let unwritten = stage_layer_files(brush, from, &saved, &mut names, &mut save, &mut index)?;
+    let unwritten = if brush.layer_files {
+        stage_layer_files(brush, from, &saved, &mut names, &mut save, &mut index)?
+    } else {
+        Vec::new()
+    };
     let mut edited = 0;
     for layer in from.edits {
         let file = names.claim(&layer.name, "edits");

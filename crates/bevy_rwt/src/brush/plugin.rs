@@ -8,6 +8,7 @@ use super::{
 use crate::edits::ScatterEdits;
 use crate::layers::file::NamedAssets;
 use crate::layers::{HeightFn, ScatterLayer};
+use crate::look::GroundPlane;
 use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use crate::streaming::DensityMapPainted;
 use crate::streaming::LayerState;
@@ -79,18 +80,23 @@ impl BrushHistory {
     }
 }
 
-/// The selected target's ground, as the layer's chunks are generated with.
-fn target_height(brush: &DensityBrush, layers: &Query<&LayerState>) -> Option<HeightFn> {
+/// The selected target's plane and ground, as the layer's chunks are generated with.
+fn target_ground(
+    brush: &DensityBrush,
+    layers: &Query<(&ScatterLayer, &LayerState)>,
+) -> Option<(GroundPlane, HeightFn)> {
     let target = brush.target()?;
-    layers.get(target.layer).ok()?.height().cloned()
+    let (layer, state) = layers.get(target.layer).ok()?;
+    Some((layer.plane, state.height()?.clone()))
 }
 
-/// The ground point under the cursor, on the selected target's layer.
+/// The ground point under the cursor, on the selected target's layer: on the ground of a
+/// 3-D world or on a 2-D plane, seen by a 3-D or a 2-D camera.
 fn locate_cursor(
     mut brush: ResMut<DensityBrush>,
     windows: Query<&Window, With<PrimaryWindow>>,
     cameras: Query<(&Camera, &GlobalTransform, Has<RwtViewer>)>,
-    layers: Query<&LayerState>,
+    layers: Query<(&ScatterLayer, &LayerState)>,
 ) {
     if !brush.enabled {
         brush.cursor = None;
@@ -101,17 +107,30 @@ fn locate_cursor(
         .iter()
         .filter(|(c, ..)| c.is_active)
         .max_by_key(|(.., viewer)| *viewer);
-    let height = target_height(&brush, &layers);
-    let hit = match (cursor, camera, height) {
-        (Some(cursor), Some((camera, transform, _)), Some(height)) => camera
+    let hit = match (cursor, camera, target_ground(&brush, &layers)) {
+        (Some(cursor), Some((camera, transform, _)), Some((plane, height))) => camera
             .viewport_to_world(transform, cursor)
             .ok()
-            .and_then(|ray| ground_hit(ray.origin, *ray.direction, &*height, 5000.0)),
+            .and_then(|ray| plane_hit(plane, ray.origin, *ray.direction, &*height)),
         _ => None,
     };
     if brush.cursor != hit {
         brush.cursor = hit;
     }
+}
+
+/// Where a ray meets the ground of `plane` (the height field `height` over it).
+fn plane_hit(
+    plane: GroundPlane,
+    origin: Vec3,
+    direction: Vec3,
+    height: &dyn Fn(Vec2) -> f32,
+) -> Option<Vec3> {
+    // In the plane's own frame, x and z lie on the ground and y is the height.
+    let up = plane.point_at(Vec2::ZERO, 1.0);
+    let local = |p: Vec3| GroundPlane::Xz.point_at(plane.ground_of(p), p.dot(up));
+    let hit = ground_hit(local(origin), local(direction), height, 5000.0)?;
+    Some(plane.point_at(hit.xz(), hit.y))
 }
 
 /// Keys, wheel and buttons to brush settings, [`PaintDab`]s and [`BrushCommand`]s.
@@ -122,6 +141,7 @@ fn brush_input(
     buttons: Option<Res<ButtonInput<MouseButton>>>,
     scroll: Option<Res<AccumulatedMouseScroll>>,
     time: Res<Time>,
+    layers: Query<&ScatterLayer>,
     mut dabs: MessageWriter<PaintDab>,
     mut commands: MessageWriter<BrushCommand>,
 ) {
@@ -161,9 +181,13 @@ fn brush_input(
         (false, true) => -1.0,
         _ => return,
     };
+    let plane = brush
+        .target()
+        .and_then(|t| layers.get(t.layer).ok())
+        .map_or(GroundPlane::Xz, |l| l.plane);
     dabs.write(PaintDab {
         target: brush.selected,
-        centre: cursor.xz(),
+        centre: plane.ground_of(cursor),
         radius: brush.radius,
         amount: sign * brush.strength * time.delta_secs().min(0.1),
     });
@@ -348,25 +372,56 @@ fn undo(
 }
 
 /// The brush circle, following the ground.
-fn draw_circle(brush: Res<DensityBrush>, layers: Query<&LayerState>, mut gizmos: Gizmos) {
+fn draw_circle(
+    brush: Res<DensityBrush>,
+    layers: Query<(&ScatterLayer, &LayerState)>,
+    mut gizmos: Gizmos,
+) {
     let Some(centre) = brush.cursor.filter(|_| brush.enabled) else {
         return;
     };
-    let Some(height) = target_height(&brush, &layers) else {
+    let Some((plane, height)) = target_ground(&brush, &layers) else {
         return;
     };
-    let lift = brush.circle_lift;
+    let (centre, lift) = (plane.ground_of(centre), brush.circle_lift);
     let ring = |r: f32| {
         (0..=48).map(move |i| {
             let a = i as f32 / 48.0 * std::f32::consts::TAU;
-            centre.xz() + Vec2::new(a.cos(), a.sin()) * r
+            centre + Vec2::new(a.cos(), a.sin()) * r
         })
     };
     let color = Color::srgb(1.0, 0.85, 0.2);
     for (r, alpha) in [(brush.radius, 1.0), (brush.radius * 0.5, 0.5)] {
         gizmos.linestrip(
-            ring(r).map(|p| Vec3::new(p.x, height(p) + lift, p.y)),
+            ring(r).map(|p| plane.point_at(p, height(p) + lift)),
             color.with_alpha(alpha),
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cursor_ray_meets_either_plane() {
+        let hills = |p: Vec2| 0.5 * (p.x * 0.3).sin();
+        // A 2-D camera looks down -z onto the x-y plane, whose heights point at it.
+        let down = plane_hit(
+            GroundPlane::Xy,
+            Vec3::new(3.0, 4.0, 1000.0),
+            -Vec3::Z,
+            &hills,
+        )
+        .unwrap();
+        assert!((down - Vec3::new(3.0, 4.0, hills(Vec2::new(3.0, 4.0)))).length() < 1e-2);
+        // On the ground of a 3-D world the ray meets y = height(x, z).
+        let origin = Vec3::new(-5.0, 10.0, 2.0);
+        let direction = Vec3::new(1.0, -1.0, 0.5);
+        let hit = plane_hit(GroundPlane::Xz, origin, direction, &hills).unwrap();
+        assert_eq!(Some(hit), ground_hit(origin, direction, &hills, 5000.0));
+        assert!((hit.y - hills(hit.xz())).abs() < 1e-2);
+        // Looking away from the plane finds nothing.
+        assert_eq!(plane_hit(GroundPlane::Xy, Vec3::Z, Vec3::Z, &hills), None);
     }
 }

@@ -145,6 +145,24 @@ pub enum GroundPlane {
 }
 
 impl GroundPlane {
+    /// The ground position of a world point: its (x, z) on the ground of a 3-D world, its
+    /// (x, y) on a 2-D plane.
+    pub fn ground_of(self, p: Vec3) -> Vec2 {
+        match self {
+            GroundPlane::Xz => p.xz(),
+            GroundPlane::Xy => p.xy(),
+        }
+    }
+
+    /// The world point at ground position `ground`, `height` above the plane (along y on
+    /// the ground of a 3-D world, along z, towards a 2-D camera, on a 2-D plane).
+    pub fn point_at(self, ground: Vec2, height: f32) -> Vec3 {
+        match self {
+            GroundPlane::Xz => Vec3::new(ground.x, height, ground.y),
+            GroundPlane::Xy => Vec3::new(ground.x, ground.y, height),
+        }
+    }
+
     /// Where an instance of `p` stands: its ground position at `height`, in `pose`, with
     /// the sprite depth of the x-y plane hashed from its identity in a layer of `seed`.
     pub fn place(self, p: &Point, height: f32, pose: Pose, seed: u64) -> Transform {

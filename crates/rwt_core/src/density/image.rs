@@ -140,17 +140,6 @@ pub struct Placement {
     pub scale: f64,
 }
 
-impl Placement {
-    /// Over `rect`, a value of 1 meaning `scale` points per unit area.
-    pub fn over(rect: crate::query::Rect, scale: f64) -> Self {
-        Self {
-            min: rect.min(),
-            size: rect.max() - rect.min(),
-            scale,
-        }
-    }
-}
-
 impl ImageDensity {
     /// From row-major values (row 0 at the *top*, as images are stored) in `[0, 1]`; other
     /// values are clamped, NaN counts as 0.
