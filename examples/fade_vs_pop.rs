@@ -10,7 +10,6 @@
 //! yet drawn one step before: on the right they pop in at full size, on the left they are
 //! specks.
 
-use bevy::asset::AssetPlugin;
 use bevy::prelude::*;
 use bevy_rwt::instancing::InstancedChunk;
 use bevy_rwt::prelude::*;
@@ -82,14 +81,7 @@ fn main() {
 
 /// A headless app with one instanced grass layer.
 fn headless_app() -> App {
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin::default(),
-        RwtPlugins::default(),
-    ));
-    app.finish();
-    app.cleanup();
+    let mut app = bevy_rwt::testing::headless_app(RwtPlugins::default());
     let grass = ScatterClass::instanced(
         LayerDensity::Constant(3.0),
         Handle::default(),
@@ -112,15 +104,10 @@ fn headless_app() -> App {
 
 /// Runs frames until nothing is pending.
 fn settle(app: &mut App) {
-    for _ in 0..100_000 {
-        app.update();
-        let s = app.world().resource::<RwtStats>();
-        if s.pending_tasks == 0 && s.queued_spawns == 0 && s.live_instanced > 0 {
-            return;
-        }
-        std::thread::sleep(std::time::Duration::from_micros(200));
-    }
-    panic!("streaming did not settle");
+    assert!(
+        bevy_rwt::testing::settle(app, 100_000),
+        "streaming did not settle"
+    );
 }
 
 /// Blades in view, by position in centimetres: their drawn size with and without the fade

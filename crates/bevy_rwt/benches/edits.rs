@@ -165,12 +165,8 @@ fn fly(edits: EditSet) -> (f64, f64) {
 
 /// Runs frames until nothing is pending.
 fn settle(app: &mut App) {
-    for _ in 0..100_000 {
-        app.update();
-        let s = app.world().resource::<RwtStats>();
-        if s.pending_tasks == 0 && s.queued_spawns == 0 && s.live_entities > 0 {
-            return;
-        }
-    }
-    panic!("the world did not fill");
+    assert!(
+        bevy_rwt::testing::settle(app, 100_000),
+        "the world did not fill"
+    );
 }

@@ -53,16 +53,8 @@
 //! let trees = ScatterClass::new(LayerDensity::Constant(0.05), Handle::default(), Handle::default());
 //! let stumps = ScatterClass::new(LayerDensity::Constant(0.0), Handle::default(), Handle::default());
 //! let layer = app.world_mut().spawn(ScatterLayer::new(vec![trees, stumps])).id();
-//! let settle = |app: &mut App| {
-//!     for _ in 0..500 {
-//!         app.update();
-//!         let stats = app.world().resource::<RwtStats>();
-//!         if stats.live_entities > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
-//!             break;
-//!         }
-//!         std::thread::sleep(std::time::Duration::from_millis(2));
-//!     }
-//! };
+//! // Runs frames until the chunks have streamed (see `bevy_rwt::testing`, feature `testing`).
+//! let settle = |app: &mut App| assert!(bevy_rwt::testing::settle(app, 2_000));
 //! settle(&mut app);
 //! // Chop a tree: a stump (class 1) takes its place, now and whenever its chunk comes back.
 //! let tree = *app.world_mut().query::<&ScatterEntity>().iter(app.world()).next().unwrap();
@@ -75,13 +67,24 @@
 //! assert_eq!(now.class, 1);
 //! ```
 //!
+//! ## Tuning live, and saving scenes
+//!
+//! Every component, resource and message derives `Reflect` and is registered, so an
+//! inspector (`bevy-inspector-egui`'s `WorldInspectorPlugin`) shows and edits layers,
+//! classes, settings, statistics and viewers, and Bevy scenes can hold them. A layer edited
+//! in place (its seed, tile size, streaming distances, fall-off, densities, instanced
+//! shading) streams anew with its new settings. Code is not data: custom densities, height
+//! functions and inserters are skipped by reflection.
+//!
 //! ## Names
 //!
 //! - `Rwt*`: the plugin and its parts, their resources, system sets and the viewer marker
 //!   ([`RwtPlugins`], [`RwtSettings`], [`RwtSystems`], [`RwtStats`], [`RwtViewer`]);
 //! - `Scatter*`: components and assets that describe a layer and what it places
-//!   ([`ScatterLayer`], [`ScatterClass`], [`ScatterEntity`], [`ScatterLayerStatus`],
-//!   [`layers::file::ScatterLayerSource`]);
+//!   ([`ScatterLayer`], [`ScatterClass`], [`ScatterEntity`]: an instance that is an entity,
+//!   [`ScatterLayerStatus`], [`layers::file::ScatterLayerSource`]); instances of instanced
+//!   classes live in chunk buffers and are counted apart (`live_entities` beside
+//!   `live_instanced`);
 //! - plain names for the values inside them and for messages ([`LayerDensity`],
 //!   [`HeightSource`], [`ClassLook`], [`GroundPlane`], [`ViewCone`], [`ChunkLoaded`]).
 //!
@@ -132,14 +135,7 @@
 //! let streaming = StreamingConfig { chunk_size: 16.0, load_distance: 32.0, unload_distance: 40.0, near_distance: 16.0 };
 //! app.world_mut().spawn(ScatterLayer::new(vec![stones, grass]).with_streaming(streaming));
 //! // Chunks are generated on the async compute pool: run frames until they have landed.
-//! for _ in 0..10_000 {
-//!     app.update();
-//!     let stats = app.world().resource::<RwtStats>();
-//!     if stats.live_entities > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
-//!         break;
-//!     }
-//!     std::thread::sleep(std::time::Duration::from_millis(1));
-//! }
+//! assert!(bevy_rwt::testing::settle(&mut app, 10_000));
 //! let stats = app.world().resource::<RwtStats>();
 //! // About 0.5 stones (entities) and 20 blades (instanced, no entities) per square unit.
 //! let ratio = stats.live_instanced as f64 / stats.live_entities as f64;
@@ -159,6 +155,8 @@ pub mod look;
 pub mod picking;
 mod settings;
 pub mod streaming;
+#[cfg(feature = "testing")]
+pub mod testing;
 pub mod viewers;
 
 use bevy::app::PluginGroupBuilder;

@@ -57,16 +57,9 @@
 //! app.world_mut().resource_mut::<DensityBrush>().targets.push(BrushTarget::new(layer, 0, "meadow"));
 //! // One dab of 5 m at full strength: about 2 instances per square metre within it.
 //! app.world_mut().write_message(PaintDab { target: 0, centre: Vec2::ZERO, radius: 5.0, amount: 1.0 });
-//! let live = |app: &App| app.world().resource::<RwtStats>().live_entities;
-//! for _ in 0..10_000 {
-//!     app.update();
-//!     let stats = app.world().resource::<RwtStats>();
-//!     if live(&app) > 0 && stats.pending_tasks == 0 && stats.queued_spawns == 0 {
-//!         break;
-//!     }
-//!     std::thread::sleep(std::time::Duration::from_millis(1));
-//! }
-//! assert!((20..200).contains(&live(&app)), "{}", live(&app));
+//! assert!(bevy_rwt::testing::settle(&mut app, 10_000));
+//! let live = app.world().resource::<RwtStats>().live_entities;
+//! assert!((20..200).contains(&live), "{live}");
 //! ```
 
 mod paint;

@@ -64,6 +64,15 @@ pub(super) fn target_map(
 }
 
 impl GroundMap {
+    /// Ground position of the centre of texel `(x, y)` of its `w x h` image (row 0 at the
+    /// far edge).
+    fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> Vec2 {
+        Vec2::new(
+            self.min.x + (x as f32 + 0.5) / w as f32 * self.size.x,
+            self.min.y + self.size.y - (y as f32 + 0.5) / h as f32 * self.size.y,
+        )
+    }
+
     /// Texel columns and rows whose centres may lie within `radius` of `centre`.
     fn texel_span(&self, centre: Vec2, radius: f32, w: u32, h: u32) -> (u32, u32, u32, u32) {
         let to_x = |g: f32| (g - self.min.x) / self.size.x * w as f32;

@@ -50,15 +50,6 @@ impl GroundMap {
     pub fn density(&self, images: &Assets<Image>) -> Option<ImageDensity> {
         from_bevy_image(images.get(&self.image)?, self.placement())
     }
-
-    /// Ground position of the centre of texel `(x, y)` of its `w x h` image (row 0 at the
-    /// far edge).
-    pub(crate) fn texel_centre(&self, x: u32, y: u32, w: u32, h: u32) -> Vec2 {
-        Vec2::new(
-            self.min.x + (x as f32 + 0.5) / w as f32 * self.size.x,
-            self.min.y + self.size.y - (y as f32 + 0.5) / h as f32 * self.size.y,
-        )
-    }
 }
 
 /// The luminance times alpha of a Bevy image (row 0 at the top, as Bevy stores it; a

@@ -10,7 +10,9 @@ use bevy_rwt::instancing::InstancedChunk;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
 use std::collections::{HashMap, HashSet};
-use std::time::Duration;
+
+#[allow(unused_imports)] // each test file uses some of them
+pub use bevy_rwt::testing::{move_viewer, run_until, spawn_viewer};
 
 pub fn create_app() -> App {
     create_app_with(|_| {})
@@ -18,16 +20,7 @@ pub fn create_app() -> App {
 
 /// A headless app; `extra` adds plugins before the app is finished.
 pub fn create_app_with(extra: impl FnOnce(&mut App)) -> App {
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin::default(),
-        RwtPlugins::default().with_spawn_budget(50_000),
-    ));
-    extra(&mut app);
-    app.finish();
-    app.cleanup();
-    app
+    bevy_rwt::testing::headless_app_with(RwtPlugins::default().with_spawn_budget(50_000), extra)
 }
 
 /// A headless app that reads assets (PNG images too) from `dir`.
@@ -58,33 +51,12 @@ pub fn app_reading_with(dir: &std::path::Path, extra: impl FnOnce(&mut App)) -> 
     app
 }
 
-/// Runs frames until `done` holds (or `max` frames).
-pub fn run_until(app: &mut App, max: usize, done: impl Fn(&App) -> bool) -> bool {
-    for _ in 0..max {
-        app.update();
-        if done(app) {
-            return true;
-        }
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    false
-}
-
 /// Runs frames until nothing is pending or queued (or `max` frames).
 pub fn tick_app(app: &mut App, max: usize) {
-    for _ in 0..max {
-        app.update();
-        let s = app.world().resource::<RwtStats>();
-        if s.pending_tasks == 0 && s.queued_spawns == 0 {
-            app.update();
-            let s = app.world().resource::<RwtStats>();
-            if s.pending_tasks == 0 && s.queued_spawns == 0 {
-                return;
-            }
-        }
-        std::thread::sleep(Duration::from_millis(1));
-    }
-    panic!("streaming did not settle in {max} frames");
+    assert!(
+        bevy_rwt::testing::settle(app, max),
+        "streaming did not settle in {max} frames"
+    );
 }
 
 /// A `size x size` image of one colour.
@@ -136,22 +108,6 @@ pub fn layer(density: LayerDensity) -> ScatterLayer {
         .with_tile_size(8.0)
         .with_seed(3)
         .with_streaming(streaming())
-}
-
-pub fn spawn_viewer(app: &mut App, at: Vec3) -> Entity {
-    app.world_mut()
-        .spawn((
-            RwtViewer::all_around(),
-            Transform::from_translation(at),
-            GlobalTransform::from_translation(at),
-        ))
-        .id()
-}
-
-pub fn move_viewer(app: &mut App, viewer: Entity, at: Vec3) {
-    let mut e = app.world_mut().entity_mut(viewer);
-    *e.get_mut::<Transform>().unwrap() = Transform::from_translation(at);
-    *e.get_mut::<GlobalTransform>().unwrap() = GlobalTransform::from_translation(at);
 }
 
 pub fn instances(app: &mut App) -> HashMap<PointId, Vec3> {
