@@ -36,7 +36,7 @@ fn main() {
             GlobalTransform::default(),
         ))
         .id();
-    let band = InstancedMaterial::default().fade_band;
+    let band = InstancedShading::default().fade_band;
     let (w, h) = (((VIEW.1 - VIEW.0) * PX) as u32, (2.0 * DEPTH * PX) as u32);
     let gap = 6;
     let mut out = RgbImage::from_pixel(2 * w + gap, STEPS.len() as u32 * (h + gap), Rgb([255; 3]));
@@ -85,7 +85,7 @@ fn headless_app() -> App {
     let grass = ScatterClass::instanced(
         LayerDensity::Constant(3.0),
         Handle::default(),
-        InstancedMaterial::default(),
+        InstancedShading::default(),
     );
     app.world_mut().spawn(
         ScatterLayer::new(vec![grass])

@@ -151,7 +151,7 @@ fn setup(
         });
         ScatterClass::new(density, blade, material)
     } else {
-        let material = InstancedMaterial {
+        let material = InstancedShading {
             shadows: SETTINGS[0].0,
             ..default()
         };

@@ -126,7 +126,7 @@ fn setup(
     let mut grass = ScatterClass::instanced(
         LayerDensity::Custom(Arc::new(field)),
         meshes.add(blade_mesh(0.1, 0.72, 0.1)),
-        InstancedMaterial {
+        InstancedShading {
             base_color: Color::srgb(0.12, 0.3, 0.05),
             tip_color: Color::srgb(0.5, 0.75, 0.2),
             ..default()
@@ -148,7 +148,7 @@ fn setup(
             density: 3.0,
         })),
         meshes.add(card_mesh()),
-        InstancedMaterial {
+        InstancedShading {
             base_color: Color::WHITE,
             tip_color: Color::WHITE,
             color_variation: 0.0,

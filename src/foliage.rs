@@ -231,7 +231,7 @@ pub fn rock() -> Mesh {
 }
 
 /// A flower for an instanced class: a thin stem under a flat star of six petals. With
-/// [`bevy_rwt::InstancedMaterial::tip_from`] at about 0.85 the stem takes the base colour
+/// [`bevy_rwt::InstancedShading::tip_from`] at about 0.85 the stem takes the base colour
 /// and the head the tip colour.
 pub fn flower(height: f32) -> Mesh {
     let mut positions: Vec<[f32; 3]> = Vec::new();

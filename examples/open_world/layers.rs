@@ -280,7 +280,7 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
             scale: 140.0,
         })),
         meshes.add(blade_mesh(0.085, 0.6, 0.11)),
-        InstancedMaterial {
+        InstancedShading {
             base_color: Color::srgb(0.05, 0.13, 0.025),
             tip_color: Color::srgb(0.33, 0.47, 0.12),
             // Blades cast near the player only: far grass costs nothing in shadow passes.
@@ -312,7 +312,7 @@ fn ferns(
     let mut class = ScatterClass::instanced(
         LayerDensity::Custom(Arc::new(FernDensity(ForestCover::new()))),
         meshes.add(foliage::fern(7, 1.6)),
-        InstancedMaterial {
+        InstancedShading {
             base_color: Color::srgb(0.07, 0.17, 0.04),
             tip_color: Color::srgb(0.3, 0.5, 0.12),
             tip_from: 0.2,
@@ -356,7 +356,7 @@ fn flowers(
             let mut class = ScatterClass::instanced(
                 density,
                 mesh.clone(),
-                InstancedMaterial {
+                InstancedShading {
                     base_color: Color::srgb(0.1, 0.22, 0.05),
                     tip_color: *petals,
                     color_variation: 0.15,

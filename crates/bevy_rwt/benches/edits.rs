@@ -138,7 +138,7 @@ fn fly(edits: EditSet) -> (f64, f64) {
     let grass = ScatterClass::instanced(
         LayerDensity::Constant(DENSITIES[1]),
         default(),
-        InstancedMaterial::default(),
+        InstancedShading::default(),
     );
     let streaming = StreamingConfig {
         chunk_size: 32.0,

@@ -82,7 +82,7 @@ fn world(path: Path, density: f64) -> (App, Entity) {
         Path::Instanced => ScatterClass::instanced(
             LayerDensity::Constant(density),
             Handle::default(),
-            InstancedMaterial::default(),
+            InstancedShading::default(),
         ),
         Path::Entities => ScatterClass::new(
             LayerDensity::Constant(density),

@@ -131,7 +131,7 @@
 //! app.cleanup();
 //! app.world_mut().spawn((RwtViewer::all_around(), Transform::default(), GlobalTransform::default()));
 //! let stones = ScatterClass::new(LayerDensity::Constant(0.5), Handle::default(), Handle::default());
-//! let grass = ScatterClass::instanced(LayerDensity::Constant(20.0), Handle::default(), InstancedMaterial::default());
+//! let grass = ScatterClass::instanced(LayerDensity::Constant(20.0), Handle::default(), InstancedShading::default());
 //! let streaming = StreamingConfig { chunk_size: 16.0, load_distance: 32.0, unload_distance: 40.0, near_distance: 16.0 };
 //! app.world_mut().spawn(ScatterLayer::new(vec![stones, grass]).with_streaming(streaming));
 //! // Chunks are generated on the async compute pool: run frames until they have landed.
@@ -171,7 +171,7 @@ pub use layers::{
     ScatterLayerStatus,
 };
 pub use look::{
-    ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedMaterial, InstancedShadows,
+    ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedShading, InstancedShadows,
     MeshLod, Pose,
 };
 pub use rwt_core;
@@ -195,7 +195,7 @@ pub mod prelude {
     pub use crate::picking::{PickFilter, ScatterHit, ScatterPicking};
     pub use crate::{
         AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundMap,
-        GroundPlane, HeightSource, InstancedChunk, InstancedMaterial, InstancedShadows,
+        GroundPlane, HeightSource, InstancedChunk, InstancedShading, InstancedShadows,
         LayerDensity, RwtDiagnosticsPlugin, RwtFadeIn, RwtInstancingPlugin, RwtLayersPlugin,
         RwtPlugins, RwtSettings, RwtStats, RwtStreamingPlugin, RwtSystems, RwtViewer,
         RwtViewersPlugin, RwtWind, ScatterClass, ScatterEntity, ScatterLayer, ScatterLayerStatus,

@@ -20,7 +20,7 @@ fn two_class_layer(app: &mut App, instanced: bool) -> Handle<Image> {
     let (map, painted) = gray_map(app, 0.8);
     let bushes = ScatterClass::new(LayerDensity::Constant(0.05), default(), default());
     let grass = if instanced {
-        ScatterClass::instanced(painted, default(), InstancedMaterial::default())
+        ScatterClass::instanced(painted, default(), InstancedShading::default())
     } else {
         ScatterClass::new(painted, default(), default())
     };
@@ -340,7 +340,7 @@ fn textures_that_cannot_be_drawn_are_reported_per_class() {
     let integer = images.add(texture(d2, 1, TextureFormat::R32Uint));
     let volume = images.add(texture(TextureDimension::D3, 4, TextureFormat::Rgba8Unorm));
     let class = |mesh: &Handle<Mesh>, image: Option<&Handle<Image>>| {
-        let material = InstancedMaterial {
+        let material = InstancedShading {
             texture: image.cloned(),
             ..default()
         };

@@ -23,7 +23,7 @@ fn orchard(app: &mut App) -> Entity {
     let trees = ScatterClass::instanced(
         LayerDensity::Constant(0.08),
         default(),
-        InstancedMaterial::default(),
+        InstancedShading::default(),
     )
     .with_promotion(DISTANCE, |e| {
         e.insert(Trunk);

@@ -61,7 +61,7 @@ fn components_resources_and_messages_are_registered() {
     assert!(registered::<PaintDab>(&registry));
     // Field types come with the types that hold them.
     assert!(registered::<LayerDensity>(&registry));
-    assert!(registered::<InstancedMaterial>(&registry));
+    assert!(registered::<InstancedShading>(&registry));
     assert!(registered::<StreamingConfig>(&registry));
 }
 

@@ -23,7 +23,7 @@
 //!     let density = LayerDensity::Image(map);
 //!     let flowers = commands.spawn((
 //!         Name::new("flowers"),
-//!         ScatterLayer::new(vec![ScatterClass::instanced(density, Handle::default(), InstancedMaterial::default())]),
+//!         ScatterLayer::new(vec![ScatterClass::instanced(density, Handle::default(), InstancedShading::default())]),
 //!     )).id();
 //!     brush.targets.push(BrushTarget::new(flowers, 0, "flowers"));
 //!     brush.enabled = true;

@@ -5,7 +5,7 @@
 //! [`BEND_FIELD_TEXELS`]² texels of [`BEND_TEXEL`] metres centred on the main camera. The
 //! field relaxes towards upright over [`BEND_RECOVERY`] seconds, so a bender leaves a trail
 //! that straightens behind it. The vertex shader turns each instance of a class with a
-//! [`InstancedMaterial::bend_response`](crate::InstancedMaterial::bend_response) about its
+//! [`InstancedShading::bend_response`](crate::InstancedShading::bend_response) about its
 //! root by the lean it reads at its root. The cost is bounded whatever the number of
 //! benders: a 32 KB texture uploaded once a frame, one texture read per vertex, and on the
 //! CPU the texels each bender covers. Blades farther than half the field's side (16 m) from

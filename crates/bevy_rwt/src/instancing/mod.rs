@@ -29,7 +29,7 @@ pub use plugin::RwtInstancingPlugin;
 pub use promote::PromotedInstance;
 pub(crate) use queue::{InstancedQueue, Upload};
 
-use crate::look::InstancedMaterial;
+use crate::look::InstancedShading;
 use bevy::camera::primitives::Aabb;
 use bevy::camera::visibility::{self, VisibilityClass};
 use bevy::prelude::*;
@@ -141,7 +141,7 @@ pub struct InstancedChunk {
     /// The class's meshes: near, and far with its distance.
     pub meshes: (Handle<Mesh>, Option<crate::look::InstancedFar>),
     /// The shading.
-    pub material: InstancedMaterial,
+    pub material: InstancedShading,
     /// Height of the mesh's top above its origin (the tip, which sways most).
     pub mesh_top: f32,
     /// Largest scale of the class's instances (for the chunk's bounds).

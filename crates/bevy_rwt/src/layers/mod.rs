@@ -18,7 +18,7 @@ pub use status::{
 
 use crate::edits::ScatterEdits;
 use crate::look::{
-    ClassLook, GroundPlane, InstanceInserter, InstancedFar, InstancedLook, InstancedMaterial,
+    ClassLook, GroundPlane, InstanceInserter, InstancedFar, InstancedLook, InstancedShading,
     MeshLod,
 };
 use bevy::prelude::*;
@@ -180,7 +180,7 @@ impl ScatterClass {
     pub fn instanced(
         density: LayerDensity,
         mesh: Handle<Mesh>,
-        material: InstancedMaterial,
+        material: InstancedShading,
     ) -> Self {
         Self::with_look(
             density,

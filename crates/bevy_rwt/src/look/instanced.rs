@@ -30,14 +30,15 @@ impl InstancedShadows {
     }
 }
 
-/// [`InstancedMaterial::alpha_cutoff`]'s default.
+/// [`InstancedShading::alpha_cutoff`]'s default.
 pub const DEFAULT_ALPHA_CUTOFF: f32 = 0.5;
 
 /// How an instanced class is shaded: a blade-like gradient from root to tip, lit by the
-/// scene's lights, with a hashed colour variation per instance.
+/// scene's lights, with a hashed colour variation per instance. Not a Bevy `Material`: the
+/// instanced renderer draws it with its own pipeline (see [`crate::instancing`]).
 #[derive(Clone, Debug, PartialEq, Reflect)]
 #[reflect(Clone, Debug, Default, PartialEq)]
-pub struct InstancedMaterial {
+pub struct InstancedShading {
     /// Colour at the root (the mesh's lowest point).
     pub base_color: Color,
     /// Colour at the tip (the mesh's highest point).
@@ -74,7 +75,7 @@ pub struct InstancedMaterial {
     pub bend_response: f32,
 }
 
-impl Default for InstancedMaterial {
+impl Default for InstancedShading {
     fn default() -> Self {
         Self {
             base_color: Color::srgb(0.10, 0.22, 0.04),
@@ -100,7 +101,7 @@ pub struct InstancedLook {
     /// root is its lowest point and the tip its highest.
     pub mesh: Handle<Mesh>,
     /// Its shading.
-    pub material: InstancedMaterial,
+    pub material: InstancedShading,
     /// A cheaper mesh for far chunks, if any.
     pub far: Option<InstancedFar>,
 }

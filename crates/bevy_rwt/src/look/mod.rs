@@ -12,7 +12,7 @@ pub use blade::blade_mesh;
 pub use check::{InstancedClassError, check_instanced_mesh};
 pub(crate) use check::{check_texture, check_topology};
 pub use instanced::{
-    DEFAULT_ALPHA_CUTOFF, InstancedFar, InstancedLook, InstancedMaterial, InstancedShadows,
+    DEFAULT_ALPHA_CUTOFF, InstancedFar, InstancedLook, InstancedShading, InstancedShadows,
 };
 
 use bevy::camera::visibility::VisibilityRange;

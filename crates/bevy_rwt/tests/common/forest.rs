@@ -15,11 +15,11 @@ pub fn forest(app: &mut App) -> (Entity, Handle<Image>) {
     let (map, painted) = gray_map(app, 0.8);
     let tree = ScatterClass::new(LayerDensity::Constant(0.05), default(), default());
     let stump = ScatterClass::new(LayerDensity::Constant(0.0), default(), default());
-    let grass = ScatterClass::instanced(painted, default(), InstancedMaterial::default());
+    let grass = ScatterClass::instanced(painted, default(), InstancedShading::default());
     let clover = ScatterClass::instanced(
         LayerDensity::Constant(0.0),
         default(),
-        InstancedMaterial::default(),
+        InstancedShading::default(),
     );
     let mut l = layer(LayerDensity::Constant(0.0)).with_falloff(10.0, 70.0);
     l.classes = vec![tree, stump, grass, clover];

@@ -1,7 +1,7 @@
 //! Layers back to layer files: [`LayerDescription::describe`].
 
 use super::{
-    ClassDescription, DensityDescription, HeightDescription, InstancedMaterialDescription,
+    ClassDescription, DensityDescription, HeightDescription, InstancedShadingDescription,
     LayerDescription, LayerFileError, LayerPart, LodDescription, MapDescription,
     MaterialDescription, MeshDescription, NamedAssets, Undescribable,
 };
@@ -77,7 +77,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
         let (mesh, material) = match &c.look {
             ClassLook::Mesh { mesh, material } => (self.mesh(mesh)?, self.material(material)?),
             ClassLook::Instanced(look) => {
-                let mut material = InstancedMaterialDescription::from(&look.material);
+                let mut material = InstancedShadingDescription::from(&look.material);
                 if let Some(texture) = &look.material.texture {
                     material.texture = Some(self.image(texture)?);
                 }
@@ -95,7 +95,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
         let lod = match (&c.lod, far) {
             (_, Some(far)) => Some(LodDescription {
                 mesh: self.mesh(&far.mesh)?,
-                material: MaterialDescription::Instanced(InstancedMaterialDescription::default()),
+                material: MaterialDescription::Instanced(InstancedShadingDescription::default()),
                 distance: far.distance,
                 crossfade: None,
             }),

@@ -74,7 +74,7 @@ use super::{
     DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap, HeightSource, LayerDensity,
     ScatterClass, ScatterLayer,
 };
-use crate::look::{GroundPlane, InstancedMaterial, InstancedShadows, MeshLod, blade_mesh};
+use crate::look::{GroundPlane, InstancedShading, InstancedShadows, MeshLod, blade_mesh};
 use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::Falloff;
@@ -207,47 +207,47 @@ pub enum MaterialDescription {
     /// A plain colour.
     Color(f32, f32, f32),
     /// The class is instanced (no entity per instance; see [`crate::instancing`]), shaded so.
-    Instanced(InstancedMaterialDescription),
+    Instanced(InstancedShadingDescription),
 }
 
 /// The shading of an instanced class in a layer file (colours linear RGB); each field
-/// defaults to [`InstancedMaterial::default`]'s.
+/// defaults to [`InstancedShading::default`]'s.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 #[serde(default)]
-pub struct InstancedMaterialDescription {
+pub struct InstancedShadingDescription {
     /// Colour at the root.
     pub base: (f32, f32, f32),
     /// Colour at the tip.
     pub tip: (f32, f32, f32),
-    /// See [`InstancedMaterial::color_variation`].
+    /// See [`InstancedShading::color_variation`].
     pub color_variation: f32,
-    /// See [`InstancedMaterial::roughness`].
+    /// See [`InstancedShading::roughness`].
     pub roughness: f32,
-    /// See [`InstancedMaterial::wind_response`].
+    /// See [`InstancedShading::wind_response`].
     pub wind_response: f32,
-    /// See [`InstancedMaterial::fade_band`].
+    /// See [`InstancedShading::fade_band`].
     pub fade_band: f32,
-    /// See [`InstancedMaterial::tip_from`].
+    /// See [`InstancedShading::tip_from`].
     pub tip_from: f32,
-    /// See [`InstancedMaterial::shadows`]: `Off`, `On` or `Within(30.0)`.
+    /// See [`InstancedShading::shadows`]: `Off`, `On` or `Within(30.0)`.
     pub shadows: InstancedShadows,
-    /// See [`InstancedMaterial::bend_response`].
+    /// See [`InstancedShading::bend_response`].
     pub bend_response: f32,
-    /// Asset path of the base-colour texture ([`InstancedMaterial::texture`]), e.g.
+    /// Asset path of the base-colour texture ([`InstancedShading::texture`]), e.g.
     /// `"foliage/fern.png"`.
     pub texture: Option<String>,
-    /// See [`InstancedMaterial::alpha_cutoff`].
+    /// See [`InstancedShading::alpha_cutoff`].
     pub alpha_cutoff: f32,
 }
 
-impl Default for InstancedMaterialDescription {
+impl Default for InstancedShadingDescription {
     fn default() -> Self {
-        Self::from(&InstancedMaterial::default())
+        Self::from(&InstancedShading::default())
     }
 }
 
-impl From<&InstancedMaterial> for InstancedMaterialDescription {
-    fn from(m: &InstancedMaterial) -> Self {
+impl From<&InstancedShading> for InstancedShadingDescription {
+    fn from(m: &InstancedShading) -> Self {
         let linear = |c: Color| {
             let c = c.to_linear();
             (c.red, c.green, c.blue)
@@ -269,11 +269,11 @@ impl From<&InstancedMaterial> for InstancedMaterialDescription {
     }
 }
 
-impl InstancedMaterialDescription {
+impl InstancedShadingDescription {
     /// The material it describes; `image` loads the texture by its path.
-    pub fn to_material(&self, image: impl FnOnce(&str) -> Handle<Image>) -> InstancedMaterial {
+    pub fn to_material(&self, image: impl FnOnce(&str) -> Handle<Image>) -> InstancedShading {
         let color = |(r, g, b): (f32, f32, f32)| Color::linear_rgb(r, g, b);
-        InstancedMaterial {
+        InstancedShading {
             base_color: color(self.base),
             tip_color: color(self.tip),
             color_variation: self.color_variation,

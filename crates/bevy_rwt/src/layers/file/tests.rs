@@ -127,7 +127,7 @@ fn instanced_classes_in_a_layer_file() {
     };
     assert_eq!(look.material.tip_color, Color::linear_rgb(0.3, 0.5, 0.1));
     assert_eq!(look.material.fade_band, 0.2);
-    let defaults = InstancedMaterial::default();
+    let defaults = InstancedShading::default();
     assert_eq!(look.material.roughness, defaults.roughness);
     assert_eq!(layer.classes[0].scale_variation, 0.3);
     let ClassLook::Instanced(plain) = &layer.classes[1].look else {
@@ -190,7 +190,7 @@ fn code_layer(names: &NamedAssets, map: &Handle<Image>) -> ScatterLayer {
     let mut flower = ScatterClass::instanced(
         painted,
         bush.clone(),
-        InstancedMaterial {
+        InstancedShading {
             tip_from: 0.8,
             shadows: InstancedShadows::Off,
             ..default()
