@@ -317,7 +317,9 @@ pub(crate) fn slope(height: &HeightFn, p: Vec2, step: f32) -> f32 {
 }
 
 /// A scatter layer: instances of its classes, streamed around every [`crate::RwtViewer`].
-/// Removing the component (or despawning its entity) despawns all its instances.
+/// Removing the component (or despawning its entity) despawns all its instances. Changing
+/// it in place (an inspector, a `Mut<ScatterLayer>` dereferenced mutably) streams it anew
+/// with the new settings, as inserting a new one does: touch it mutably only to change it.
 #[derive(Component, Clone, Debug, Reflect)]
 #[reflect(Component, Clone, Debug)]
 #[require(Transform, Visibility, ScatterLayerStatus, ScatterEdits)]
