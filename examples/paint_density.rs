@@ -138,10 +138,17 @@ impl Canvas {
     }
 }
 
-/// The value of every texel of a map painted by the brush (linear grey), row 0 at the top.
-fn map_values(image: &Image) -> Option<Vec<f32>> {
-    let data = image.data.as_ref()?;
-    Some(data.chunks_exact(4).map(|p| p[0] as f32 / 255.0).collect())
+impl Canvas {
+    /// Each class map's texel values (linear grey, as the brush paints them; row 0 at the
+    /// top), empty for a map not loaded.
+    fn values(&self, images: &Assets<Image>) -> Vec<Vec<f32>> {
+        let values = |image: &Image| -> Option<Vec<f32>> {
+            let data = image.data.as_ref()?;
+            Some(data.chunks_exact(4).map(|p| p[0] as f32 / 255.0).collect())
+        };
+        let map = |m: &GroundMap| images.get(&m.image).and_then(values).unwrap_or_default();
+        self.maps.iter().map(map).collect()
+    }
 }
 
 fn save_dir() -> PathBuf {
@@ -348,16 +355,7 @@ fn compare_with_random(
         return;
     }
     commands.entity(canvas.layer).remove::<ScatterLayer>();
-    let maps: Vec<Vec<f32>> = canvas
-        .maps
-        .iter()
-        .map(|m| {
-            images
-                .get(&m.image)
-                .and_then(map_values)
-                .unwrap_or_default()
-        })
-        .collect();
+    let maps = canvas.values(&images);
     let total: f64 = CLASSES.iter().map(|c| c.max_density).sum();
     let n = MAP_TEXELS as usize;
     for k in 0..total as u64 {
@@ -407,16 +405,7 @@ fn show_maps(
     if !maps_changed(&canvas, &mut events) {
         return;
     }
-    let maps: Vec<Vec<f32>> = canvas
-        .maps
-        .iter()
-        .map(|m| {
-            images
-                .get(&m.image)
-                .and_then(map_values)
-                .unwrap_or_default()
-        })
-        .collect();
+    let maps = canvas.values(&images);
     let Some(mut overlay) = images.get_mut(&canvas.overlay) else {
         return;
     };

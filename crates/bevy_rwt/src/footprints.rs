@@ -117,15 +117,8 @@ impl Footprint {
     /// The footprint placed by `transform` on `plane`, in world ground coordinates.
     pub fn on_ground(&self, transform: &GlobalTransform, plane: GroundPlane) -> GroundFootprint {
         let to_ground = |local: Vec2| -> DVec2 {
-            let local3 = match plane {
-                GroundPlane::Xz => Vec3::new(local.x, 0.0, local.y),
-                GroundPlane::Xy => Vec3::new(local.x, local.y, 0.0),
-            };
-            let w = transform.transform_point(local3);
-            match plane {
-                GroundPlane::Xz => DVec2::new(w.x as f64, w.z as f64),
-                GroundPlane::Xy => DVec2::new(w.x as f64, w.y as f64),
-            }
+            let w = transform.transform_point(plane.point_at(local, 0.0));
+            plane.ground_of(w).as_dvec2()
         };
         let margin = self.margin.max(0.0) as f64;
         let shape = match &self.shape {

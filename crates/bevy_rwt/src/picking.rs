@@ -294,10 +294,7 @@ impl ClassBounds {
 /// The ray's path over the ground from its origin to `length` along it (plane coordinates).
 fn ground_segment(ray: Ray3d, length: f32, plane: GroundPlane) -> (DVec2, DVec2) {
     let end = ray.origin + *ray.direction * length;
-    let flat = |v: Vec3| match plane {
-        GroundPlane::Xz => DVec2::new(v.x as f64, v.z as f64),
-        GroundPlane::Xy => DVec2::new(v.x as f64, v.y as f64),
-    };
+    let flat = |v: Vec3| plane.ground_of(v).as_dvec2();
     (flat(ray.origin), flat(end))
 }
 

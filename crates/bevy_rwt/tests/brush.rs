@@ -19,14 +19,7 @@ fn painted_app() -> (App, Handle<Image>) {
         app.add_plugins(RwtBrushPlugin::default());
     });
     spawn_viewer(&mut app, Vec3::ZERO);
-    let map = bevy_rwt::brush::blank_map(
-        &mut app.world_mut().resource_mut::<Assets<Image>>(),
-        64,
-        Rect::from_center_size(Vec2::ZERO, Vec2::splat(128.0)),
-        1.0,
-    );
-    let density = LayerDensity::Image(map.clone());
-    let map = map.image;
+    let (map, density) = blank_canvas(&mut app);
     let meadow = app
         .world_mut()
         .spawn((Name::new("meadow"), layer(density)))
@@ -649,15 +642,10 @@ fn a_layer_on_the_2d_plane_is_painted_saved_and_loaded() {
         app.add_plugins(RwtBrushPlugin::default());
     });
     spawn_viewer(&mut app, Vec3::ZERO);
-    let map = bevy_rwt::brush::blank_map(
-        &mut app.world_mut().resource_mut::<Assets<Image>>(),
-        64,
-        Rect::from_center_size(Vec2::ZERO, Vec2::splat(128.0)),
-        1.0,
-    );
+    let (_, density) = blank_canvas(&mut app);
     let sprites = app
         .world_mut()
-        .spawn(layer(LayerDensity::Image(map)).on_plane(GroundPlane::Xy))
+        .spawn(layer(density).on_plane(GroundPlane::Xy))
         .id();
     {
         let mut brush = app.world_mut().resource_mut::<DensityBrush>();

@@ -66,14 +66,7 @@ fn every_part_runs_in_the_schedule_it_is_given_the_brush_first() {
             .enable::<RwtBrushPlugin>(),
     );
     spawn_viewer(&mut app, Vec3::ZERO);
-    let map = bevy_rwt::brush::blank_map(
-        &mut app.world_mut().resource_mut::<Assets<Image>>(),
-        64,
-        Rect::from_center_size(Vec2::ZERO, Vec2::splat(128.0)),
-        1.0,
-    );
-    let density = LayerDensity::Image(map.clone());
-    let map = map.image;
+    let (map, density) = blank_canvas(&mut app);
     let meadow = app.world_mut().spawn(layer(density)).id();
     app.world_mut().spawn(layer(LayerDensity::Constant(0.2)));
     app.world_mut().resource_mut::<DensityBrush>().targets =

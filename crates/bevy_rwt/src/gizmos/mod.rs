@@ -31,10 +31,7 @@ impl Default for RwtGizmos {
 }
 
 fn square(gizmos: &mut Gizmos, plane: GroundPlane, min: Vec2, size: f32, lift: f32, color: Color) {
-    let corner = |u: f32, v: f32| match plane {
-        GroundPlane::Xz => Vec3::new(u, lift, v),
-        GroundPlane::Xy => Vec3::new(u, v, lift),
-    };
+    let corner = |u: f32, v: f32| plane.point_at(Vec2::new(u, v), lift);
     let corners = [
         corner(min.x, min.y),
         corner(min.x + size, min.y),

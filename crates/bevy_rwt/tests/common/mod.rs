@@ -123,6 +123,18 @@ pub fn instances(app: &mut App) -> HashMap<PointId, Vec3> {
     out
 }
 
+/// The brush's blank 64-texel map over -64..64 (x and z) at up to 1 instance per square
+/// unit, and the layer density reading it.
+pub fn blank_canvas(app: &mut App) -> (Handle<Image>, LayerDensity) {
+    let map = bevy_rwt::brush::blank_map(
+        &mut app.world_mut().resource_mut::<Assets<Image>>(),
+        64,
+        Rect::from_center_size(Vec2::ZERO, Vec2::splat(128.0)),
+        1.0,
+    );
+    (map.image.clone(), LayerDensity::Image(map))
+}
+
 /// A mid-grey 64-texel density map over -64..64 (x and z) times `scale`, and the layer
 /// density reading it.
 pub fn gray_map(app: &mut App, scale: f64) -> (Handle<Image>, LayerDensity) {

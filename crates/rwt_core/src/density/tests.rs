@@ -322,47 +322,22 @@ fn transparent_pixels_have_no_density() {
     }
     let img = ::image::DynamicImage::ImageRgba8(rgba);
     let at = |d: &ImageDensity, x: f64| d.value(DVec2::new(x + 0.5, 0.5));
-    let light = ImageDensity::from_image(
-        &img,
-        None,
-        false,
-        Placement {
-            min: DVec2::ZERO,
-            size: DVec2::new(4.0, 1.0),
-            scale: 1.0,
-        },
-    )
-    .unwrap();
+    let strip = Placement {
+        min: DVec2::ZERO,
+        size: DVec2::new(4.0, 1.0),
+        scale: 1.0,
+    };
+    let light = ImageDensity::from_image(&img, None, false, strip).unwrap();
     assert!((at(&light, 0.0) - 1.0).abs() < 1e-6);
     assert_eq!(at(&light, 1.0), 0.0);
     assert!((at(&light, 2.0) - 128.0 / 255.0).abs() < 1e-6);
     assert_eq!(at(&light, 3.0), 0.0);
     // Dark pixels dense (`dark:`), transparent ones still empty.
-    let dark = ImageDensity::from_image(
-        &img,
-        None,
-        true,
-        Placement {
-            min: DVec2::ZERO,
-            size: DVec2::new(4.0, 1.0),
-            scale: 1.0,
-        },
-    )
-    .unwrap();
+    let dark = ImageDensity::from_image(&img, None, true, strip).unwrap();
     assert_eq!(at(&dark, 1.0), 0.0);
     assert!((at(&dark, 3.0) - 1.0).abs() < 1e-6);
     // An explicit channel is that channel: the alpha channel itself here.
-    let alpha = ImageDensity::from_image(
-        &img,
-        Some(3),
-        false,
-        Placement {
-            min: DVec2::ZERO,
-            size: DVec2::new(4.0, 1.0),
-            scale: 1.0,
-        },
-    )
-    .unwrap();
+    let alpha = ImageDensity::from_image(&img, Some(3), false, strip).unwrap();
     assert_eq!(at(&alpha, 1.0), 0.0);
     assert!((at(&alpha, 0.0) - 1.0).abs() < 1e-6);
 }
