@@ -2,7 +2,7 @@
 
 use crate::draw::Canvas;
 use glam::DVec2;
-use rwt_core::analysis::{Spectrum, reference, rho};
+use rwt_core::analysis::{Spectrum, WindowAnalysis, WindowGrid, reference};
 use std::path::Path;
 
 /// One row of the comparison table.
@@ -26,14 +26,10 @@ pub fn compare(windows: &[(DVec2, Vec<DVec2>)], side: f64, size: usize) -> Vec<R
     let count = (windows.iter().map(|w| w.1.len()).sum::<usize>() / windows.len().max(1)).max(1);
     let density = count as f64 / (side * side);
     let row = |name, wins: &[(DVec2, Vec<DVec2>)]| {
-        let spectrum = Spectrum::averaged(wins, side, size);
-        let r = wins
-            .iter()
-            .filter_map(|(_, p)| rho(p, p.len() as f64 / (side * side)))
-            .fold(f64::INFINITY, f64::min);
+        let WindowAnalysis { rho, spectrum, .. } = WindowAnalysis::of(wins, side, size);
         Row {
             name,
-            rho: r,
+            rho,
             low_frequency: spectrum.low_frequency_power(side, density, 0.5),
             mean_anisotropy: spectrum.mean_anisotropy(2),
             max_anisotropy: spectrum.max_anisotropy(2),
@@ -84,11 +80,6 @@ pub fn print_table(rows: &[Row]) {
     }
 }
 
-/// Most points of one analysis window: a window's periodogram costs its points times 128^2,
-/// and each reference is made as large, so larger files are analysed in windows of this
-/// many points (memory and time stay bounded however large the file).
-const MAX_WINDOW_POINTS: f64 = 20_000.0;
-
 /// Calls `f` with every point of the file (`x y` first on each line; lines with fewer than
 /// two fields are skipped), streaming it; returns how many.
 fn for_each_point(path: &Path, mut f: impl FnMut(DVec2)) -> Result<usize, String> {
@@ -127,28 +118,14 @@ pub fn run(path: &Path, plot: Option<&Path>) -> Result<(), String> {
             path.display()
         ));
     }
-    let side_all = (hi - lo).min_element();
-    if side_all.is_nan() || side_all <= 0.0 {
+    let Some(grid) = WindowGrid::new(lo, hi, count) else {
         return Err("points span no area".into());
-    }
-    // Up to 4x4 square windows, each with at least ~500 points and at most
-    // MAX_WINDOW_POINTS.
-    let per_axis = ((count as f64 / 500.0).sqrt().floor() as usize).clamp(1, 4);
-    let cell = side_all / per_axis as f64;
-    let density = count as f64 / ((hi.x - lo.x) * (hi.y - lo.y));
-    let side = cell.min((MAX_WINDOW_POINTS / density).sqrt());
-    let origins: Vec<DVec2> = (0..per_axis * per_axis)
-        .map(|k| lo + DVec2::new((k % per_axis) as f64, (k / per_axis) as f64) * cell)
-        .collect();
-    let mut windows: Vec<(DVec2, Vec<DVec2>)> = origins.iter().map(|&o| (o, Vec::new())).collect();
+    };
+    let (side, density) = (grid.side, grid.density);
+    let mut windows = grid.split(std::iter::empty());
     for_each_point(path, |p| {
-        let k = ((p - lo) / cell).floor();
-        let (i, j) = (k.x as usize, k.y as usize);
-        if i < per_axis && j < per_axis {
-            let (o, w) = &mut windows[j * per_axis + i];
-            if p.x < o.x + side && p.y < o.y + side {
-                w.push(p);
-            }
+        if let Some(k) = grid.window_of(p) {
+            windows[k].1.push(p);
         }
     })?;
     say!(

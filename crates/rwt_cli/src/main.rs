@@ -57,7 +57,7 @@ enum Command {
         #[arg(long, default_value_t = 1.0)]
         tile_size: f64,
         /// Refuse queries that may produce more points than this.
-        #[arg(long, default_value_t = 50_000_000)]
+        #[arg(long, default_value_t = rwt_core::query::DEFAULT_BUDGET)]
         budget: usize,
         /// Output file (default: standard output).
         #[arg(long)]

@@ -6,7 +6,9 @@ pub mod check;
 pub mod reference;
 mod spectrum;
 mod statistics;
+mod windows;
 
 pub use crate::geometry::hex_spacing;
 pub use spectrum::Spectrum;
 pub use statistics::{min_distance, nearest_neighbour_distances, rho};
+pub use windows::{MAX_WINDOW_POINTS, WindowAnalysis, WindowGrid};

@@ -50,6 +50,10 @@ pub const MAX_TILE_COORDINATE: f64 = 1.0e12;
 /// [`QueryError::Precision`].
 pub const MIN_SPACING_ULPS: f64 = 256.0;
 
+/// Most points (or base tiles visited) one query may produce unless
+/// [`Sampler::with_budget`] says otherwise: 50 million, about 2 GB of points.
+pub const DEFAULT_BUDGET: usize = 50_000_000;
+
 /// Hash stream of the per-base-tile rank offsets.
 const OFFSET_STREAM: u64 = 0x0ff5_e7a1_u64;
 
@@ -134,7 +138,7 @@ pub struct Sampler {
 
 impl Sampler {
     /// A sampler over `set`'s tiling for `seed`, with base tiles 1 world unit wide and a
-    /// budget of 50 million points per query.
+    /// budget of [`DEFAULT_BUDGET`] points per query.
     pub fn new(set: &TileSet, seed: u64) -> Self {
         let tiles = set
             .tiles
@@ -149,7 +153,7 @@ impl Sampler {
             colors: set.colors,
             seed,
             tile_size: 1.0,
-            budget: 50_000_000,
+            budget: DEFAULT_BUDGET,
             fingerprint: set.fingerprint(),
         }
     }

@@ -1,0 +1,140 @@
+//! Square windows over a rectangle of points, for averaged spectra and the minimum distance.
+
+use super::{Spectrum, rho};
+use glam::DVec2;
+
+/// Most points of one analysis window: a window's periodogram costs its points times the
+/// spectrum's size squared, so larger sets are analysed in windows of about this many
+/// points (memory and time stay bounded however many points there are).
+pub const MAX_WINDOW_POINTS: f64 = 20_000.0;
+
+/// Up to 4 x 4 square windows laid from a rectangle's lower corner, each with at least
+/// about 500 of its points and at most about [`MAX_WINDOW_POINTS`]: what an analysis of the
+/// rectangle's points averages over.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindowGrid {
+    /// The rectangle's lower corner, the first window's origin.
+    pub origin: DVec2,
+    /// Windows per axis.
+    pub per_axis: usize,
+    /// Distance between window origins.
+    pub cell: f64,
+    /// Side of each window (at most `cell`).
+    pub side: f64,
+    /// Points per unit area over the whole rectangle.
+    pub density: f64,
+}
+
+impl WindowGrid {
+    /// The windows for `count` points over `min..max`; `None` when the rectangle has no area
+    /// or no points.
+    pub fn new(min: DVec2, max: DVec2, count: usize) -> Option<Self> {
+        let extent = max - min;
+        let square = extent.min_element();
+        if !(square.is_finite() && square > 0.0) || count == 0 {
+            return None;
+        }
+        let per_axis = ((count as f64 / 500.0).sqrt().floor() as usize).clamp(1, 4);
+        let cell = square / per_axis as f64;
+        let density = count as f64 / (extent.x * extent.y);
+        Some(Self {
+            origin: min,
+            per_axis,
+            cell,
+            side: cell.min((MAX_WINDOW_POINTS / density).sqrt()),
+            density,
+        })
+    }
+
+    /// The window holding `p` (row-major from the origin), if any.
+    pub fn window_of(&self, p: DVec2) -> Option<usize> {
+        let k = ((p - self.origin) / self.cell).floor();
+        if !(k.x >= 0.0 && k.y >= 0.0) {
+            return None;
+        }
+        let (i, j) = (k.x as usize, k.y as usize);
+        if i >= self.per_axis || j >= self.per_axis {
+            return None;
+        }
+        let o = self.origin + DVec2::new(i as f64, j as f64) * self.cell;
+        (p.x < o.x + self.side && p.y < o.y + self.side).then_some(j * self.per_axis + i)
+    }
+
+    /// Every window's origin, with the points of `points` that fall in it.
+    pub fn split(&self, points: impl IntoIterator<Item = DVec2>) -> Vec<(DVec2, Vec<DVec2>)> {
+        let n = self.per_axis;
+        let mut windows: Vec<(DVec2, Vec<DVec2>)> = (0..n * n)
+            .map(|k| {
+                let at = DVec2::new((k % n) as f64, (k / n) as f64);
+                (self.origin + at * self.cell, Vec::new())
+            })
+            .collect();
+        for p in points {
+            if let Some(k) = self.window_of(p) {
+                windows[k].1.push(p);
+            }
+        }
+        windows
+    }
+}
+
+/// The blue-noise figures of one point set, over the windows of a [`WindowGrid`].
+#[derive(Clone, Debug)]
+pub struct WindowAnalysis {
+    /// The smallest normalized minimum distance of any window (each at its own density);
+    /// NaN when no window holds two points.
+    pub rho: f64,
+    /// The averaged periodogram and its radial statistics.
+    pub spectrum: Spectrum,
+    /// The window side the spectrum's frequencies are in units of (`1 / side`).
+    pub side: f64,
+}
+
+impl WindowAnalysis {
+    /// Analyses `windows` of side `side` with a `size x size` periodogram.
+    pub fn of(windows: &[(DVec2, Vec<DVec2>)], side: f64, size: usize) -> Self {
+        let rho = windows
+            .iter()
+            .filter_map(|(_, p)| rho(p, p.len() as f64 / (side * side)))
+            .reduce(f64::min)
+            .unwrap_or(f64::NAN);
+        Self {
+            rho,
+            spectrum: Spectrum::averaged(windows, side, size),
+            side,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn windows_hold_only_their_own_points() {
+        let grid = WindowGrid::new(DVec2::ZERO, DVec2::new(20.0, 10.0), 8_000).unwrap();
+        assert_eq!(grid.per_axis, 4);
+        assert_eq!(grid.cell, 2.5);
+        let points = (0..200).map(|i| DVec2::splat(i as f64 * 0.05));
+        let windows = grid.split(points);
+        assert_eq!(windows.len(), 16);
+        for (origin, pts) in &windows {
+            for p in pts {
+                assert!(
+                    p.x >= origin.x && p.x < origin.x + grid.side,
+                    "{p} {origin}"
+                );
+                assert!(
+                    p.y >= origin.y && p.y < origin.y + grid.side,
+                    "{p} {origin}"
+                );
+            }
+        }
+        // The diagonal runs through the windows i == j only.
+        let used: Vec<usize> = (0..16).filter(|&k| !windows[k].1.is_empty()).collect();
+        assert_eq!(used, vec![0, 5, 10, 15]);
+        assert_eq!(grid.window_of(DVec2::new(-0.1, 1.0)), None);
+        assert_eq!(grid.window_of(DVec2::new(10.0, 1.0)), None);
+        assert!(WindowGrid::new(DVec2::ZERO, DVec2::new(0.0, 1.0), 10).is_none());
+    }
+}

@@ -1,0 +1,41 @@
+"""Type stubs of the native module (called through `rwt`'s Python functions)."""
+
+from typing import Optional, Tuple, Union
+
+import numpy as np
+
+Corners = Tuple[float, float, float, float]
+
+DEFAULT_BUDGET: int
+
+class BudgetError(ValueError):
+    """A request over its point, dot or raster budget, refused before any allocation."""
+
+def query(
+    rect: Corners,
+    density: Union[float, np.ndarray],
+    *,
+    scale: float = 1.0,
+    extent: Optional[Corners] = None,
+    seed: int = 0,
+    tile_size: float = 1.0,
+    budget: int = ...,
+    tileset: Optional[str] = None,
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]: ...
+def stipple(
+    image: np.ndarray,
+    *,
+    dots: Optional[int] = None,
+    radius: Optional[float] = None,
+    gamma: Optional[float] = None,
+    contrast: Optional[float] = None,
+    seed: Optional[int] = None,
+    scale: Optional[float] = None,
+    render: bool = False,
+    max_dots: Optional[int] = None,
+    max_raster_pixels: Optional[int] = None,
+    tileset: Optional[str] = None,
+) -> Tuple[np.ndarray, float, Optional[np.ndarray], Optional[Tuple[float, float]]]: ...
+def analyse(
+    points: np.ndarray, window: Corners, *, size: int = 128
+) -> Tuple[float, float, int, float, np.ndarray, np.ndarray, np.ndarray]: ...

@@ -1,0 +1,312 @@
+"""`rwt.sample`: blue-noise points of any density in a rectangle."""
+
+from __future__ import annotations
+
+import numbers
+import os
+from dataclasses import dataclass
+from typing import Callable, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _rwt
+
+Rect = Tuple[float, float, float, float]
+DensityFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
+Density = Union[float, np.ndarray, DensityFn]
+
+#: Most points one call may produce unless ``budget=`` says otherwise (50 million).
+DEFAULT_BUDGET: int = _rwt.DEFAULT_BUDGET
+
+# A callable density is bounded from its values on a grid of at most this many nodes along
+# the rectangle's longer side (one batch of at most 257 x 257 evaluations).
+_GRID_NODES = 257
+# The bound at a node is the largest value of its 3 x 3 neighbourhood times this.
+_BOUND_MARGIN = 1.5
+# Rounds of raising the bound where a candidate shows the callable above it.
+_BOUND_ROUNDS = 8
+
+
+@dataclass(frozen=True)
+class Sample:
+    """Points of one query; ``len()`` is their number.
+
+    ``points``: positions, shape ``(N, 2)``, float64. ``ids``: a 64-bit identity per point
+    (a hash of the tile it first appears in and its index there), the same in every query
+    that produces the point. ``thresholds``: the density above which each point is present
+    (points per unit area). ``scale``: the factor the density was multiplied by (1.0 unless
+    ``n=`` was given).
+    """
+
+    points: np.ndarray
+    ids: np.ndarray
+    thresholds: np.ndarray
+    scale: float
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+
+def sample(
+    rect: Sequence[float],
+    density: Density,
+    *,
+    seed: int = 0,
+    n: Optional[int] = None,
+    tileset: Optional[Union[str, os.PathLike]] = None,
+    extent: Optional[Sequence[float]] = None,
+    max_density: Optional[float] = None,
+    tile_size: Optional[float] = None,
+    budget: int = DEFAULT_BUDGET,
+) -> Sample:
+    """Blue-noise points in ``rect`` following ``density`` (points per unit area).
+
+    ``rect`` is ``(x0, y0, x1, y1)``, half-open: a point on ``x1`` or ``y1`` belongs to
+    the next rectangle, so the points of adjacent rectangles are exactly those of their
+    union. ``density`` is one of:
+
+    - a number: the same density everywhere;
+    - a 2-D array spread over ``extent`` (``rect`` by default), bilinear between texel
+      centres; row 0 is the top edge (largest y), as in an image; zero outside ``extent``;
+    - a callable ``f(x, y)`` taking two 1-D float64 arrays and returning an array of the
+      same shape. It is called in batches: once on a grid that bounds it, then on the
+      candidate points; a point is kept exactly where ``f`` at its position exceeds its
+      threshold, as for the other kinds. A known upper bound ``max_density=`` replaces the
+      grid (then the result is exact for any ``f``; without it, features narrower than
+      1/256 of the rectangle may be missed).
+
+    The same arguments always give the same arrays. Raising the density anywhere only adds
+    points. With ``n``, exactly ``n`` points are returned, the density scaled to fit
+    (``Sample.scale``), in the order in which they appear as the density grows: the first
+    ``k`` of them are the result for ``n=k``.
+
+    ``seed`` picks one of many independent point sets; ``tileset`` is a tile set file made
+    by ``rwt tileset build`` (default: the one built in). ``tile_size`` is the width of a
+    base tile in rectangle units (``rwt points --tile-size``); the points depend on it. By
+    default it is :func:`auto_tile_size` of ``rect``, so that the points are blue noise at
+    any density down to a few points per rectangle, whatever its units; queries meant to
+    combine (chunks of one rectangle, points to match ``rwt points``) give the same
+    ``tile_size`` explicitly. A query that may produce more than ``budget`` points raises
+    :class:`rwt.BudgetError` before allocating them.
+
+    >>> import rwt
+    >>> s = rwt.sample((0, 0, 10, 10), 5.0, seed=1)
+    >>> s.points.shape[1], 400 < len(s) < 600
+    (2, True)
+    >>> len(rwt.sample((0, 0, 10, 10), lambda x, y: 2.0 * x, n=100))
+    100
+    """
+    box = _rect(rect, "rect")
+    tile = auto_tile_size(box) if tile_size is None else _positive(tile_size, "tile_size")
+    opts = dict(seed=_count(seed, "seed"), tile_size=tile,
+                budget=_count(budget, "budget"),
+                tileset=None if tileset is None else os.fspath(tileset))
+    if extent is not None and (callable(density) or isinstance(density, numbers.Real)):
+        raise ValueError("extent places a density array; this density is not an array")
+    if max_density is not None and not callable(density):
+        raise ValueError("max_density bounds a callable density; this density is not one")
+    points_at, estimate = _density_source(box, density, extent, max_density, opts)
+    if n is None:
+        pos, ids, thr, _ = points_at(1.0)
+        return Sample(pos, ids, thr, 1.0)
+    return _first_n(points_at, _count(n, "n"), estimate)
+
+
+def auto_tile_size(rect: Sequence[float]) -> float:
+    """The base tile width :func:`sample` uses by default for ``rect``: the smallest power
+    of two at least as long as its longer side (1 for an empty rectangle), so that the
+    rectangle lies in at most 2 x 2 base tiles and the tiles' recursive subdivision gives
+    blue noise at every density. (Tiles much smaller than the point spacing give white
+    noise: a tile's first points are drawn from a handful of positions.)"""
+    x0, y0, x1, y1 = _rect(rect, "rect")
+    longest = max(x1 - x0, y1 - y0)
+    if longest <= 0:
+        return 1.0
+    return float(2.0 ** np.ceil(np.log2(longest)))
+
+
+def _rect(rect: Sequence[float], what: str) -> Rect:
+    try:
+        x0, y0, x1, y1 = (float(v) for v in rect)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be four numbers (x0, y0, x1, y1), got {rect!r}") from None
+    if not all(np.isfinite([x0, y0, x1, y1])):
+        raise ValueError(f"{what} {(x0, y0, x1, y1)} is not finite")
+    if x1 < x0 or y1 < y0:
+        raise ValueError(f"{what} {(x0, y0, x1, y1)} is inverted (x1 < x0 or y1 < y0)")
+    return (x0, y0, x1, y1)
+
+
+def _count(v: object, what: str) -> int:
+    if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < 0:
+        raise ValueError(f"{what} must be a non-negative integer, got {v!r}")
+    return int(v)
+
+
+def _positive(v: object, what: str) -> float:
+    if isinstance(v, bool) or not isinstance(v, numbers.Real) or not (0 < float(v) < np.inf):
+        raise ValueError(f"{what} must be a positive finite number, got {v!r}")
+    return float(v)
+
+
+def _density_source(box: Rect, density: Density, extent, max_density, opts):
+    """``points_at(scale) -> (points, ids, thresholds, density at each point)`` for the
+    density times ``scale``, and the expected number of points at scale 1."""
+    area = (box[2] - box[0]) * (box[3] - box[1])
+    if callable(density):
+        return _callable_source(box, density, max_density, opts)
+    if isinstance(density, bool):
+        raise ValueError("density must be a number, a 2-D array or a callable, got a bool")
+    if isinstance(density, numbers.Real):
+        d = float(density)
+        if not (np.isfinite(d) and d >= 0):
+            raise ValueError(f"density must be a non-negative finite number, got {density!r}")
+        return (lambda s: _rwt.query(box, d, scale=s, **opts)), d * area
+    values = _density_array(density)
+    over = box if extent is None else _rect(extent, "extent")
+    return (lambda s: _rwt.query(box, values, scale=s, extent=over, **opts)), values.mean() * area
+
+
+def _density_array(density: object) -> np.ndarray:
+    arr = np.asarray(density)
+    if arr.dtype.kind not in "fiu":
+        raise ValueError(f"density array must hold real numbers, got dtype {arr.dtype}")
+    if arr.ndim != 2 or arr.size == 0:
+        raise ValueError(f"density array must be 2-D and non-empty, got shape {arr.shape}")
+    values = np.ascontiguousarray(arr, dtype=np.float64)
+    bad = ~(np.isfinite(values) & (values >= 0))
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        raise ValueError(f"density array: value {values[row, col]} at [{row}, {col}] "
+                         "is not a non-negative finite number")
+    return values
+
+
+def _evaluate(f: DensityFn, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``f(x, y)`` checked: real, finite, the shape of ``x``; negative values count as 0."""
+    out = np.asarray(f(x.copy(), y.copy()))
+    if out.dtype.kind not in "fiu":
+        raise ValueError(f"density callable returned dtype {out.dtype}, not real numbers")
+    if out.shape != x.shape:
+        raise ValueError(f"density callable returned shape {out.shape} for inputs of shape "
+                         f"{x.shape}: it must return one value per point")
+    out = out.astype(np.float64)
+    bad = ~np.isfinite(out)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"density callable returned {out[i]} at ({x[i]}, {y[i]}): "
+                         "densities must be finite")
+    return np.maximum(out, 0.0)
+
+
+def _callable_source(box: Rect, f: DensityFn, max_density, opts):
+    """Candidates from a bound of ``f``, kept where ``f`` exceeds their thresholds."""
+    area = (box[2] - box[0]) * (box[3] - box[1])
+    if max_density is not None:
+        top = _positive(max_density, "max_density")
+        bound = _ConstantBound(top)
+        estimate = top * area
+    else:
+        bound = _GridBound(box, f)
+        estimate = bound.mean * area
+
+    def points_at(scale: float):
+        for _ in range(_BOUND_ROUNDS):
+            pos, ids, thr, at_bound = bound.query(box, scale, opts)
+            value = _evaluate(f, pos[:, 0], pos[:, 1]) if len(pos) else np.zeros(0)
+            over = value * scale > at_bound * (1 + 1e-9)
+            if not over.any():
+                keep = thr < value * scale
+                return pos[keep], ids[keep], thr[keep], value[keep] * scale
+            bound.raise_at(pos[over], value[over])
+        raise ValueError("the density callable keeps exceeding its sampled bound (a spike "
+                         "narrower than the bound grid?): pass max_density=")
+
+    return points_at, estimate
+
+
+class _ConstantBound:
+    def __init__(self, top: float):
+        self.top = top
+
+    def query(self, box: Rect, scale: float, opts):
+        return _rwt.query(box, self.top, scale=scale, **opts)
+
+    def raise_at(self, pos: np.ndarray, value: np.ndarray):
+        raise ValueError(f"the density callable returned {value.max()} at "
+                         f"{tuple(pos[np.argmax(value)])}, above max_density={self.top}")
+
+
+class _GridBound:
+    """A bound of a callable on a grid of nodes (texel centres of a density map): each
+    node holds the largest value of its 3 x 3 neighbourhood, times a margin, so bilinear
+    interpolation in a cell is at least the largest value at the cell's corners."""
+
+    def __init__(self, box: Rect, f: DensityFn):
+        x0, y0, x1, y1 = box
+        w, h = x1 - x0, y1 - y0
+        step = max(w, h) / (_GRID_NODES - 1)
+        nx = _nodes(w, step)
+        ny = _nodes(h, step)
+        self.x = np.linspace(x0, x1, nx)
+        self.y = np.linspace(y0, y1, ny)
+        gx, gy = np.meshgrid(self.x, self.y)
+        values = _evaluate(f, gx.ravel(), gy.ravel()).reshape(ny, nx)
+        self.mean = float(values.mean())
+        self.nodes = _dilate(values) * _BOUND_MARGIN
+        hx = (x1 - x0) / (nx - 1) if nx > 1 else 1.0
+        hy = (y1 - y0) / (ny - 1) if ny > 1 else 1.0
+        self.cell = (hx, hy)
+        self.extent = (x0 - hx / 2, y0 - hy / 2, x0 + (nx - 0.5) * hx, y0 + (ny - 0.5) * hy)
+
+    def query(self, box: Rect, scale: float, opts):
+        # Row 0 of a density map is its top edge.
+        return _rwt.query(box, np.ascontiguousarray(self.nodes[::-1]), scale=scale,
+                          extent=self.extent, **opts)
+
+    def raise_at(self, pos: np.ndarray, value: np.ndarray):
+        ny, nx = self.nodes.shape
+        i = np.clip(((pos[:, 0] - self.x[0]) / self.cell[0]).astype(np.int64), 0, nx - 1)
+        j = np.clip(((pos[:, 1] - self.y[0]) / self.cell[1]).astype(np.int64), 0, ny - 1)
+        for di in (-1, 0, 1, 2):
+            for dj in (-1, 0, 1, 2):
+                ii, jj = np.clip(i + di, 0, nx - 1), np.clip(j + dj, 0, ny - 1)
+                np.maximum.at(self.nodes, (jj, ii), 2.0 * value)
+
+
+def _nodes(length: float, step: float) -> int:
+    if length <= 0:
+        return 1
+    return int(min(_GRID_NODES, max(2, np.ceil(length / step - 1e-9) + 1)))
+
+
+def _dilate(values: np.ndarray) -> np.ndarray:
+    """Largest value of each 3 x 3 neighbourhood (edges repeat)."""
+    padded = np.pad(values, 1, mode="edge")
+    ny, nx = values.shape
+    out = values.copy()
+    for dy in range(3):
+        for dx in range(3):
+            np.maximum(out, padded[dy:dy + ny, dx:dx + nx], out=out)
+    return out
+
+
+def _first_n(points_at, n: int, estimate: float) -> Sample:
+    """Exactly ``n`` points: the density is scaled until more than ``n`` points exist, and
+    the ``n`` that appear first as it grows are kept, in that order."""
+    if n == 0:
+        return Sample(np.zeros((0, 2)), np.zeros(0, np.uint64), np.zeros(0), 0.0)
+    scale = 1.25 * (n + 1) / estimate if estimate > 0 else 1.0
+    for _ in range(64):
+        pos, ids, thr, at = points_at(scale)
+        if len(pos) > n:
+            break
+        scale *= 16.0 if len(pos) == 0 else max(1.25, 1.25 * (n + 1) / len(pos))
+    else:
+        raise ValueError(f"the density is zero in the rectangle: {n} points cannot be placed")
+    keys = thr / (at / scale)
+    order = np.lexsort((ids, keys))
+    first = order[:n]
+    # Any density factor between the n-th and the next appearance gives these n points.
+    fit = 0.5 * (keys[order[n - 1]] + keys[order[n]])
+    return Sample(pos[first], ids[first], thr[first], float(fit))

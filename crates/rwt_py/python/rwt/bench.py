@@ -1,0 +1,89 @@
+"""Benchmark: rwt against ``scipy.stats.qmc.PoissonDisk`` at an equal point count.
+
+    python -m rwt.bench [--points 100000] [--repeat 5]
+
+Prints, from one run, points per second and rho (normalized minimum distance) of both on
+the unit square, scipy's radius set so that it fills the square with the same number of
+points, then rwt on a variable density scipy cannot produce, and the speed ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from typing import Callable, List, Tuple
+
+import numpy as np
+
+import rwt
+
+UNIT = (0.0, 0.0, 1.0, 1.0)
+
+
+def best_time(run: Callable[[], np.ndarray], repeat: int) -> Tuple[float, np.ndarray]:
+    """The fastest of ``repeat`` runs, in seconds, and the points of the last."""
+    times: List[float] = []
+    points = np.zeros((0, 2))
+    for _ in range(repeat):
+        start = time.perf_counter()
+        points = run()
+        times.append(time.perf_counter() - start)
+    return min(times), points
+
+
+def rho(points: np.ndarray) -> float:
+    """The normalized minimum distance of points on the unit square."""
+    return rwt.analyse(points, UNIT).rho
+
+
+def scipy_radius(count: int) -> float:
+    """The radius at which scipy's PoissonDisk fills the unit square with about ``count``
+    points: its count scales as ``1 / radius**2``, measured at a small size."""
+    from scipy.stats import qmc
+
+    probe = 0.02
+    filled = len(qmc.PoissonDisk(d=2, radius=probe, seed=0).fill_space())
+    return probe * np.sqrt(filled / count)
+
+
+def variable_density(count: int) -> np.ndarray:
+    """A density map with a 20 : 1 range (a bright disc and a ramp) holding ``count``
+    points on the unit square."""
+    y, x = np.mgrid[0:256, 0:256] / 255.0
+    shape = 0.05 + x + 3.0 * np.exp(-((x - 0.6) ** 2 + (y - 0.4) ** 2) / 0.02)
+    return shape * (count / shape.mean())
+
+
+def main(argv: List[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(prog="python -m rwt.bench", description=__doc__)
+    parser.add_argument("--points", type=int, default=100_000)
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args(argv)
+    n, repeat = args.points, max(1, args.repeat)
+    from scipy.stats import qmc
+
+    radius = scipy_radius(n)
+    t_scipy, p_scipy = best_time(
+        lambda: qmc.PoissonDisk(d=2, radius=radius, seed=1).fill_space(), max(1, repeat // 5))
+    count = len(p_scipy)
+    t_rwt, p_rwt = best_time(lambda: rwt.sample(UNIT, float(count), seed=1).points, repeat)
+    t_n, p_n = best_time(lambda: rwt.sample(UNIT, 1.0, n=count, seed=1).points, repeat)
+    dens = variable_density(count)
+    t_var, p_var = best_time(lambda: rwt.sample(UNIT, dens, seed=1).points, repeat)
+    r_rwt, r_scipy = rho(p_rwt), rho(p_scipy)
+    print(f"{'':<34}{'points':>9}{'seconds':>10}{'points/s':>14}{'rho':>7}")
+    rows = [
+        ("scipy PoissonDisk (uniform)", p_scipy, t_scipy, f"{r_scipy:7.3f}"),
+        ("rwt.sample (uniform)", p_rwt, t_rwt, f"{r_rwt:7.3f}"),
+        ("rwt.sample (uniform, n=)", p_n, t_n, f"{rho(p_n):7.3f}"),
+        ("rwt.sample (variable, 20:1 map)", p_var, t_var, "      -"),
+    ]
+    for name, pts, t, r in rows:
+        print(f"{name:<34}{len(pts):>9}{t:>10.4f}{len(pts) / t:>14,.0f}{r}")
+    speedup = (len(p_rwt) / t_rwt) / (len(p_scipy) / t_scipy)
+    print(f"rwt is {speedup:.0f}x scipy's points per second at {count} points; "
+          f"rho {r_rwt:.3f} against scipy's {r_scipy:.3f} ({r_rwt - r_scipy:+.3f})")
+
+
+if __name__ == "__main__":
+    main()

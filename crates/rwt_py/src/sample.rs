@@ -1,0 +1,176 @@
+//! `rwt.sample`'s query: the points of a rectangle for a constant or a density map.
+
+use crate::errors::{image_error, query_error};
+use crate::tiles;
+use glam::DVec2;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use rwt_core::density::{Constant, Density, ImageDensity, Placement};
+use rwt_core::query::{DEFAULT_BUDGET, Point, Rect};
+use std::path::PathBuf;
+
+/// Hash salt of the 64-bit point ids (`PointId::hash`).
+const ID_SALT: u64 = 0x1d5;
+
+/// Rectangles of at least this many base tiles are queried on all cores (as `rwt points`
+/// does; the points and their order are the same either way).
+const PARALLEL_TILES: f64 = 256.0;
+
+/// Longest side of a density map (as of an image density).
+const MAX_MAP_SIDE: usize = 32_768;
+
+/// A density as Python passes it: points per unit area, or a map of them (row 0 at the
+/// rectangle's top edge, largest y).
+#[derive(FromPyObject)]
+pub enum DensityArg<'py> {
+    /// The same density everywhere.
+    Constant(f64),
+    /// A map, bilinearly interpolated between texel centres.
+    Map(PyReadonlyArray2<'py, f64>),
+}
+
+/// `(x0, y0, x1, y1)`.
+type Corners = (f64, f64, f64, f64);
+
+/// What a query returns: positions `(N, 2)`, 64-bit ids, thresholds and the density at
+/// each point.
+type Arrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
+/// The points of `rect` for `density` times `scale`: positions, ids, thresholds and the
+/// density at each point, in the query's order.
+#[pyfunction]
+#[pyo3(signature = (rect, density, *, scale = 1.0, extent = None, seed = 0, tile_size = 1.0,
+    budget = DEFAULT_BUDGET, tileset = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn query<'py>(
+    py: Python<'py>,
+    rect: Corners,
+    density: DensityArg<'py>,
+    scale: f64,
+    extent: Option<Corners>,
+    seed: u64,
+    tile_size: f64,
+    budget: usize,
+    tileset: Option<PathBuf>,
+) -> PyResult<Arrays<'py>> {
+    let rect = rect_of(rect, "rect")?;
+    if !(tile_size.is_finite() && tile_size > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "tile_size must be positive and finite, got {tile_size}"
+        )));
+    }
+    if !(scale.is_finite() && scale >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "the density scale must be non-negative and finite, got {scale}"
+        )));
+    }
+    let density: Box<dyn Density + Send + Sync> = match density {
+        DensityArg::Constant(c) if c.is_finite() && c >= 0.0 => Box::new(Constant(c * scale)),
+        DensityArg::Constant(c) => {
+            return Err(PyValueError::new_err(format!(
+                "density must be a non-negative finite number, got {c}"
+            )));
+        }
+        DensityArg::Map(values) => {
+            let over = rect_of(extent.unwrap_or(corners(&rect)), "extent")?;
+            Box::new(map_density(&values, over, scale)?)
+        }
+    };
+    let sampler = tiles::sampler(tileset.as_deref(), seed)?
+        .with_tile_size(tile_size)
+        .with_budget(budget);
+    let parallel = rect.area() / (tile_size * tile_size) >= PARALLEL_TILES;
+    let points = py
+        .detach(|| {
+            let mut out = Vec::new();
+            if parallel {
+                sampler.query_par(rect, &*density, &mut out)?;
+            } else {
+                sampler.query(rect, &*density, &mut out)?;
+            }
+            Ok(out)
+        })
+        .map_err(query_error)?;
+    Ok(arrays(py, &points, &*density, seed))
+}
+
+/// A rectangle from Python's corners (finite, not inverted).
+fn rect_of((x0, y0, x1, y1): Corners, what: &str) -> PyResult<Rect> {
+    Rect::new(DVec2::new(x0, y0), DVec2::new(x1, y1))
+        .map_err(|e| PyValueError::new_err(format!("{what} ({x0}, {y0}, {x1}, {y1}): {e}")))
+}
+
+fn corners(r: &Rect) -> Corners {
+    (r.min().x, r.min().y, r.max().x, r.max().y)
+}
+
+/// A density map over `over`: values are points per unit area (finite, non-negative).
+fn map_density(
+    values: &PyReadonlyArray2<'_, f64>,
+    over: Rect,
+    scale: f64,
+) -> PyResult<ImageDensity> {
+    let values = values.as_array();
+    let (h, w) = values.dim();
+    if h == 0 || w == 0 || h > MAX_MAP_SIDE || w > MAX_MAP_SIDE {
+        return Err(PyValueError::new_err(format!(
+            "density array: shape ({h}, {w}) must be between 1 and {MAX_MAP_SIDE} on each side"
+        )));
+    }
+    if let Some(((row, col), v)) = values
+        .indexed_iter()
+        .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+    {
+        return Err(PyValueError::new_err(format!(
+            "density array: value {v} at [{row}, {col}] is not a non-negative finite number"
+        )));
+    }
+    let top = values.iter().copied().fold(0.0f64, f64::max);
+    let unit: Vec<f32> = if top > 0.0 {
+        values.iter().map(|v| (v / top) as f32).collect()
+    } else {
+        vec![0.0; values.len()]
+    };
+    if over.is_empty() {
+        return Err(PyValueError::new_err(
+            "extent: the density map's rectangle is empty",
+        ));
+    }
+    let at = Placement {
+        min: over.min(),
+        size: over.size(),
+        scale: top * scale,
+    };
+    ImageDensity::from_values(w as u32, h as u32, &unit, at).map_err(image_error)
+}
+
+/// The points as numpy arrays.
+fn arrays<'py>(py: Python<'py>, points: &[Point], density: &dyn Density, seed: u64) -> Arrays<'py> {
+    let n = points.len();
+    let mut xy = Vec::with_capacity(2 * n);
+    let (mut ids, mut thresholds, mut at) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    for p in points {
+        xy.extend([p.position.x, p.position.y]);
+        ids.push(p.id.hash(seed, ID_SALT));
+        thresholds.push(p.threshold);
+        at.push(density.density(p.position));
+    }
+    let xy = Array2::from_shape_vec((n, 2), xy).expect("two coordinates per point");
+    (
+        xy.into_pyarray(py),
+        ids.into_pyarray(py),
+        thresholds.into_pyarray(py),
+        at.into_pyarray(py),
+    )
+}

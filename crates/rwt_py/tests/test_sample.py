@@ -1,0 +1,225 @@
+"""rwt.sample: determinism, bounds, density kinds, n=, monotonicity, errors."""
+
+import resource
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import rwt
+
+RECT = (-3.0, 2.0, 17.0, 14.5)
+
+
+def by_id(s):
+    order = np.argsort(s.ids)
+    return s.ids[order], s.points[order]
+
+
+def same_points(a, b):
+    ia, pa = by_id(a)
+    ib, pb = by_id(b)
+    np.testing.assert_array_equal(ia, ib)
+    np.testing.assert_array_equal(pa, pb)
+
+
+def wave(x, y):
+    return 3.0 + 2.0 * np.sin(x) * np.cos(0.5 * y)
+
+
+@pytest.mark.parametrize("density", [4.0, "map", wave])
+def test_same_inputs_same_arrays(density, ramp_map):
+    d = ramp_map / 255.0 * 6 if isinstance(density, str) else density
+    a = rwt.sample(RECT, d, seed=3)
+    b = rwt.sample(RECT, d, seed=3)
+    assert len(a) > 300
+    for field in ("points", "ids", "thresholds"):
+        np.testing.assert_array_equal(getattr(a, field), getattr(b, field))
+    assert a.points.dtype == np.float64 and a.points.shape == (len(a), 2)
+    assert a.ids.dtype == np.uint64 and a.ids.shape == (len(a),)
+    assert len(np.unique(a.ids)) == len(a)
+    other = rwt.sample(RECT, d, seed=4)
+    assert not np.array_equal(other.points[:10], a.points[:10])
+
+
+@pytest.mark.parametrize("density", [25.0, "map", wave])
+def test_every_point_inside_the_half_open_rect(density, ramp_map):
+    d = ramp_map / 255.0 * 25 if isinstance(density, str) else density
+    p = rwt.sample(RECT, d, seed=1).points
+    x0, y0, x1, y1 = RECT
+    assert len(p) > 700
+    assert ((p[:, 0] >= x0) & (p[:, 0] < x1) & (p[:, 1] >= y0) & (p[:, 1] < y1)).all()
+
+
+def test_constant_array_and_callable_equal_the_constant():
+    constant = rwt.sample(RECT, 7.5, seed=2)
+    flat = rwt.sample(RECT, np.full((13, 29), 7.5), seed=2)
+    np.testing.assert_array_equal(flat.points, constant.points)
+    np.testing.assert_array_equal(flat.ids, constant.ids)
+    same_points(rwt.sample(RECT, lambda x, y: np.full_like(x, 7.5), seed=2), constant)
+
+
+def test_callable_is_exact_with_or_without_a_known_bound():
+    grid = rwt.sample(RECT, wave, seed=5)
+    known = rwt.sample(RECT, wave, seed=5, max_density=5.0)
+    same_points(grid, known)
+    # Every point is kept exactly where the density exceeds its threshold.
+    assert (grid.thresholds < wave(grid.points[:, 0], grid.points[:, 1])).all()
+
+
+def test_a_callable_is_called_in_batches():
+    calls = []
+
+    def f(x, y):
+        calls.append(len(x))
+        return 50.0 * np.exp(-((x - 5) ** 2 + (y - 8) ** 2) / 4)
+
+    s = rwt.sample(RECT, f, seed=1)
+    assert len(s) > 200
+    assert len(calls) <= 4, calls
+
+
+@pytest.mark.parametrize("density", [3.0, "map", wave])
+def test_n_is_exact_and_a_prefix_of_more(density, ramp_map):
+    d = ramp_map / 255.0 * 3 if isinstance(density, str) else density
+    small = rwt.sample(RECT, d, n=57, seed=9)
+    large = rwt.sample(RECT, d, n=400, seed=9)
+    assert len(small) == 57 and len(large) == 400
+    np.testing.assert_array_equal(small.points, large.points[:57])
+    np.testing.assert_array_equal(small.ids, large.ids[:57])
+    assert small.scale < large.scale
+    # The reported scale gives exactly these points.
+    scaled = d * small.scale if not callable(d) else (lambda x, y: wave(x, y) * small.scale)
+    same_points(rwt.sample(RECT, scaled, seed=9), small)
+    assert len(rwt.sample(RECT, d, n=0)) == 0
+
+
+def test_n_with_a_huge_density_stays_within_the_budget():
+    s = rwt.sample((0, 0, 1000, 1000), 1e9, n=15, seed=2)
+    assert len(s) == 15 and s.scale < 1e-6
+
+
+def test_raising_the_density_only_adds_points(ramp_map):
+    low = rwt.sample(RECT, ramp_map / 255.0 * 4, seed=6)
+    high = rwt.sample(RECT, ramp_map / 255.0 * 4 + 1.0, seed=6)
+    assert len(high) > len(low)
+    assert np.isin(low.ids, high.ids).all()
+    c1, c2 = rwt.sample(RECT, 2.0), rwt.sample(RECT, 2.5)
+    assert np.isin(c1.ids, c2.ids).all() and len(c2) > len(c1)
+
+
+def test_array_placed_by_extent():
+    # Zero on the left half of the extent: no point up to the last zero texel's centre.
+    m = np.zeros((4, 8))
+    m[:, 4:] = 10.0
+    s = rwt.sample((0, 0, 3.5, 4), m, extent=(0, 0, 8, 4))
+    assert len(s) == 0
+    s = rwt.sample((4, 0, 8, 4), m, extent=(0, 0, 8, 4))
+    assert len(s) > 100
+
+
+@pytest.mark.parametrize("rect", [(0, 0, np.nan, 1), (0, 0, np.inf, 1), (5, 0, 1, 1),
+                                  (0, 3, 1, 1), (0, 0, 1), "abcd", None])
+def test_bad_rects_are_value_errors(rect):
+    with pytest.raises(ValueError):
+        rwt.sample(rect, 1.0)
+
+
+@pytest.mark.parametrize("density", [
+    np.ones(5), np.ones((2, 2, 2)), np.ones((0, 3)), np.array([[1 + 2j]]),
+    np.array([["a"]]), np.array([[1.0, np.nan]]), np.array([[1.0, -1.0]]),
+    np.array([[np.inf]]), -1.0, float("nan"), True, "dense",
+])
+def test_bad_densities_are_value_errors(density):
+    with pytest.raises(ValueError):
+        rwt.sample((0, 0, 1, 1), density)
+
+
+@pytest.mark.parametrize("f", [
+    lambda x, y: 1.0,
+    lambda x, y: np.ones((len(x), 2)),
+    lambda x, y: np.ones(len(x) + 1),
+    lambda x, y: np.full(len(x), np.nan),
+    lambda x, y: np.full(len(x), "x"),
+])
+def test_bad_callable_results_are_value_errors(f):
+    with pytest.raises(ValueError, match="callable"):
+        rwt.sample((0, 0, 2, 2), f)
+
+
+def test_a_raising_callable_propagates_its_exception():
+    class Mine(Exception):
+        pass
+
+    def f(x, y):
+        raise Mine("from the callable")
+
+    with pytest.raises(Mine, match="from the callable"):
+        rwt.sample((0, 0, 2, 2), f)
+
+
+def test_a_callable_above_max_density_is_refused():
+    with pytest.raises(ValueError, match="max_density"):
+        rwt.sample((0, 0, 5, 5), lambda x, y: 10.0 + x, max_density=4.0)
+
+
+def test_a_runaway_density_is_refused_before_any_allocation():
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    start = time.perf_counter()
+    for density in (1e12, np.full((3, 3), 1e12), lambda x, y: np.full_like(x, 1e12)):
+        with pytest.raises(rwt.BudgetError, match="budget"):
+            rwt.sample((0, 0, 1000, 1000), density)
+    with pytest.raises(rwt.BudgetError):
+        rwt.sample((0, 0, 100, 100), 10.0, budget=1000)
+    assert isinstance(rwt.BudgetError("x"), ValueError)
+    grown_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before
+    assert grown_kb < 64 * 1024, f"peak memory grew by {grown_kb} KB"
+    assert time.perf_counter() - start < 10
+
+
+def test_the_gil_is_released_while_rust_runs():
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(1)
+
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        time.sleep(0.01)
+        before = len(ticks)
+        start = time.perf_counter()
+        s = rwt.sample((0, 0, 1000, 1000), 3.0)
+        elapsed = time.perf_counter() - start
+        during = len(ticks) - before
+    finally:
+        done.set()
+        t.join()
+    assert len(s) > 2_000_000
+    # Python ran beside the query: far more than the few switches a held GIL allows.
+    assert during > 1000 * elapsed, (during, elapsed)
+
+
+def test_default_tiles_give_blue_noise_at_any_scale():
+    # A few points over a large area, and dense points in pixel units: both blue noise.
+    for rect, n in (((0, 0, 5000, 3000), 40), ((0, 0, 384, 384), 9000), ((0, 0, 1e-3, 1e-3), 500)):
+        s = rwt.sample(rect, 1.0, n=n, seed=1)
+        assert rwt.analyse(s.points, rect).rho > 0.55, rect
+    assert rwt.auto_tile_size((0, 0, 100, 60)) == 128.0
+    assert rwt.auto_tile_size((3, 3, 3, 3)) == 1.0
+    # The explicit tile size of `rwt points` gives its (here sparse, white-noise) points.
+    sparse = rwt.sample((0, 0, 384, 384), 1.0, n=9000, seed=1, tile_size=1.0)
+    assert rwt.analyse(sparse.points, (0, 0, 384, 384)).rho < 0.3
+
+
+def test_bad_options_are_value_errors():
+    for kwargs in ({"seed": -1}, {"seed": 1.5}, {"n": -3}, {"tile_size": 0},
+                   {"tile_size": float("nan")}, {"budget": -1}, {"extent": (0, 0, 1, 1)},
+                   {"max_density": 3.0}):
+        with pytest.raises(ValueError):
+            rwt.sample((0, 0, 1, 1), 1.0, **kwargs)
+    with pytest.raises(OSError):
+        rwt.sample((0, 0, 1, 1), 1.0, tileset="/nonexistent/tiles.ron")

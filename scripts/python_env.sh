@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Builds the Python package `rwt` (crates/rwt_py) into a fresh virtual environment with what
+# its tests need, and runs them: `scripts/python_env.sh [pytest args]`. The environment is
+# target/py-venv; `source target/py-venv/bin/activate` to use it afterwards.
+#   RWT_PY_KEEP=1 scripts/python_env.sh   # reuse the environment (only rebuild the package)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+venv=target/py-venv
+# pip runs maturin (the build backend) from the environment's bin.
+export PATH=$PWD/$venv/bin:$PATH
+if [ "${RWT_PY_KEEP:-0}" != 1 ] || [ ! -x "$venv/bin/python" ]; then
+    rm -rf "$venv"
+    python3 -m venv "$venv"
+    "$venv/bin/pip" install --quiet --upgrade pip
+    "$venv/bin/pip" install --quiet "maturin>=1.7,<2" numpy pytest scipy "dask[array]" matplotlib
+fi
+# The one install a user makes (`pip install crates/rwt_py`); the environment already has
+# maturin, so pip builds without fetching it again.
+"$venv/bin/pip" install --quiet --no-build-isolation --force-reinstall --no-deps crates/rwt_py
+# The CLI comparison runs `rwt points`: the debug build `cargo test` made, or one made now.
+[ -x target/debug/rwt ] || cargo build --quiet -p rwt_cli
+export RWT_CLI=$PWD/target/debug/rwt
+cd crates/rwt_py
+"../../$venv/bin/python" -m pytest -q "$@"
