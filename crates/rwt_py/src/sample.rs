@@ -7,16 +7,25 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use rayon::prelude::*;
 use rwt_core::density::{Constant, Density, ImageDensity, Placement};
-use rwt_core::query::{DEFAULT_BUDGET, Point, Rect};
+use rwt_core::query::{DEFAULT_BUDGET, Point, QueryError, Rect, Sampler};
 use std::path::PathBuf;
 
 /// Hash salt of the 64-bit point ids (`PointId::hash`).
 const ID_SALT: u64 = 0x1d5;
 
-/// Rectangles of at least this many base tiles are queried on all cores (as `rwt points`
-/// does; the points and their order are the same either way).
+/// Rectangles of at least this many base tiles are queried on all cores by
+/// `Sampler::query_par`, as `rwt points` does: the same points in the same order.
 const PARALLEL_TILES: f64 = 256.0;
+
+/// Queries over fewer base tiles that may produce at least this many points are split into
+/// a grid of chunks queried on all cores (the points of the chunks are exactly the
+/// rectangle's; they come chunk by chunk).
+const PARALLEL_POINTS: f64 = 100_000.0;
+
+/// Chunks per axis of such a query.
+const CHUNKS_PER_AXIS: usize = 8;
 
 /// Longest side of a density map (as of an image density).
 const MAX_MAP_SIDE: usize = 32_768;
@@ -86,19 +95,64 @@ pub fn query<'py>(
     let sampler = tiles::sampler(tileset.as_deref(), seed)?
         .with_tile_size(tile_size)
         .with_budget(budget);
-    let parallel = rect.area() / (tile_size * tile_size) >= PARALLEL_TILES;
     let points = py
-        .detach(|| {
-            let mut out = Vec::new();
-            if parallel {
-                sampler.query_par(rect, &*density, &mut out)?;
-            } else {
-                sampler.query(rect, &*density, &mut out)?;
-            }
-            Ok(out)
-        })
+        .detach(|| collect(&sampler, rect, &*density))
         .map_err(query_error)?;
     Ok(arrays(py, &points, &*density, seed))
+}
+
+/// The points of `rect`: serially, on all cores by base tiles (the serial order), or on all
+/// cores by chunks (chunk by chunk) for many points over few base tiles.
+fn collect(
+    sampler: &Sampler,
+    rect: Rect,
+    density: &(dyn Density + Sync),
+) -> Result<Vec<Point>, QueryError> {
+    let mut out = Vec::new();
+    let tile = sampler.tile_size();
+    if rect.area() / (tile * tile) >= PARALLEL_TILES {
+        sampler.query_par(rect, density, &mut out)?;
+        return Ok(out);
+    }
+    // Refused queries are refused whole, before any chunk.
+    sampler.admits(&rect, density)?;
+    if sampler.work_bound(&rect, density) < PARALLEL_POINTS || rayon::current_num_threads() < 2 {
+        sampler.query(rect, density, &mut out)?;
+        return Ok(out);
+    }
+    let parts: Vec<Result<Vec<Point>, QueryError>> = chunks(&rect, CHUNKS_PER_AXIS)
+        .into_par_iter()
+        .map(|chunk| {
+            let mut part = Vec::new();
+            sampler.query(chunk, density, &mut part)?;
+            Ok(part)
+        })
+        .collect();
+    for part in parts {
+        out.extend(part?);
+    }
+    Ok(out)
+}
+
+/// A `k x k` grid of half-open chunks whose union is exactly `rect` (row by row from the
+/// lowest y): neighbours share their edge coordinate, and the outer edges are `rect`'s.
+fn chunks(rect: &Rect, k: usize) -> Vec<Rect> {
+    let (lo, hi) = (rect.min(), rect.max());
+    let edge = |a: f64, b: f64, i: usize| {
+        if i == k {
+            b
+        } else {
+            a + (b - a) * (i as f64 / k as f64)
+        }
+    };
+    (0..k * k)
+        .filter_map(|c| {
+            let (i, j) = (c % k, c / k);
+            let min = DVec2::new(edge(lo.x, hi.x, i), edge(lo.y, hi.y, j));
+            let max = DVec2::new(edge(lo.x, hi.x, i + 1), edge(lo.y, hi.y, j + 1));
+            Rect::new(min, max).ok()
+        })
+        .collect()
 }
 
 /// A rectangle from Python's corners (finite, not inverted).

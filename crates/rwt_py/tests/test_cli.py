@@ -47,6 +47,17 @@ def test_constant_density_matches_rwt_points(cli, rect, value, seed, tile):
     np.testing.assert_array_equal(got, expected)
 
 
+def test_a_large_query_has_the_points_of_rwt_points(cli):
+    # Python computes it on all cores in chunks, the CLI serially: the same set.
+    rect = (0.0, 0.0, 400.0, 300.0)
+    tile = rwt.auto_tile_size(rect)
+    expected = cli_points(cli, rect, "const:1.5", 8, tile)
+    got = rwt.sample(rect, 1.5, seed=8).points
+    assert len(expected) > 150_000
+    np.testing.assert_array_equal(np.unique(got, axis=0), np.unique(expected, axis=0))
+    assert len(np.unique(got, axis=0)) == len(got)
+
+
 def test_density_array_matches_an_image_density(cli, tmp_path, ramp_map):
     png = tmp_path / "map.png"
     write_grey_png(png, ramp_map)

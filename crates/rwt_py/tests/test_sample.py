@@ -215,6 +215,22 @@ def test_default_tiles_give_blue_noise_at_any_scale():
     assert rwt.analyse(sparse.points, (0, 0, 384, 384)).rho < 0.3
 
 
+def test_a_large_query_on_all_cores_is_the_union_of_small_ones(ramp_map):
+    rect, tile = (0.0, 0.0, 300.0, 200.0), rwt.auto_tile_size((0.0, 0.0, 300.0, 200.0))
+    density = ramp_map / 255.0 * 10.0
+    whole = rwt.sample(rect, density, seed=2)
+    assert len(whole) > 200_000
+    xs, ys = np.linspace(0, 300, 5), np.linspace(0, 200, 4)
+    parts = [rwt.sample((xs[i], ys[j], xs[i + 1], ys[j + 1]), density, seed=2, tile_size=tile,
+                        extent=rect) for i in range(4) for j in range(3)]
+    assert all(len(p) < 50_000 for p in parts)  # each queried serially
+    ids = np.concatenate([p.ids for p in parts])
+    points = np.concatenate([p.points for p in parts])
+    order = np.argsort(ids)
+    same_points(whole, rwt.Sample(points=points[order], ids=ids[order],
+                                  thresholds=np.zeros(len(ids)), scale=1.0))
+
+
 def test_bad_options_are_value_errors():
     for kwargs in ({"seed": -1}, {"seed": 1.5}, {"n": -3}, {"tile_size": 0},
                    {"tile_size": float("nan")}, {"budget": -1}, {"extent": (0, 0, 1, 1)},

@@ -48,6 +48,10 @@ def test_white_and_bad_settings_are_value_errors(sphere):
         rwt.stipple(sphere, gamma=-1.0)
     with pytest.raises(ValueError, match="not both"):
         rwt.stipple(sphere, dots=10, radius=1.0)
+    for kwargs in ({"dots": -5}, {"seed": 1.5}, {"radius": "big"}, {"scale": float("nan")},
+                   {"max_dots": -1}, {"contrast": 0.0}):
+        with pytest.raises(ValueError):
+            rwt.stipple(sphere, **kwargs)
 
 
 def test_limits_raise_budget_errors(sphere):

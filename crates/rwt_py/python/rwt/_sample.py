@@ -75,8 +75,9 @@ def sample(
       grid (then the result is exact for any ``f``; without it, features narrower than
       1/256 of the rectangle may be missed).
 
-    The same arguments always give the same arrays. Raising the density anywhere only adds
-    points. With ``n``, exactly ``n`` points are returned, the density scaled to fit
+    The same arguments always give the same arrays, in the query's order (a large query
+    over few base tiles is computed on all cores in an 8 x 8 grid of chunks and comes chunk
+    by chunk). Raising the density anywhere only adds points. With ``n``, exactly ``n`` points are returned, the density scaled to fit
     (``Sample.scale``), in the order in which they appear as the density grows: the first
     ``k`` of them are the result for ``n=k``.
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numbers
 import os
 from dataclasses import dataclass
 from typing import Optional, Union
@@ -9,6 +10,7 @@ from typing import Optional, Union
 import numpy as np
 
 from . import _rwt
+from ._sample import _count
 
 
 @dataclass(frozen=True)
@@ -62,12 +64,22 @@ def stipple(
     True
     """
     grey = _grey(image)
+    counts = {k: None if v is None else _count(v, k) for k, v in
+              (("dots", dots), ("seed", seed), ("max_dots", max_dots),
+               ("max_raster_pixels", max_raster_pixels))}
+    reals = {k: None if v is None else _real(v, k) for k, v in
+             (("radius", radius), ("gamma", gamma), ("contrast", contrast), ("scale", scale))}
     points, r, raster, tone = _rwt.stipple(
-        grey, dots=dots, radius=radius, gamma=gamma, contrast=contrast, seed=seed,
-        scale=scale, render=render, max_dots=max_dots, max_raster_pixels=max_raster_pixels,
-        tileset=None if tileset is None else os.fspath(tileset))
+        grey, render=bool(render), tileset=None if tileset is None else os.fspath(tileset),
+        **counts, **reals)
     blue, white = tone if tone is not None else (None, None)
     return Stipple(points, r, raster, blue, white)
+
+
+def _real(v: object, what: str) -> float:
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        raise ValueError(f"{what} must be a number, got {v!r}")
+    return float(v)
 
 
 def _grey(image: object) -> np.ndarray:
