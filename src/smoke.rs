@@ -176,6 +176,7 @@ fn finish(
               live: Res<LiveInstances>,
               report: Res<SmokeReport>,
               mut shots: ResMut<Shots>,
+              real: Res<Time<Real>>,
               mut exit: MessageWriter<AppExit>| {
             shots.pending = false;
             let Ok(image) = captured.image.clone().try_into_dynamic() else {
@@ -184,11 +185,21 @@ fn finish(
                 return;
             };
             let rgb = image.to_rgb8();
-            if luminance_variance(&rgb) < BLANK_VARIANCE {
+            let variance = luminance_variance(&rgb);
+            if variance < BLANK_VARIANCE {
                 // Still compiling pipelines: look again a little later.
+                eprintln!(
+                    "rwt-smoke: frame {} blank (luminance variance {variance:.1}), again in 10",
+                    smoke.frame
+                );
                 shots.next = Some(smoke.frame + 10);
                 return;
             }
+            println!(
+                "rwt-smoke: screenshot taken at frame {}, {:.1} s after start",
+                smoke.frame,
+                real.elapsed_secs()
+            );
             exit.write(save(&path, &rgb, *live, *report));
         },
     );
