@@ -1,11 +1,11 @@
 """Blue noise over a large rectangle, computed as independent Dask tasks.
 
 Every point of an rwt query belongs to exactly one half-open chunk ``[x0, x1) x [y0, y1)``
-and does not depend on the others (given one tile size), so the chunks of a grid are computed with no
-coordination at all, and their union is exactly the points of one query over the whole
-rectangle. On one machine Dask's local scheduler runs the chunks on threads (rwt releases
-the GIL); with ``dask.distributed.Client("scheduler:8786")`` the same graph runs on a
-cluster.
+and does not depend on the others (given one tile size), so the chunks of a grid are
+computed with no coordination at all, and their union is exactly the points of one query
+over the whole rectangle. On one machine Dask's local scheduler runs the chunks on threads
+(rwt releases the GIL); with ``dask.distributed.Client("scheduler:8786")`` the same
+graph runs on a cluster.
 
     python examples/dask_chunks.py
 """

@@ -52,6 +52,7 @@ def analyse(points: np.ndarray, window: Sequence[float], *, size: int = 128) -> 
         raise ValueError(f"points must be a real array of shape (N, 2), got {pts.dtype} "
                          f"{pts.shape}")
     pts = np.ascontiguousarray(pts, dtype=np.float64)
-    rho, density, windows, side, power, radial, aniso = _rwt.analyse(pts, box, size=_count(size, "size"))
+    figures = _rwt.analyse(pts, box, size=_count(size, "size"))
+    rho, density, windows, side, power, radial, aniso = figures
     frequencies = np.arange(len(radial)) / side
     return Analysis(rho, density, windows, side, frequencies, radial, aniso, power)

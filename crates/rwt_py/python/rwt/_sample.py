@@ -77,9 +77,10 @@ def sample(
 
     The same arguments always give the same arrays, in the query's order (a large query
     over few base tiles is computed on all cores in an 8 x 8 grid of chunks and comes chunk
-    by chunk). Raising the density anywhere only adds points. With ``n``, exactly ``n`` points are returned, the density scaled to fit
-    (``Sample.scale``), in the order in which they appear as the density grows: the first
-    ``k`` of them are the result for ``n=k``.
+    by chunk). Raising the density anywhere only adds points. With ``n``, exactly ``n``
+    points are returned, the density scaled to fit (``Sample.scale``), in the order in
+    which they appear as the density grows: the first ``k`` of them are the result for
+    ``n=k``.
 
     ``seed`` picks one of many independent point sets; ``tileset`` is a tile set file made
     by ``rwt tileset build`` (default: the one built in). ``tile_size`` is the width of a
