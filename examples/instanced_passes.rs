@@ -1,8 +1,9 @@
 //! Instanced grass inside Bevy's renderer, checked on screen (`scripts/smoke.sh` runs it
 //! under Xvfb and lavapipe): `cargo run --example instanced_passes`.
 //!
-//! A field of tall instanced grass, a box beside it, a few textured cards lying on the
-//! ground and a low sun. Five screenshots of the same scene, each compared region by region:
+//! A field of tall instanced grass, a box beside it, a few stiff textured cards lying on
+//! the ground (`bend_response` 0) and a low sun. Five screenshots of the same scene, each
+//! compared region by region:
 //! 1. shadows on: the reference; each card (found by picking) shows its texture's red disc
 //!    at its centre and the ground at its corners, where the texture's alpha cuts it out;
 //! 2. the sun's shadows off: the grass the box shades must be brighter there, so the
@@ -12,13 +13,15 @@
 //! 4. depth, normal and motion-vector prepasses with TAA and SSAO (and MSAA off, as they
 //!    need): the grass must still be drawn (its region unlike the bare ground) and the image
 //!    not blank;
-//! 5. a [`Bender`] standing in the grass: the blades around it must lie down (the pixels
-//!    around it change much more than pixels of grass far from it).
+//! 5. a [`Bender`] standing in the grass and another on the cards: the blades around the
+//!    first must lie down (the pixels around it change much more than pixels of grass far
+//!    from it), and the cards must not move (their class does not respond: its pipelines
+//!    compile without the bend field).
 //!
 //! It prints `rwt-passes: cards C cut out K, receive lit L shadowed S, cast off L on S,
-//! prepass grass G ground B, bent near N far F` (cards drawn and cut out as their texture
-//! says; mean luminances, 0..255; mean pixel changes for the bender) and exits with an error
-//! when a check fails. Screenshots go to `RWT_PASSES_DIR` (default
+//! prepass grass G ground B, bent near N far F stiff T` (cards drawn and cut out as their
+//! texture says; mean luminances, 0..255; mean pixel changes for the benders) and exits
+//! with an error when a check fails. Screenshots go to `RWT_PASSES_DIR` (default
 //! `target/passes`).
 
 use bevy::anti_alias::taa::TemporalAntiAliasing;
@@ -42,8 +45,10 @@ const FIELD: (DVec2, DVec2) = (DVec2::new(0.0, -6.0), DVec2::new(6.0, 6.0));
 /// Ground points compared: grass the box shades, and bare ground the grass shades.
 const UNDER_BOX: Vec3 = Vec3::new(4.3, 0.35, 0.0);
 const BEHIND_GRASS: Vec3 = Vec3::new(-0.45, 0.0, 2.5);
-/// Where the textured cards lie (a few in a small square), their side and height.
+/// Where the textured cards lie (a few in a small square, a bender at its centre), their
+/// side and height.
 const CARDS: (DVec2, DVec2) = (DVec2::new(-3.6, -1.6), DVec2::new(-2.4, -0.4));
+const ON_CARDS: Vec3 = Vec3::new(-3.0, CARD_HEIGHT, -1.0);
 const CARD: f32 = 0.8;
 const CARD_HEIGHT: f32 = 0.05;
 /// Where the bender stands, and grass far from it.
@@ -153,6 +158,7 @@ fn setup(
             tip_color: Color::WHITE,
             color_variation: 0.0,
             texture: Some(images.add(disc_texture())),
+            bend_response: 0.0,
             ..default()
         },
     );
@@ -258,7 +264,7 @@ fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands)
         ]);
         if matches!(check.step, Step::Prepasses | Step::Bent) {
             check.bent.push(image.clone());
-            check.bent_regions = [BENDER + Vec3::Y * 0.3, FAR_GRASS]
+            check.bent_regions = [BENDER + Vec3::Y * 0.3, FAR_GRASS, ON_CARDS]
                 .iter()
                 .filter_map(|p| camera.world_to_viewport(at, *p).ok())
                 .collect();
@@ -371,13 +377,15 @@ fn next(step: Step, scene: &mut Scene, commands: &mut Commands) -> Step {
             Step::Prepasses
         }
         Step::Prepasses => {
-            commands.spawn((
-                Transform::from_translation(BENDER),
-                Bender {
-                    radius: 1.5,
-                    strength: 1.0,
-                },
-            ));
+            for at in [BENDER, ON_CARDS] {
+                commands.spawn((
+                    Transform::from_translation(at),
+                    Bender {
+                        radius: 1.5,
+                        strength: 1.0,
+                    },
+                ));
+            }
             Step::Bent
         }
         Step::Bent | Step::Done => Step::Done,
@@ -432,7 +440,7 @@ fn save(image: &Image, step: Step) {
 
 /// Prints the line; whether every check holds.
 fn report(check: &Check) -> bool {
-    let ([reference, sun_off, grass_off, prepass, _], [straight, bent], [near, far]) = (
+    let ([reference, sun_off, grass_off, prepass, _], [straight, bent], [near, far, cards_at]) = (
         check.shots.as_slice(),
         check.bent.as_slice(),
         check.bent_regions.as_slice(),
@@ -444,10 +452,10 @@ fn report(check: &Check) -> bool {
         return false;
     };
     let change = |at: Vec2| region_change(straight, bent, at);
-    let (bent_near, bent_far) = (change(*near), change(*far));
+    let (bent_near, bent_far, stiff) = (change(*near), change(*far), change(*cards_at));
     let (cards, cut) = check.cards;
     println!(
-        "rwt-passes: cards {cards} cut out {cut}, receive lit {:.1} shadowed {:.1}, cast off {:.1} on {:.1}, prepass grass {:.1} ground {:.1}, bent near {bent_near:.1} far {bent_far:.1}",
+        "rwt-passes: cards {cards} cut out {cut}, receive lit {:.1} shadowed {:.1}, cast off {:.1} on {:.1}, prepass grass {:.1} ground {:.1}, bent near {bent_near:.1} far {bent_far:.1} stiff {stiff:.1}",
         sun_off[0], reference[0], grass_off[1], reference[1], prepass[2], prepass[1]
     );
     // Each check holds only when its comparison does (a NaN region fails it).
@@ -475,6 +483,10 @@ fn report(check: &Check) -> bool {
         (
             bent_near > 12.0 && bent_near > 3.0 * bent_far,
             "the blades around the bender did not lie down",
+        ),
+        (
+            stiff < 3.0 * bent_far.max(1.0),
+            "the stiff cards moved under a bender",
         ),
     ];
     let mut ok = true;

@@ -7,8 +7,8 @@
 use super::draw::{DrawChunkInstances, SetChunkBindGroup};
 use super::main_pass::{mesh_attributes, mesh_bin};
 use super::{
-    ChunkBindings, ChunkPipelines, ExtractedChunk, MainViewer, Queued, instance_layout,
-    rebin_cameras,
+    ChunkBindings, ChunkPipelines, ClassFeatures, ExtractedChunk, MainViewer, Queued,
+    instance_layout, rebin_cameras,
 };
 use crate::instancing::distance_to_box;
 use crate::look::InstancedShadows;
@@ -54,8 +54,8 @@ pub(in crate::instancing) struct InstancedDepthPipeline {
 pub(in crate::instancing) struct DepthKey {
     mesh: MeshPipelineKey,
     shadow: bool,
-    /// Whether the class is textured (its cut-out discards fragments here too).
-    textured: bool,
+    /// The class's features (a textured class's cut-out discards fragments here too).
+    features: ClassFeatures,
 }
 
 pub(in crate::instancing) fn init_depth_pipeline(
@@ -85,7 +85,7 @@ impl SpecializedMeshPipeline for InstancedDepthPipeline {
         let emulate_unclipped = k.contains(MeshPipelineKey::UNCLIPPED_DEPTH_ORTHO)
             && !self.prepass.depth_clip_control_supported;
         let mut defs: Vec<ShaderDefVal> = vec!["PREPASS_PIPELINE".into()];
-        let attributes = mesh_attributes(layout, key.textured, &mut defs);
+        let attributes = mesh_attributes(layout, key.features, &mut defs);
         for (on, def) in [
             (normals, "NORMAL_PREPASS"),
             (motion, "MOTION_VECTOR_PREPASS"),
@@ -103,7 +103,7 @@ impl SpecializedMeshPipeline for InstancedDepthPipeline {
             defs.push("PREPASS_FRAGMENT".into());
         }
         // A textured class needs the fragment stage to cut out, even for depth alone.
-        let fragment = (writes || key.textured).then(|| FragmentState {
+        let fragment = (writes || key.features.textured).then(|| FragmentState {
             shader: self.bindings.shader.clone(),
             shader_defs: defs.clone(),
             targets: if normals || motion { targets } else { vec![] },
@@ -176,7 +176,7 @@ pub(in crate::instancing) fn queue_prepass(
             let id = pipelines.of(chunk, |topology| DepthKey {
                 mesh: view_key | topology,
                 shadow: false,
-                textured: chunk.texture.is_some(),
+                features: chunk.features,
             })?;
             let batch_set = OpaqueNoLightmap3dBatchSetKey {
                 draw_function: draw,
@@ -235,7 +235,7 @@ pub(in crate::instancing) fn queue_shadows(
                 let id = pipelines.of(chunk, |topology| DepthKey {
                     mesh: light_key | topology,
                     shadow: true,
-                    textured: chunk.texture.is_some(),
+                    features: chunk.features,
                 })?;
                 let batch_set = ShadowBatchSetKey {
                     pipeline: id,

@@ -136,8 +136,10 @@ fn sway(root: vec3<f32>, t: f32, tint: f32, height: f32, time: f32) -> vec3<f32>
 }
 
 // The lean of an instance rooted at `root` (x, z; length 0..1, 1 is flat): none outside
-// the field, while nothing leans or when the class does not respond.
+// the field or while nothing leans; a class that does not respond (no `RWT_BEND`) never
+// reads the field.
 fn lean_at(root: vec3<f32>) -> vec2<f32> {
+#ifdef RWT_BEND
     let uv = (root.xz - frame.bend.xy) * frame.bend.z;
     if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
         return vec2<f32>(0.0);
@@ -146,6 +148,9 @@ fn lean_at(root: vec3<f32>) -> vec2<f32> {
     let lean = textureSampleLevel(bend_field, bend_sampler, uv, 0.0).xy * response;
     let amount = length(lean);
     return select(lean, lean / amount, amount > 1.0);
+#else
+    return vec2<f32>(0.0);
+#endif
 }
 
 // Turns `v` (relative to the root) about the horizontal axis across `dir` by the angle

@@ -2,7 +2,8 @@
 
 use super::draw::DrawInstancedChunk;
 use super::{
-    ChunkBindings, ChunkPipelines, ExtractedChunk, Queued, instance_layout, rebin_cameras,
+    ChunkBindings, ChunkPipelines, ClassFeatures, ExtractedChunk, Queued, instance_layout,
+    rebin_cameras,
 };
 use bevy::asset::UntypedAssetId;
 use bevy::core_pipeline::core_3d::{Opaque3d, Opaque3dBatchSetKey, Opaque3dBinKey};
@@ -34,12 +35,11 @@ pub(in crate::instancing) fn init_main_pipeline(
     });
 }
 
-/// A main-pass pipeline's key: the view's and mesh's bits, and whether the class is
-/// textured.
+/// A main-pass pipeline's key: the view's and mesh's bits, and the class's features.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(in crate::instancing) struct InstancedKey {
     mesh: MeshPipelineKey,
-    textured: bool,
+    features: ClassFeatures,
 }
 
 impl SpecializedMeshPipeline for InstancedPipeline {
@@ -52,7 +52,7 @@ impl SpecializedMeshPipeline for InstancedPipeline {
     ) -> Result<RenderPipelineDescriptor, SpecializedMeshPipelineError> {
         let mut descriptor = self.mesh_pipeline.specialize(key.mesh, layout)?;
         let mut defs = vec![ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 3)];
-        let attributes = mesh_attributes(layout, key.textured, &mut defs);
+        let attributes = mesh_attributes(layout, key.features, &mut defs);
         descriptor.vertex.buffers = vec![layout.0.get_layout(&attributes)?, instance_layout()];
         descriptor.vertex.shader = self.bindings.shader.clone();
         descriptor.vertex.shader_defs.extend(defs.iter().cloned());
@@ -70,10 +70,10 @@ impl SpecializedMeshPipeline for InstancedPipeline {
 }
 
 /// The mesh attributes a pipeline reads (position; normals when the mesh has them; UVs when
-/// the class is textured), with the shader definitions they need.
+/// the class is textured), with the shader definitions they and the class's features need.
 pub(super) fn mesh_attributes(
     layout: &MeshVertexBufferLayoutRef,
-    textured: bool,
+    features: ClassFeatures,
     defs: &mut Vec<ShaderDefVal>,
 ) -> Vec<VertexAttributeDescriptor> {
     let mut attributes = vec![Mesh::ATTRIBUTE_POSITION.at_shader_location(0)];
@@ -81,7 +81,10 @@ pub(super) fn mesh_attributes(
         attributes.push(Mesh::ATTRIBUTE_NORMAL.at_shader_location(1));
         defs.push("RWT_NORMALS".into());
     }
-    if textured {
+    if features.bends {
+        defs.push("RWT_BEND".into());
+    }
+    if features.textured {
         // A mesh without UVs fails the layout, and the class is reported once.
         attributes.push(Mesh::ATTRIBUTE_UV_0.at_shader_location(2));
         defs.push("RWT_TEXTURE".into());
@@ -115,7 +118,7 @@ pub(in crate::instancing) fn queue_main(
             let chunk = chunks.get(entity).ok()?;
             let id = pipelines.of(chunk, |topology| InstancedKey {
                 mesh: view_key | topology,
-                textured: chunk.texture.is_some(),
+                features: chunk.features,
             })?;
             let batch_set = Opaque3dBatchSetKey {
                 draw_function: draw,

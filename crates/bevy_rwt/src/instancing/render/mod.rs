@@ -98,6 +98,20 @@ pub struct ExtractedChunk {
     shadows: InstancedShadows,
     /// The base-colour texture, if the class has one.
     texture: Option<AssetId<Image>>,
+    /// What the class's pipelines compile in.
+    features: ClassFeatures,
+}
+
+/// What a class's pipelines compile in, as shader definitions rather than branches on
+/// uniforms (a branch on uniforms alone makes lavapipe recompile at each draw; a feature a
+/// class lacks costs nothing): UVs and the alpha cut-out for a textured class, the bend
+/// field's fetch for a class that bends.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub(in crate::instancing) struct ClassFeatures {
+    /// The class has a base-colour texture (`RWT_TEXTURE`).
+    textured: bool,
+    /// The class leans away from benders (`RWT_BEND`).
+    bends: bool,
 }
 
 impl SyncComponent for InstancedChunk {
@@ -153,6 +167,10 @@ impl ExtractComponent for InstancedChunk {
             },
             shadows: m.shadows,
             texture: m.texture.as_ref().map(Handle::id),
+            features: ClassFeatures {
+                textured: m.texture.is_some(),
+                bends: m.bend_response != 0.0,
+            },
         })
     }
 }
