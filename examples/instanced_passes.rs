@@ -48,7 +48,11 @@ const BEHIND_GRASS: Vec3 = Vec3::new(-0.45, 0.0, 2.5);
 /// Where the textured cards lie (a few in a small square, a bender at its centre), their
 /// side and height.
 const CARDS: (DVec2, DVec2) = (DVec2::new(-3.6, -1.6), DVec2::new(-2.4, -0.4));
-const ON_CARDS: Vec3 = Vec3::new(-3.0, CARD_HEIGHT, -1.0);
+const ON_CARDS: Vec3 = Vec3::new(
+    ((CARDS.0.x + CARDS.1.x) / 2.0) as f32,
+    CARD_HEIGHT,
+    ((CARDS.0.y + CARDS.1.y) / 2.0) as f32,
+);
 const CARD: f32 = 0.8;
 const CARD_HEIGHT: f32 = 0.05;
 /// Where the bender stands, and grass far from it.

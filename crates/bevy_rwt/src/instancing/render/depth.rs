@@ -176,7 +176,7 @@ pub(in crate::instancing) fn queue_prepass(
             let id = pipelines.of(chunk, |topology| DepthKey {
                 mesh: view_key | topology,
                 shadow: false,
-                features: chunk.features,
+                features: chunk.features(),
             })?;
             let batch_set = OpaqueNoLightmap3dBatchSetKey {
                 draw_function: draw,
@@ -235,7 +235,7 @@ pub(in crate::instancing) fn queue_shadows(
                 let id = pipelines.of(chunk, |topology| DepthKey {
                     mesh: light_key | topology,
                     shadow: true,
-                    features: chunk.features,
+                    features: chunk.features(),
                 })?;
                 let batch_set = ShadowBatchSetKey {
                     pipeline: id,

@@ -118,7 +118,7 @@ pub(in crate::instancing) fn queue_main(
             let chunk = chunks.get(entity).ok()?;
             let id = pipelines.of(chunk, |topology| InstancedKey {
                 mesh: view_key | topology,
-                features: chunk.features,
+                features: chunk.features(),
             })?;
             let batch_set = Opaque3dBatchSetKey {
                 draw_function: draw,

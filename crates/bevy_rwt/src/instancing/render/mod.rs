@@ -98,8 +98,17 @@ pub struct ExtractedChunk {
     shadows: InstancedShadows,
     /// The base-colour texture, if the class has one.
     texture: Option<AssetId<Image>>,
-    /// What the class's pipelines compile in.
-    features: ClassFeatures,
+}
+
+impl ExtractedChunk {
+    /// What its class's pipelines compile in: a texture, and a bend response (the
+    /// uniform's `shading.y`) other than 0.
+    fn features(&self) -> ClassFeatures {
+        ClassFeatures {
+            textured: self.texture.is_some(),
+            bends: self.uniform.shading[1] != 0.0,
+        }
+    }
 }
 
 /// What a class's pipelines compile in, as shader definitions rather than branches on
@@ -167,10 +176,6 @@ impl ExtractComponent for InstancedChunk {
             },
             shadows: m.shadows,
             texture: m.texture.as_ref().map(Handle::id),
-            features: ClassFeatures {
-                textured: m.texture.is_some(),
-                bends: m.bend_response != 0.0,
-            },
         })
     }
 }
