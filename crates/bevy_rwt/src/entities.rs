@@ -4,8 +4,9 @@
 //! entities appear, stay or go is decided here, by point identity: existing instances never
 //! move.
 
-use crate::layers::{HeightFn, ScatterEntity, ScatterLayer};
-use crate::look::{ClassLook, Pose};
+use crate::ground::GroundRule;
+use crate::layers::{ScatterEntity, ScatterLayer};
+use crate::look::ClassLook;
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 use rwt_core::query::{Point, PointId};
@@ -38,8 +39,8 @@ pub(crate) struct Spawner<'a> {
     /// The layer entity.
     pub entity: Entity,
     pub layer: &'a ScatterLayer,
-    /// The ground height the layer's chunks are generated with.
-    pub height: &'a HeightFn,
+    /// The ground the layer's chunks are generated on.
+    pub ground: &'a GroundRule,
 }
 
 impl EntityQueue {
@@ -64,6 +65,28 @@ impl EntityQueue {
         if !c.queued.is_empty() && !c.in_order {
             c.in_order = true;
             self.spawn_order.push_back(chunk);
+        }
+    }
+
+    /// Puts the instances of `chunk` that `points` keep (same identity and class) where
+    /// they stand now: the ground under them changed.
+    pub fn replace_kept(
+        &self,
+        commands: &mut Commands,
+        spawner: &Spawner,
+        chunk: ChunkCoord,
+        points: &[Point],
+    ) {
+        let Some(c) = self.chunks.get(&chunk) else {
+            return;
+        };
+        for p in points {
+            if let Some((e, class)) = c.spawned.get(&p.id)
+                && *class == p.class
+            {
+                let at = spawner.layer.place(p, spawner.ground);
+                commands.entity(*e).try_insert(at);
+            }
         }
     }
 
@@ -165,15 +188,11 @@ impl EntityQueue {
     }
 }
 
-/// Spawns one instance: the class's look placed by [`GroundPlane::place`](crate::GroundPlane::place).
+/// Spawns one instance: the class's look placed on the ground by [`ScatterLayer::place`].
 fn spawn_instance(commands: &mut Commands, spawner: &Spawner, p: &Point) -> Entity {
     let layer = spawner.layer;
     let class = &layer.classes[(p.class as usize).min(layer.classes.len().saturating_sub(1))];
-    let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
-    let pose = Pose::of(&p.id, layer.seed, class.scale, class.scale_variation);
-    let transform = layer
-        .plane
-        .place(p, (spawner.height)(ground), pose, layer.seed);
+    let transform = layer.place(p, spawner.ground);
     let instance = ScatterEntity {
         layer: spawner.entity,
         id: p.id,

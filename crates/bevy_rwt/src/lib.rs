@@ -149,6 +149,7 @@ pub mod edits;
 mod entities;
 pub mod footprints;
 pub mod gizmos;
+pub mod ground;
 pub mod instancing;
 pub mod layers;
 pub mod look;
@@ -167,12 +168,12 @@ pub use instancing::{Bender, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, Rwt
 pub use layers::RwtLayersPlugin;
 pub use layers::{
     AssetFailure, AssetProblem, AssetStatus, DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap,
-    HeightSource, LayerAsset, LayerDensity, Promotion, ScatterClass, ScatterEntity, ScatterLayer,
-    ScatterLayerStatus,
+    HeightSource, KeepOut, LayerAsset, LayerDensity, Promotion, ScatterClass, ScatterEntity,
+    ScatterLayer, ScatterLayerStatus,
 };
 pub use look::{
-    ClassLook, GroundPlane, InstanceInserter, InstancedLook, InstancedShading, InstancedShadows,
-    MeshLod, Pose,
+    ClassLook, Footing, GroundPlane, InstanceInserter, InstancedLook, InstancedShading,
+    InstancedShadows, MeshLod, Pose, Stance,
 };
 pub use rwt_core;
 use rwt_core::tileset::TileSet;

@@ -34,7 +34,7 @@
 //! ```
 
 use crate::layers::ScatterLayer;
-use crate::look::{ClassLook, GroundPlane, Pose};
+use crate::look::{ClassLook, GroundPlane};
 use crate::streaming::{Changes, KnownFootprints, LayerState, ShownLayer};
 use bevy::camera::primitives::MeshAabb;
 use bevy::ecs::system::SystemParam;
@@ -216,15 +216,11 @@ impl ScatterPicking<'_, '_> {
         shown: &ShownLayer,
         p: &Point,
     ) -> ScatterHit {
-        let class = &layer.classes[(p.class as usize).min(layer.classes.len() - 1)];
-        let pose = Pose::of(&p.id, layer.seed, class.scale, class.scale_variation);
-        let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
-        let height = (shown.generator.height)(ground);
         ScatterHit {
             layer: entity,
             class: p.class,
             id: p.id,
-            transform: layer.plane.place(p, height, pose, layer.seed),
+            transform: layer.place(p, &shown.generator.ground),
             distance: 0.0,
         }
     }

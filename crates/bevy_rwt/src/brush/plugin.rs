@@ -20,6 +20,7 @@ use bevy::input::mouse::AccumulatedMouseScroll;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 /// Paints density maps with the mouse (see [`crate::brush`]). Part of [`crate::RwtPlugins`],
 /// disabled there (enable it, or add it alone with the group's schedule); its systems run in
@@ -80,14 +81,17 @@ impl BrushHistory {
     }
 }
 
-/// The selected target's plane and ground, as the layer's chunks are generated with.
+/// The selected target's plane and the height of its ground (its top-most surface; below
+/// everything where there is none), as the layer's chunks are generated on.
 fn target_ground(
     brush: &DensityBrush,
     layers: &Query<(&ScatterLayer, &LayerState)>,
 ) -> Option<(GroundPlane, HeightFn)> {
     let target = brush.target()?;
     let (layer, state) = layers.get(target.layer).ok()?;
-    Some((layer.plane, state.height()?.clone()))
+    let ground = state.ground()?.clone();
+    let height = move |p: Vec2| ground.top(p).map_or(f32::NEG_INFINITY, |h| h.height);
+    Some((layer.plane, Arc::new(height)))
 }
 
 /// The ground point under the cursor, on the selected target's layer: on the ground of a

@@ -25,8 +25,9 @@ pub fn ground_hit(
     while t < max_distance {
         let step = (0.25 + 0.01 * t).min(8.0);
         t = (t + step).min(max_distance);
+        // Infinitely far above where the ground has a hole; no answer where it is NaN.
         let h = above(t);
-        if !h.is_finite() {
+        if h.is_nan() || h == f32::NEG_INFINITY {
             return None;
         }
         if h < 0.0 {

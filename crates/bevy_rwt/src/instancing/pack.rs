@@ -2,8 +2,9 @@
 //! task (off the main thread).
 
 use super::{GpuInstance, InstanceBuffer};
-use crate::layers::{HeightFn, ScatterLayer};
-use crate::look::{ClassLook, GroundPlane, Pose};
+use crate::ground::{GroundRule, Stands, SurfaceHit};
+use crate::layers::ScatterLayer;
+use crate::look::{ClassLook, GroundPlane, Pose, Stance};
 use bevy::prelude::*;
 use glam::DVec2;
 use rwt_core::density::{Density, sanitize};
@@ -16,13 +17,22 @@ const TINT_SALT: u64 = 0x7117;
 /// What packing needs of a layer: which classes are instanced, with their scale.
 #[derive(Clone, Debug)]
 pub(crate) struct InstancedClasses {
-    /// Per class: `(scale, scale variation, keep ids)` when instanced (promoted classes
-    /// keep their instances' identities).
-    classes: Arc<[Option<(f32, f32, bool)>]>,
+    /// Per class, when instanced: how it is packed.
+    classes: Arc<[Option<PackedLook>]>,
     seed: u64,
     /// Whether the layer's plane can show them (the x-z ground only); their points are left
     /// out otherwise.
     drawable: bool,
+}
+
+/// What packing needs of an instanced class.
+#[derive(Clone, Copy, Debug)]
+struct PackedLook {
+    scale: f32,
+    variation: f32,
+    stance: Stance,
+    /// Promoted classes keep their instances' identities.
+    keep_ids: bool,
 }
 
 /// A chunk's instances of one class, ready for the GPU.
@@ -38,11 +48,12 @@ impl InstancedClasses {
             .classes
             .iter()
             .map(|c| match c.look {
-                ClassLook::Instanced(_) => Some((
-                    c.scale,
-                    c.scale_variation,
-                    keep_ids || c.promotion.is_some(),
-                )),
+                ClassLook::Instanced(_) => Some(PackedLook {
+                    scale: c.scale,
+                    variation: c.scale_variation,
+                    stance: c.stance,
+                    keep_ids: keep_ids || c.promotion.is_some(),
+                }),
                 _ => None,
             })
             .collect();
@@ -79,7 +90,7 @@ impl InstancedClasses {
         &self,
         points: &mut Vec<Point>,
         corner: DVec2,
-        height: &HeightFn,
+        (ground, stands): (&GroundRule, &Stands),
         densities: &[impl Density],
         factor: f64,
     ) -> Vec<PackedClass> {
@@ -95,12 +106,15 @@ impl InstancedClasses {
             if !self.drawable {
                 return false;
             }
-            let appear = appear_factor(p, densities, factor);
+            let (hit, area) = ground
+                .stand_in(p, stands)
+                .unwrap_or((SurfaceHit::flat(0.0), 1.0));
+            let appear = appear_factor(p, densities, area * factor);
             let buffer = &mut buffers[p.class as usize];
             buffer
                 .instances
-                .push(self.instance(p, corner, height, appear));
-            if matches!(self.classes[p.class as usize], Some((_, _, true))) {
+                .push(self.instance(p, corner, &hit, appear));
+            if self.classes[p.class as usize].is_some_and(|c| c.keep_ids) {
                 buffer.ids.push(p.id);
             }
             false
@@ -119,14 +133,16 @@ impl InstancedClasses {
             .collect()
     }
 
-    /// One instance: the same place, turn and scale as the entity path would give it.
-    fn instance(&self, p: &Point, corner: DVec2, height: &HeightFn, appear: f64) -> GpuInstance {
-        let (scale, variation, _) = self.classes[p.class as usize].unwrap_or((1.0, 0.0, false));
-        let pose = Pose::of(&p.id, self.seed, scale, variation);
-        let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
+    /// One instance on surface `hit`: the same place, turn and scale as the entity path
+    /// would give it.
+    fn instance(&self, p: &Point, corner: DVec2, hit: &SurfaceHit, appear: f64) -> GpuInstance {
+        let look = self.classes[p.class as usize].expect("packed classes are instanced");
+        let pose = Pose::of(&p.id, self.seed, look.scale, look.variation);
+        let footing = look.stance.footing(hit.height, hit.normal);
+        let root = Vec3::new(0.0, footing.height, 0.0) - footing.up * footing.sink;
         let offset = p.position - corner;
         GpuInstance {
-            offset: [offset.x as f32, height(ground), offset.y as f32],
+            offset: [offset.x as f32 + root.x, root.y, offset.y as f32 + root.z],
             scale: pose.scale,
             yaw: unit_u16(pose.yaw / std::f64::consts::TAU),
             appear: unit_u16(appear),
@@ -137,7 +153,8 @@ impl InstancedClasses {
 }
 
 /// The level-of-detail factor at which `p` appears: its threshold over the summed density
-/// at full detail (the query ran at `factor` times it).
+/// at full detail (the query ran at `factor` times it, `factor` including the ground's area
+/// weight at the point).
 fn appear_factor(p: &Point, densities: &[impl Density], factor: f64) -> f64 {
     let total: f64 = densities
         .iter()

@@ -17,12 +17,17 @@ pub use status::{
 };
 
 use crate::edits::ScatterEdits;
+use crate::ground::{
+    FlatGround, FunctionGround, GroundRule, HeightmapGround, SharedGround, SurfaceHit,
+    SurfacePolicy,
+};
 use crate::look::{
     ClassLook, GroundPlane, InstanceInserter, InstancedFar, InstancedLook, InstancedShading,
-    MeshLod,
+    MeshLod, Pose, Stance,
 };
 use bevy::prelude::*;
 use rwt_core::density::{Constant, Density, NoiseDensity};
+use rwt_core::query::Point;
 use rwt_core::streaming::{Falloff, StreamingConfig};
 use std::sync::Arc;
 
@@ -118,6 +123,8 @@ pub struct ScatterClass {
     /// For a [`ClassLook::Instanced`] class: its instances near a viewer become entities
     /// (colliders, game logic), drawn exactly as before.
     pub promotion: Option<Promotion>,
+    /// How its instances stand on their surface: upright, along its normal, or between.
+    pub stance: Stance,
 }
 
 /// Near instances of an instanced class become entities: within `distance` (on the ground)
@@ -227,7 +234,15 @@ impl ScatterClass {
             lod: None,
             pick_bounds: None,
             promotion: None,
+            stance: Stance::UPRIGHT,
         }
+    }
+
+    /// Stands instances between upright (`align` 0) and along the surface normal (1), sunk
+    /// `sink` world units into the surface along their up axis.
+    pub fn with_stance(mut self, align: f32, sink: f32) -> Self {
+        self.stance = Stance { align, sink };
+        self
     }
 
     /// Makes the instances of this instanced class within `distance` of a viewer entities
@@ -252,7 +267,7 @@ impl ScatterClass {
     }
 }
 
-/// Ground height under an instance.
+/// The ground a layer's instances stand on.
 #[derive(Clone, Reflect)]
 #[reflect(Clone, Debug)]
 pub enum HeightSource {
@@ -263,9 +278,20 @@ pub enum HeightSource {
     Function(#[reflect(ignore, default = "flat_ground")] Arc<dyn Fn(Vec2) -> f32 + Send + Sync>),
     /// A heightmap: its scale is the height where it is white; 0 outside.
     Image(GroundMap),
+    /// The meshes of entities marked [`crate::ground::ScatterSurface`] for this layer (a terrain, a glTF
+    /// level): no mesh above a point, no instance there.
+    Surfaces,
+    /// Any [`crate::ground::Ground`] (a terrain crate's). Code, not data: reflection does
+    /// not see it (and makes flat ground at 0 when it builds this variant).
+    Custom(#[reflect(ignore, default = "flat_custom")] SharedGround),
 }
 
-/// A thread-safe height function, as generation tasks use it.
+/// What reflection puts in a [`HeightSource::Custom`] it builds: flat ground at 0.
+fn flat_custom() -> SharedGround {
+    Arc::new(FlatGround(0.0))
+}
+
+/// A thread-safe height function, as [`HeightSource::Function`] holds it.
 pub type HeightFn = Arc<dyn Fn(Vec2) -> f32 + Send + Sync>;
 
 impl std::fmt::Debug for HeightSource {
@@ -276,6 +302,8 @@ impl std::fmt::Debug for HeightSource {
             HeightSource::Image(map) => {
                 write!(f, "Image {{ {:?}, scale: {}, .. }}", map.image, map.scale)
             }
+            HeightSource::Surfaces => write!(f, "Surfaces"),
+            HeightSource::Custom(_) => write!(f, "Custom(..)"),
         }
     }
 }
@@ -289,31 +317,19 @@ impl HeightSource {
         }
     }
 
-    /// A thread-safe snapshot; `None` while a heightmap is loading.
-    pub fn resolve(&self, images: &Assets<Image>) -> Option<HeightFn> {
+    /// A thread-safe snapshot; `None` while a heightmap is loading, and for
+    /// [`HeightSource::Surfaces`] (the streaming plugin gathers those meshes).
+    pub fn resolve(&self, images: &Assets<Image>) -> Option<SharedGround> {
         Some(match self {
-            HeightSource::Constant(h) => {
-                let h = *h;
-                Arc::new(move |_| h)
-            }
-            HeightSource::Function(f) => f.clone(),
+            HeightSource::Constant(h) => Arc::new(FlatGround(*h)),
+            HeightSource::Function(f) => Arc::new(FunctionGround::new(f.clone())),
             HeightSource::Image(map) => {
-                let density = map.density(images)?;
-                let scale = map.scale as f32;
-                // `value` is the image's own value, before the density's scale.
-                Arc::new(move |p: Vec2| {
-                    density.value(glam::DVec2::new(p.x as f64, p.y as f64)) as f32 * scale
-                })
+                Arc::new(HeightmapGround::new(map.density(images)?, map.size))
             }
+            HeightSource::Surfaces => return None,
+            HeightSource::Custom(ground) => ground.clone(),
         })
     }
-}
-
-/// Slope (rise over run) of `height` at `p`, by central differences over `step`.
-pub(crate) fn slope(height: &HeightFn, p: Vec2, step: f32) -> f32 {
-    let dx = height(p + Vec2::X * step) - height(p - Vec2::X * step);
-    let dz = height(p + Vec2::Y * step) - height(p - Vec2::Y * step);
-    Vec2::new(dx, dz).length() / (2.0 * step)
 }
 
 /// A scatter layer: instances of its classes, streamed around every [`crate::RwtViewer`].
@@ -339,15 +355,40 @@ pub struct ScatterLayer {
     /// The plane the layer lies on: the x-z ground of a 3-D world (default) or the x-y plane
     /// of a 2-D one.
     pub plane: GroundPlane,
-    /// Ground height.
+    /// The ground instances stand on.
     pub height: HeightSource,
+    /// Which surfaces above a point the layer grows on: the top-most (default) or every
+    /// upward-facing one.
+    pub surfaces: SurfacePolicy,
+    /// Whether densities count per unit of surface area (default): a 60 degree slope gets
+    /// twice the instances of its shadow on the plane, as much per square metre of ground
+    /// as a meadow. Otherwise per unit of the plane.
+    pub per_area: bool,
     /// Instances only where the ground height is within this range.
     pub height_range: Option<(f32, f32)>,
-    /// Instances only where the ground slope (rise over run) is at most this.
+    /// Instances only where the ground slope (rise over run) is at most this; surfaces
+    /// steeper than about 75 degrees grow nothing in any case (see
+    /// [`crate::ground::MAX_AREA_FACTOR`]).
     pub max_slope: Option<f32>,
     /// No instances where this density is 0.5 or more (a painted exclusion map: roads,
     /// clearings, water). Repainting it re-queries the chunks it covers, like a class map.
     pub exclusion: Option<LayerDensity>,
+    /// Other layers whose instances clear this one around them (see [`KeepOut`]).
+    pub keep_out: Vec<KeepOut>,
+}
+
+/// Instances of another layer clear this one around them: no instance of this layer lies
+/// within `radii[c]` (world units, on the ground) of an instance of class `c` of `layer`
+/// (trees clearing grass 1.2 m around their trunks, rocks clearing bushes). It follows that
+/// layer's points at full detail and its edits (removing a tree gives the grass back), not
+/// its own keep-outs or footprints.
+#[derive(Clone, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
+pub struct KeepOut {
+    /// The layer entity whose instances clear this layer.
+    pub layer: Entity,
+    /// Per class of that layer, how far its instances clear (0 or missing: not at all).
+    pub radii: Vec<f32>,
 }
 
 /// A layer's tile size (world units per base tile) unless set: in code and in layer files.
@@ -367,9 +408,12 @@ impl ScatterLayer {
             falloff: None,
             plane: GroundPlane::Xz,
             height: HeightSource::Constant(0.0),
+            surfaces: SurfacePolicy::TopMost,
+            per_area: true,
             height_range: None,
             max_slope: None,
             exclusion: None,
+            keep_out: Vec::new(),
         }
     }
 
@@ -411,9 +455,23 @@ impl ScatterLayer {
         self
     }
 
-    /// Sets the ground height.
+    /// Sets the ground.
     pub fn with_height(mut self, height: HeightSource) -> Self {
         self.height = height;
+        self
+    }
+
+    /// Grows on the meshes marked [`crate::ground::ScatterSurface`] for this layer, by `policy`.
+    pub fn on_surfaces(mut self, policy: SurfacePolicy) -> Self {
+        self.height = HeightSource::Surfaces;
+        self.surfaces = policy;
+        self
+    }
+
+    /// Sets whether densities count per unit of surface area (`true`, the default) or per
+    /// unit of the plane.
+    pub fn with_per_area(mut self, per_area: bool) -> Self {
+        self.per_area = per_area;
         self
     }
 
@@ -429,10 +487,31 @@ impl ScatterLayer {
         self
     }
 
+    /// Keeps this layer out of the instances of `layer`: none within `radii[c]` of one of
+    /// its class `c` (see [`KeepOut`]).
+    pub fn with_keep_out(mut self, layer: Entity, radii: impl Into<Vec<f32>>) -> Self {
+        self.keep_out.push(KeepOut {
+            layer,
+            radii: radii.into(),
+        });
+        self
+    }
+
     /// Removes instances where `mask` is 0.5 or more (e.g. a painted map with `scale: 1.0`).
     pub fn with_exclusion(mut self, mask: LayerDensity) -> Self {
         self.exclusion = Some(mask);
         self
+    }
+
+    /// Where the instance of point `p` stands on `ground`: on the surface the layer grows on
+    /// there, in its class's pose and stance. Every look of a point (an entity, an instanced
+    /// copy, a pick, a promotion) is placed by this.
+    pub(crate) fn place(&self, p: &Point, ground: &GroundRule) -> Transform {
+        let class = &self.classes[(p.class as usize).min(self.classes.len().saturating_sub(1))];
+        let pose = Pose::of(&p.id, self.seed, class.scale, class.scale_variation);
+        let hit = ground.surface(p).unwrap_or_else(|| SurfaceHit::flat(0.0));
+        let footing = class.stance.footing(hit.height, hit.normal);
+        self.plane.place(p, footing, pose, self.seed)
     }
 
     /// Every density the layer reads: its classes', then its exclusion's.

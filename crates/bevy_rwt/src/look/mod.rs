@@ -125,6 +125,71 @@ impl Pose {
     }
 }
 
+/// How a class's instances stand on their surface.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
+pub struct Stance {
+    /// 0: upright (along the plane's up), 1: along the surface normal; in between, the
+    /// direction between them.
+    pub align: f32,
+    /// How far an instance sinks into its surface along its up axis, in world units.
+    pub sink: f32,
+}
+
+impl Stance {
+    /// Upright, standing on the surface.
+    pub const UPRIGHT: Self = Self {
+        align: 0.0,
+        sink: 0.0,
+    };
+
+    /// Where an instance of this stance stands on a surface of `height` and unit `normal`
+    /// (in the plane's frame: `y` up from the plane).
+    pub fn footing(&self, height: f32, normal: Vec3) -> Footing {
+        let align = if self.align.is_finite() {
+            self.align.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let up = Vec3::Y.lerp(normal, align).normalize_or(Vec3::Y);
+        let sink = if self.sink.is_finite() {
+            self.sink
+        } else {
+            0.0
+        };
+        Footing { height, up, sink }
+    }
+}
+
+impl Default for Stance {
+    fn default() -> Self {
+        Self::UPRIGHT
+    }
+}
+
+/// Where one instance stands: its surface's height, its up axis and how far it sinks (in
+/// the plane's frame: `y` up from the plane).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footing {
+    /// Height of the surface above the plane.
+    pub height: f32,
+    /// The instance's up axis (unit).
+    pub up: Vec3,
+    /// How far it sinks along `up`, in world units.
+    pub sink: f32,
+}
+
+impl Footing {
+    /// Upright on a surface of `height`.
+    pub fn upright(height: f32) -> Self {
+        Self {
+            height,
+            up: Vec3::Y,
+            sink: 0.0,
+        }
+    }
+}
+
 /// Salt of the depth hash that keeps overlapping sprites of a [`GroundPlane::Xy`] layer in
 /// a stable order.
 const DEPTH_SALT: u64 = 0xde97;
@@ -163,26 +228,37 @@ impl GroundPlane {
         }
     }
 
-    /// Where an instance of `p` stands: its ground position at `height`, in `pose`, with
-    /// the sprite depth of the x-y plane hashed from its identity in a layer of `seed`.
-    pub fn place(self, p: &Point, height: f32, pose: Pose, seed: u64) -> Transform {
+    /// A vector of the plane's frame (`y` up from the plane) in the world.
+    pub fn vector_of(self, v: Vec3) -> Vec3 {
+        match self {
+            GroundPlane::Xz => v,
+            GroundPlane::Xy => Vec3::new(v.x, v.z, v.y),
+        }
+    }
+
+    /// Where an instance of `p` stands: its ground position on `footing`, turned by the
+    /// pose's yaw about the footing's up axis and scaled, with the sprite depth of the x-y
+    /// plane hashed from its identity in a layer of `seed`.
+    pub fn place(self, p: &Point, footing: Footing, pose: Pose, seed: u64) -> Transform {
         let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
         let yaw = pose.yaw as f32;
+        let up = self.vector_of(footing.up);
+        let sunk = -up * footing.sink;
         let (translation, rotation) = match self {
             GroundPlane::Xz => (
-                Vec3::new(ground.x, height, ground.y),
-                Quat::from_rotation_y(yaw),
+                Vec3::new(ground.x, footing.height, ground.y),
+                Quat::from_rotation_arc(Vec3::Y, up) * Quat::from_rotation_y(yaw),
             ),
             GroundPlane::Xy => {
                 // Sprites of one height are ordered by a depth hashed from their identity.
                 let depth = p.id.unit(seed, DEPTH_SALT) as f32;
                 (
-                    Vec3::new(ground.x, ground.y, height + depth * 1e-3),
-                    Quat::from_rotation_z(yaw),
+                    Vec3::new(ground.x, ground.y, footing.height + depth * 1e-3),
+                    Quat::from_rotation_arc(Vec3::Z, up) * Quat::from_rotation_z(yaw),
                 )
             }
         };
-        Transform::from_translation(translation)
+        Transform::from_translation(translation + sunk)
             .with_rotation(rotation)
             .with_scale(Vec3::splat(pose.scale))
     }

@@ -3,6 +3,7 @@
 
 use super::{ChunkContent, ChunkLoaded, LayerState};
 use crate::edits::EditSet;
+use crate::entities::Spawner;
 use crate::layers::ScatterLayer;
 use bevy::prelude::*;
 use bevy::tasks::futures::check_ready;
@@ -10,11 +11,13 @@ use std::sync::Arc;
 
 /// Collects finished tasks and hands their content to each look.
 pub(super) fn collect_results(
+    mut commands: Commands,
     mut layers: Query<(Entity, &ScatterLayer, &mut LayerState)>,
     mut loaded: MessageWriter<ChunkLoaded>,
 ) {
     for (entity, layer, mut state) in &mut layers {
         let classes = layer.classes.len();
+        let generator = state.generator(layer);
         let state = &mut *state;
         let mut finished = Vec::new();
         for (chunk, c) in state.states.iter_mut() {
@@ -46,6 +49,7 @@ pub(super) fn collect_results(
             c.refused = false;
             c.shown = true;
             c.lod = band;
+            let reground = std::mem::take(&mut c.task_regrounds);
             let packed_count: usize = packed.iter().map(|p| p.buffer.instances.len()).sum();
             let count = points.len() + packed_count;
             let current = state.chunk_edits.get(&chunk);
@@ -58,6 +62,16 @@ pub(super) fn collect_results(
                     EditSet::apply(current, &mut points, classes);
                 }
                 c.stale = true;
+            }
+            if let Some(generator) = generator.as_ref().filter(|_| reground) {
+                let spawner = Spawner {
+                    entity,
+                    layer,
+                    ground: &generator.ground,
+                };
+                state
+                    .entities
+                    .replace_kept(&mut commands, &spawner, chunk, &points);
             }
             state.entities.show(chunk, points);
             loaded.write(ChunkLoaded {

@@ -103,16 +103,17 @@ fn apply_edit(
     );
     let entity_class =
         class.filter(|c| !matches!(layer.classes[*c as usize].look, ClassLook::Instanced(_)));
-    let shown = match (message.edit, entity_class, state.sources.height()) {
+    let generator = state.generator(layer);
+    let shown = match (message.edit, entity_class, generator.as_ref()) {
         (InstanceEdit::Remove, _, _) => {
             state.entities.remove_now(commands, chunk, &id)
                 || state.instanced.remove_now(commands, chunk, &id)
         }
-        (InstanceEdit::Reclass(_), Some(class), Some(height)) => {
+        (InstanceEdit::Reclass(_), Some(class), Some(generator)) => {
             let spawner = Spawner {
                 entity,
                 layer,
-                height,
+                ground: &generator.ground,
             };
             let p = Point {
                 position,

@@ -1,11 +1,14 @@
-//! A chunk's points as the layer shows them: the query at the chunk's level of detail, the
-//! height and slope filters, then the chunk's per-instance edits and footprints. Generation
-//! tasks make them so, and picking makes them again for the chunks a ray crosses.
+//! A chunk's points as the layer shows them: the query at the chunk's level of detail on
+//! the layer's ground (its surfaces, their areas, the height and slope filters), then the
+//! chunk's per-instance edits and footprints. Generation tasks make them so, and picking
+//! makes them again for the chunks a ray crosses.
 
+use super::keep_out::Clearing;
 use super::resolve::Sources;
 use crate::edits::{Edit, EditSet};
 use crate::footprints::GroundFootprint;
-use crate::layers::{HeightFn, ScatterLayer, SharedDensity, slope};
+use crate::ground::{GroundRule, GroundSettings, Stands};
+use crate::layers::{ScatterLayer, SharedDensity};
 use bevy::prelude::*;
 use rwt_core::density::Scale;
 use rwt_core::query::{Point, QueryError, Rect, Sampler};
@@ -23,9 +26,10 @@ pub(crate) struct Changes {
 pub(crate) struct Generator {
     pub sampler: Arc<Sampler>,
     pub densities: Vec<SharedDensity>,
-    pub height: HeightFn,
-    range: Option<(f32, f32)>,
-    max_slope: Option<f32>,
+    /// The layer's ground and how it grows on it.
+    pub ground: GroundRule,
+    /// The other layers whose instances clear this one.
+    keep_out: Arc<[Clearing]>,
     classes: usize,
 }
 
@@ -33,15 +37,54 @@ pub(crate) struct Generator {
 pub(crate) type Scaled = Vec<Scale<SharedDensity>>;
 
 impl Generator {
-    pub(super) fn new(layer: &ScatterLayer, sampler: Arc<Sampler>, sources: &Sources) -> Self {
+    pub(super) fn new(
+        layer: &ScatterLayer,
+        sampler: Arc<Sampler>,
+        sources: &Sources,
+        keep_out: Arc<[Clearing]>,
+    ) -> Self {
         Self {
             sampler,
             densities: sources.densities.clone(),
-            height: sources.height.clone(),
-            range: layer.height_range,
-            max_slope: layer.max_slope,
+            ground: GroundRule::new(
+                sources.ground.clone(),
+                GroundSettings {
+                    policy: layer.surfaces,
+                    range: layer.height_range,
+                    max_slope: layer.max_slope,
+                    per_area: layer.per_area,
+                    seed: layer.seed,
+                },
+            ),
+            keep_out,
             classes: layer.classes.len(),
         }
+    }
+
+    /// The same generator without its keep-outs: what another layer's keep-out asks of it
+    /// (a chain of keep-outs goes one layer deep).
+    pub fn without_keep_out(&self) -> Self {
+        Self {
+            keep_out: Arc::from([]),
+            ..self.clone()
+        }
+    }
+
+    /// Whether both generate from the same sampler, densities and ground.
+    pub fn same_as(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.sampler, &other.sampler)
+            && Arc::ptr_eq(&self.ground.ground, &other.ground.ground)
+            && self.densities.len() == other.densities.len()
+            && self
+                .densities
+                .iter()
+                .zip(&other.densities)
+                .all(|(a, b)| Arc::ptr_eq(a, b))
+    }
+
+    /// Applies a set of edits of this layer to `out`.
+    pub fn edit(&self, edits: &EditSet, out: &mut Vec<Point>) {
+        EditSet::apply(edits, out, self.classes);
     }
 
     /// The class densities at level-of-detail `factor`, of classes `0..=last` (all of
@@ -65,22 +108,31 @@ impl Generator {
         scaled: &Scaled,
         changes: &Changes,
     ) -> Result<Vec<Point>, QueryError> {
-        let mut out = Vec::new();
-        let height = &self.height;
-        self.sampler.query_classes(rect, scaled, |p| {
-            let ground = Vec2::new(p.position.x as f32, p.position.y as f32);
-            let in_range = self
-                .range
-                .is_none_or(|(lo, hi)| (lo..=hi).contains(&height(ground)));
-            let flat_enough = self
-                .max_slope
-                .is_none_or(|m| slope(height, ground, 0.25) <= m);
-            if in_range && flat_enough {
-                out.push(p);
-            }
-        })?;
+        let mut out = self.ground.points(&self.sampler, rect, scaled)?;
+        self.apply(rect, &mut out, changes)?;
+        Ok(out)
+    }
+
+    /// [`Generator::points`], with the surfaces the query found them on (see
+    /// [`GroundRule::stand_in`]).
+    pub fn points_and_stands(
+        &self,
+        rect: Rect,
+        scaled: &Scaled,
+        changes: &Changes,
+    ) -> Result<(Vec<Point>, Stands), QueryError> {
+        let (mut out, stands) = self.ground.points_and_stands(&self.sampler, rect, scaled)?;
+        self.apply(rect, &mut out, changes)?;
+        Ok((out, stands))
+    }
+
+    /// The other layers' keep-outs, the chunk's edits, then its footprints.
+    fn apply(&self, rect: Rect, out: &mut Vec<Point>, changes: &Changes) -> Result<(), QueryError> {
+        for clearing in self.keep_out.iter() {
+            clearing.clear(rect, out)?;
+        }
         if let Some(edits) = &changes.edits {
-            EditSet::apply(edits, &mut out, self.classes);
+            EditSet::apply(edits, out, self.classes);
         }
         if !changes.footprints.is_empty() {
             let cleared = |p: &Point| {
@@ -91,7 +143,7 @@ impl Generator {
             };
             out.retain(|p| !cleared(p));
         }
-        Ok(out)
+        Ok(())
     }
 }
 

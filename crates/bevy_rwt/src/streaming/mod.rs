@@ -14,11 +14,13 @@ mod collect;
 mod edit;
 mod footprint;
 mod generate;
+mod keep_out;
 mod plan;
 mod plugin;
 mod repaint;
 mod resolve;
 mod spawn;
+mod surfaces;
 
 pub(crate) use footprint::KnownFootprints;
 pub(crate) use generate::{Changes, Generator};
@@ -29,8 +31,6 @@ use crate::edits::EditSet;
 use crate::edits::EditStamp;
 use crate::entities::EntityQueue;
 use crate::instancing::{InstancedClasses, InstancedQueue, PackedClass};
-#[cfg(feature = "brush")]
-use crate::layers::HeightFn;
 use crate::layers::{ScatterLayer, ScatterLayerStatus};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -126,6 +126,11 @@ struct ChunkState {
     refused: bool,
     /// Whether a generation finished since the chunk loaded (at level of detail `lod`).
     shown: bool,
+    /// The ground under the chunk changed: the next generation also moves the entities it
+    /// keeps onto the new ground.
+    reground: bool,
+    /// Whether the task in flight was started for a changed ground.
+    task_regrounds: bool,
 }
 
 /// A layer's points as shown: see [`LayerState::shown`].
@@ -163,14 +168,33 @@ pub(crate) struct LayerState {
     edits_indexed: bool,
     /// Whether a refused query was logged (once per layer).
     refusal_logged: bool,
+    /// The layers that clear this one, as its tasks generate with them; `None` while one
+    /// of them is not ready.
+    keep_out: Option<Arc<[keep_out::Clearing]>>,
 }
 
 impl LayerState {
-    /// The layer's ground height as its chunks are generated with (`None` until resolved,
-    /// e.g. while a heightmap loads): where the brush paints.
+    /// The layer's ground as its chunks are generated on (`None` until resolved, e.g.
+    /// while a heightmap loads): where the brush paints.
     #[cfg(feature = "brush")]
-    pub(crate) fn height(&self) -> Option<&HeightFn> {
-        self.sources.height()
+    pub(crate) fn ground(&self) -> Option<&crate::ground::SharedGround> {
+        self.sources.ground()
+    }
+
+    /// How the layer's chunks are generated (`None` until its sampler and sources are
+    /// made).
+    fn generator(&self, layer: &ScatterLayer) -> Option<Generator> {
+        let keep_out = match &self.keep_out {
+            Some(k) => k.clone(),
+            None if layer.keep_out.is_empty() => Arc::from([]),
+            None => return None,
+        };
+        Some(Generator::new(
+            layer,
+            self.sampler.clone()?,
+            &self.sources.ready()?,
+            keep_out,
+        ))
     }
 
     /// The layer's sampler, made on first use.
@@ -214,8 +238,7 @@ impl LayerState {
     /// and each shown chunk with its level-of-detail factor and edits (`None` until the
     /// layer's sources are made).
     pub(crate) fn shown(&self, layer: &ScatterLayer) -> Option<ShownLayer> {
-        let sampler = self.sampler.clone()?;
-        let generator = Generator::new(layer, sampler, &self.sources.ready()?);
+        let generator = self.generator(layer)?;
         let chunks = self
             .states
             .iter()
@@ -232,6 +255,24 @@ impl LayerState {
     /// Marks `chunk` for regeneration, if loaded.
     fn mark_chunk_stale(&mut self, chunk: ChunkCoord) {
         if let Some(c) = self.states.get_mut(&chunk) {
+            c.stale = true;
+        }
+    }
+
+    /// Marks every chunk overlapping `region`, where the ground changed, for regeneration
+    /// on the new ground.
+    fn mark_regrounded(&mut self, size: f64, region: &Rect) {
+        for (chunk, c) in self.states.iter_mut() {
+            if chunk.rect(size).overlaps(region) {
+                c.stale = true;
+                c.reground = true;
+            }
+        }
+    }
+
+    /// Marks every chunk for regeneration.
+    fn mark_all_stale(&mut self) {
+        for c in self.states.values_mut() {
             c.stale = true;
         }
     }
@@ -309,14 +350,22 @@ fn restart(
 }
 
 /// Copies each layer's counts into its [`ScatterLayerStatus`] (its loaded chunks are
-/// copied by planning, when they change).
-fn update_status(mut layers: Query<(&LayerState, &mut ScatterLayerStatus)>) {
-    for (state, mut status) in &mut layers {
+/// copied by planning, when they change). Meshes of surfaces being indexed count as
+/// pending tasks of the layers on surfaces.
+fn update_status(
+    mut layers: Query<(&ScatterLayer, &LayerState, &mut ScatterLayerStatus)>,
+    surfaces: Res<surfaces::SurfaceMeshes>,
+) {
+    for (layer, state, mut status) in &mut layers {
         let status = status.bypass_change_detection();
         status.live_entities = state.entities.live();
         status.live_instanced = state.instanced.live();
         status.promoted_instances = state.instanced.promoted();
-        status.pending_tasks = state.pending();
+        let indexing = match layer.height {
+            crate::layers::HeightSource::Surfaces => surfaces.building(),
+            _ => 0,
+        };
+        status.pending_tasks = state.pending() + indexing;
         status.queued_spawns = state.entities.queued() + state.instanced.queued();
         status.refused_chunks = state.states.values().filter(|c| c.refused).count();
     }

@@ -11,6 +11,7 @@ use crate::viewers::Viewers;
 use bevy::prelude::*;
 use bevy::tasks::AsyncComputeTaskPool;
 use rwt_core::streaming::{ChunkCoord, Viewer, nearest_first};
+use std::sync::Arc;
 
 /// The resources planning reads.
 #[derive(bevy::ecs::system::SystemParam)]
@@ -60,15 +61,24 @@ pub(super) fn plan_chunks(
             status.loaded_chunks = state.chunks.loaded().iter().copied().collect();
         }
         mark_band_changes(layer, state, viewers);
-        let free = inputs
-            .settings
-            .max_tasks_in_flight
-            .saturating_sub(state.in_flight());
+        // A layer that other layers clear waits until they are ready.
+        let keep_out = match &state.keep_out {
+            Some(k) => Some(k.clone()),
+            None => layer.keep_out.is_empty().then(|| Arc::from([])),
+        };
+        let free = match keep_out {
+            Some(_) => inputs
+                .settings
+                .max_tasks_in_flight
+                .saturating_sub(state.in_flight()),
+            None => 0,
+        };
+        let keep_out = keep_out.unwrap_or_else(|| Arc::from([]));
         let job = Job {
             entity,
             footprints: &inputs.footprints,
             layer,
-            generator: Generator::new(layer, sampler, &sources),
+            generator: Generator::new(layer, sampler, &sources, keep_out),
             instanced: &instanced,
         };
         start_tasks(&job, state, viewers, free);
@@ -143,6 +153,7 @@ fn start_tasks(job: &Job, state: &mut LayerState, viewers: &[Viewer], free: usiz
         };
         let c = state.states.get_mut(&chunk).expect("listed above");
         c.stale = false;
+        c.task_regrounds = std::mem::take(&mut c.reground);
         c.task = Some((start_task(job, chunk, band, changes), band));
     }
 }
@@ -157,8 +168,9 @@ fn start_task(job: &Job, chunk: ChunkCoord, band: i64, changes: Changes) -> Chun
     let factor = layer.falloff.map_or(1.0, |f| f.factor(band));
     AsyncComputeTaskPool::get().spawn(async move {
         let scaled = generator.scaled(factor, None);
-        let mut out = generator.points(rect, &scaled, &changes)?;
-        let packed = instanced.pack(&mut out, rect.min(), &generator.height, &scaled, factor);
+        let (mut out, stands) = generator.points_and_stands(rect, &scaled, &changes)?;
+        let ground = (&generator.ground, &stands);
+        let packed = instanced.pack(&mut out, rect.min(), ground, &scaled, factor);
         Ok(ChunkContent {
             points: out,
             packed,

@@ -3,9 +3,11 @@
 use super::collect::collect_results;
 use super::edit::apply_edits;
 use super::footprint::{KnownFootprints, track_footprints};
+use super::keep_out::track_keep_out;
 use super::plan::plan_chunks;
 use super::repaint::{PaintedRegions, repaint};
 use super::spawn::apply_budget;
+use super::surfaces::{SurfaceMeshes, track_surfaces};
 use super::*;
 use crate::edits::{EditInstance, ScatterEdits};
 use crate::footprints::Footprint;
@@ -55,6 +57,8 @@ impl Plugin for RwtStreamingPlugin {
         app.register_type::<ScatterEntity>()
             .register_type::<ScatterEdits>()
             .register_type::<Footprint>()
+            .register_type::<crate::KeepOut>()
+            .register_type::<crate::ground::ScatterSurface>()
             .register_type::<ChunkLoaded>()
             .register_type::<ChunkUnloaded>()
             .register_type::<DensityMapPainted>()
@@ -64,6 +68,7 @@ impl Plugin for RwtStreamingPlugin {
             .init_resource::<InstancedMeshes>()
             .init_resource::<PaintedRegions>()
             .init_resource::<KnownFootprints>()
+            .init_resource::<SurfaceMeshes>()
             .add_message::<ChunkLoaded>()
             .add_message::<ChunkUnloaded>()
             .add_message::<DensityMapPainted>()
@@ -78,6 +83,8 @@ impl Plugin for RwtStreamingPlugin {
                         repaint,
                         apply_edits,
                         track_footprints,
+                        track_surfaces,
+                        track_keep_out,
                         plan_chunks,
                     )
                         .chain()

@@ -1,8 +1,10 @@
 //! A layer's densities and height source as thread-safe snapshots for generation tasks.
 //! Each is made once and kept; repainting a map forgets only the snapshots that read it.
 
+use crate::ground::SharedGround;
+use crate::layers::too_large;
 use crate::layers::{AssetFailure, AssetProblem, LayerAsset, merge_missing, missing_asset};
-use crate::layers::{AssetStatus, HeightFn, LayerDensity, ScatterLayer, SharedDensity, too_large};
+use crate::layers::{AssetStatus, HeightSource, LayerDensity, ScatterLayer, SharedDensity};
 use bevy::prelude::*;
 use rwt_core::density::Exclude;
 use std::sync::Arc;
@@ -14,15 +16,16 @@ pub(super) struct Resolved {
     classes: Vec<Option<SharedDensity>>,
     /// The exclusion mask, when the layer has one.
     exclusion: Option<SharedDensity>,
-    height: Option<HeightFn>,
+    /// The ground; for a layer on surfaces, set by [`Resolved::set_surfaces`].
+    ground: Option<SharedGround>,
     /// Every class's density with the exclusion applied, once all are made.
     combined: Option<Vec<SharedDensity>>,
 }
 
-/// What generation tasks read: every class's density (exclusion applied) and the height.
+/// What generation tasks read: every class's density (exclusion applied) and the ground.
 pub(super) struct Sources {
     pub densities: Vec<SharedDensity>,
-    pub height: HeightFn,
+    pub ground: SharedGround,
 }
 
 /// The snapshot of `density`, or why it cannot be made yet.
@@ -91,7 +94,7 @@ impl Resolved {
         if let Some((handle, rect)) = layer.height.image()
             && handle.id() == image
         {
-            self.height = None;
+            self.ground = None;
             covered.push(rect);
         }
         covered
@@ -122,13 +125,12 @@ impl Resolved {
                 .map(|d| self.exclusion = Some(d))
                 .unwrap_or_else(|m| missing.push(m));
         }
-        if self.height.is_none() {
-            match layer.height.resolve(images) {
-                Some(h) => self.height = Some(h),
-                None => {
-                    let (image, _) = layer.height.image().expect("only heightmaps wait");
-                    missing.push(unreadable(image, images, server));
-                }
+        if self.ground.is_none() {
+            match (layer.height.resolve(images), layer.height.image()) {
+                (Some(g), _) => self.ground = Some(g),
+                (None, Some((image, _))) => missing.push(unreadable(image, images, server)),
+                // The meshes of a layer on surfaces are still being gathered.
+                (None, None) => missing.push(AssetStatus::Waiting(Vec::new())),
             }
         }
         if !missing.is_empty() {
@@ -139,7 +141,7 @@ impl Resolved {
         }
         Ok(Sources {
             densities: self.combined.clone().expect("made above"),
-            height: self.height.clone().expect("made above"),
+            ground: self.ground.clone().expect("made above"),
         })
     }
 
@@ -147,13 +149,20 @@ impl Resolved {
     pub fn ready(&self) -> Option<Sources> {
         Some(Sources {
             densities: self.combined.clone()?,
-            height: self.height.clone()?,
+            ground: self.ground.clone()?,
         })
     }
 
-    /// The height snapshot, once made.
-    pub fn height(&self) -> Option<&HeightFn> {
-        self.height.as_ref()
+    /// The ground snapshot, once made.
+    pub fn ground(&self) -> Option<&SharedGround> {
+        self.ground.as_ref()
+    }
+
+    /// Sets the ground of a layer on surfaces (its meshes were gathered or changed).
+    pub fn set_surfaces(&mut self, layer: &ScatterLayer, ground: SharedGround) {
+        if matches!(layer.height, HeightSource::Surfaces) {
+            self.ground = Some(ground);
+        }
     }
 
     /// Every class's density with the exclusion mask applied.

@@ -28,11 +28,11 @@ pub(super) fn apply_budget(
         state
             .entities
             .despawn_queued(&mut commands, &mut despawn_budget);
-        if let Some(height) = state.sources.height() {
+        if let Some(generator) = state.generator(layer) {
             let spawner = Spawner {
                 entity,
                 layer,
-                height,
+                ground: &generator.ground,
             };
             state
                 .entities

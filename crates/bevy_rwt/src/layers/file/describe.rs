@@ -40,6 +40,9 @@ impl LayerDescription {
         let (height, ground) = namer
             .height(&layer.height)
             .map_err(|e| not(LayerPart::Ground, e))?;
+        if !layer.keep_out.is_empty() {
+            return Err(not(LayerPart::Ground, Undescribable::KeepOut));
+        }
         let streaming = &layer.streaming;
         Ok(Self {
             classes,
@@ -54,6 +57,8 @@ impl LayerDescription {
             plane: layer.plane,
             height,
             ground,
+            surfaces: layer.surfaces,
+            per_area: layer.per_area,
             height_range: layer.height_range,
             max_slope: layer.max_slope,
             exclusion: match &layer.exclusion {
@@ -114,6 +119,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             scale: c.scale,
             scale_variation: c.scale_variation,
             lod,
+            stance: c.stance,
         })
     }
 
@@ -175,6 +181,8 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
                 let ground = MapDescription::of(map, self.image(&map.image)?);
                 (0.0, Some(HeightDescription::Image(ground)))
             }
+            HeightSource::Surfaces => (0.0, Some(HeightDescription::Surfaces)),
+            HeightSource::Custom(_) => return Err(Undescribable::CustomGround),
         })
     }
 }

@@ -135,6 +135,12 @@ pub enum Undescribable {
     /// An image (density map, heightmap, texture) without a path.
     #[error("image {0:?} has no asset path")]
     Image(AssetId<Image>),
+    /// Keep-outs name other layers by entity, which a file cannot.
+    #[error("keep-outs name other layers by entity, which a layer file cannot")]
+    KeepOut,
+    /// A ground made in code ([`HeightSource::Custom`](crate::HeightSource::Custom)).
+    #[error("a custom ground (code) has no file form")]
+    CustomGround,
     /// A height function without a name in `NamedAssets`.
     #[error("a height function without a name in NamedAssets")]
     HeightFunction,

@@ -74,7 +74,8 @@ use super::{
     DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap, HeightSource, LayerDensity,
     ScatterClass, ScatterLayer,
 };
-use crate::look::{GroundPlane, InstancedShading, InstancedShadows, MeshLod, blade_mesh};
+use crate::ground::SurfacePolicy;
+use crate::look::{GroundPlane, InstancedShading, InstancedShadows, MeshLod, Stance, blade_mesh};
 use bevy::prelude::*;
 use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::Falloff;
@@ -289,6 +290,10 @@ impl InstancedShadingDescription {
     }
 }
 
+fn yes() -> bool {
+    true
+}
+
 fn one() -> f32 {
     1.0
 }
@@ -315,6 +320,10 @@ pub struct ClassDescription {
     /// A far mesh and material (see [`MeshLod`]).
     #[serde(default)]
     pub lod: Option<LodDescription>,
+    /// How instances stand on their surface, e.g. `(align: 1.0, sink: 0.05)` (see
+    /// [`Stance`](crate::look::Stance)); upright when absent.
+    #[serde(default)]
+    pub stance: Stance,
 }
 
 /// The far level of detail of a class in a layer file (see [`MeshLod`]; for an instanced
@@ -340,6 +349,9 @@ pub enum HeightDescription {
     Named(String),
     /// A heightmap (see [`HeightSource::Image`]): its scale is the height where it is white.
     Image(MapDescription),
+    /// The meshes marked [`ScatterSurface`](crate::ground::ScatterSurface) for the layer
+    /// (see [`HeightSource::Surfaces`]).
+    Surfaces,
 }
 
 fn default_tile() -> f64 {
@@ -384,6 +396,12 @@ pub struct LayerDescription {
     /// The ground's height source, when it is not flat.
     #[serde(default)]
     pub ground: Option<HeightDescription>,
+    /// Which surfaces above a point the layer grows on: `TopMost` (default) or `Every`.
+    #[serde(default)]
+    pub surfaces: SurfacePolicy,
+    /// Whether densities count per unit of surface area (default) or of the plane.
+    #[serde(default = "yes")]
+    pub per_area: bool,
     /// Allowed ground height range.
     #[serde(default)]
     pub height_range: Option<(f32, f32)>,
@@ -536,6 +554,8 @@ impl LayerDescription {
             .map(|e| e.to_density(&mut handles.image));
         layer.height_range = self.height_range;
         layer.max_slope = self.max_slope;
+        layer.surfaces = self.surfaces;
+        layer.per_area = self.per_area;
         Ok(layer)
     }
 
@@ -555,6 +575,7 @@ impl LayerDescription {
             Some(HeightDescription::Image(map)) => {
                 HeightSource::Image(map.to_map(&mut handles.image))
             }
+            Some(HeightDescription::Surfaces) => HeightSource::Surfaces,
         })
     }
 }
@@ -629,6 +650,7 @@ impl ClassDescription {
                 return Ok(ScatterClass {
                     scale: self.scale,
                     scale_variation: self.scale_variation,
+                    stance: self.stance,
                     ..class.with_instanced_far(far, lod.distance)
                 });
             }
@@ -644,6 +666,7 @@ impl ClassDescription {
             scale: self.scale,
             scale_variation: self.scale_variation,
             lod,
+            stance: self.stance,
             ..class
         })
     }
