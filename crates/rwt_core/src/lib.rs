@@ -81,6 +81,7 @@
 
 pub mod analysis;
 pub mod bench;
+pub mod clumps;
 #[cfg(feature = "build")]
 pub mod construction;
 #[cfg(feature = "build")]
@@ -97,6 +98,7 @@ pub mod tileset;
 pub mod tiling;
 pub mod wang;
 
+pub use clumps::{ClumpKernel, ClumpParams, Clumps};
 pub use density::{
     Constant, Density, DistanceFalloff, Exclude, FnDensity, ImageDensity, LocalModel, Mask,
     NoiseDensity, NoiseParams, Placement, Product, Scale, Sum, SumOf,

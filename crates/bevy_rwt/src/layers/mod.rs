@@ -26,6 +26,7 @@ use crate::look::{
     MeshLod, Pose, Stance,
 };
 use bevy::prelude::*;
+use rwt_core::clumps::Clumps;
 use rwt_core::density::{Constant, Density, NoiseDensity};
 use rwt_core::query::Point;
 use rwt_core::streaming::{Falloff, StreamingConfig};
@@ -55,6 +56,9 @@ pub enum LayerDensity {
     /// A painted map: its scale is the instances per square unit where it is white.
     /// Repainting the image re-queries the chunks it covers.
     Image(GroundMap),
+    /// Instances gathered into patches around sparse blue-noise parents (`rwt_core`'s
+    /// clumps: Thomas or Matérn kernels).
+    Clumps(Clumps),
     /// Any density of `rwt_core`. Code, not data: reflection does not see it (and makes an
     /// empty one when it builds this variant).
     Custom(#[reflect(ignore, default = "no_density")] Arc<dyn Density + Send + Sync>),
@@ -65,6 +69,7 @@ impl std::fmt::Debug for LayerDensity {
         match self {
             LayerDensity::Constant(v) => write!(f, "Constant({v})"),
             LayerDensity::Noise(n) => write!(f, "{n:?}"),
+            LayerDensity::Clumps(c) => write!(f, "{:?}", c.params()),
             LayerDensity::Image(map) => {
                 write!(f, "Image {{ {:?}, scale: {}, .. }}", map.image, map.scale)
             }
@@ -95,6 +100,7 @@ impl LayerDensity {
         Some(match self {
             LayerDensity::Constant(v) => Arc::new(Constant(*v)),
             LayerDensity::Noise(n) => Arc::new(n.clone()),
+            LayerDensity::Clumps(c) => Arc::new(c.clone()),
             LayerDensity::Image(map) => Arc::new(map.density(images)?),
             LayerDensity::Custom(d) => d.clone(),
         })

@@ -154,6 +154,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
         Ok(match d {
             LayerDensity::Constant(v) => DensityDescription::Constant(*v),
             LayerDensity::Noise(n) => DensityDescription::Noise(n.params()),
+            LayerDensity::Clumps(c) => DensityDescription::Clumps(c.params()),
             LayerDensity::Image(map) => {
                 DensityDescription::Image(MapDescription::of(map, self.image(&map.image)?))
             }

@@ -80,6 +80,9 @@ pub enum InvalidLayer {
         /// The unload distance.
         unload_distance: f64,
     },
+    /// Clump parameters out of range.
+    #[error("clumps: {0}")]
+    Clumps(rwt_core::clumps::ClumpError),
     /// A class's far-mesh distance is not positive and finite.
     #[error("class {class}: lod distance {distance} must be positive")]
     LodDistance {

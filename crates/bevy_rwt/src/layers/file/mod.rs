@@ -77,6 +77,7 @@ use super::{
 use crate::ground::SurfacePolicy;
 use crate::look::{GroundPlane, InstancedShading, InstancedShadows, MeshLod, Stance, blade_mesh};
 use bevy::prelude::*;
+use rwt_core::clumps::{ClumpParams, Clumps};
 use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::Falloff;
 use rwt_core::streaming::StreamingConfig;
@@ -103,6 +104,9 @@ pub enum DensityDescription {
     Noise(NoiseParams),
     /// A painted map: its scale is the instances per square unit where it is white.
     Image(MapDescription),
+    /// Instances in patches (see [`Clumps`]), e.g. `Clumps(seed: 4, clumps: 0.002,
+    /// per_clump: 20.0, radius: 2.5, kernel: Thomas)`.
+    Clumps(ClumpParams),
 }
 
 /// An image over a ground rectangle in a layer file (a [`GroundMap`]), written
@@ -415,12 +419,18 @@ pub struct LayerDescription {
 
 impl DensityDescription {
     /// The layer density, with image handles made by `image`.
-    fn to_density(&self, image: &mut impl FnMut(&str) -> Handle<Image>) -> LayerDensity {
-        match self {
+    fn to_density(
+        &self,
+        image: &mut impl FnMut(&str) -> Handle<Image>,
+    ) -> Result<LayerDensity, InvalidLayer> {
+        Ok(match self {
             DensityDescription::Constant(v) => LayerDensity::Constant(*v),
             DensityDescription::Noise(params) => LayerDensity::Noise(NoiseDensity::new(*params)),
             DensityDescription::Image(map) => LayerDensity::Image(map.to_map(image)),
-        }
+            DensityDescription::Clumps(params) => {
+                LayerDensity::Clumps(Clumps::new(*params).map_err(InvalidLayer::Clumps)?)
+            }
+        })
     }
 }
 
@@ -491,6 +501,12 @@ impl LayerDescription {
                 unload_distance,
             });
         }
+        let densities = d.classes.iter().map(|c| &c.density).chain(&d.exclusion);
+        for density in densities {
+            if let DensityDescription::Clumps(params) = density {
+                Clumps::new(*params).map_err(InvalidLayer::Clumps)?;
+            }
+        }
         for (i, c, lod) in d
             .classes
             .iter()
@@ -548,10 +564,10 @@ impl LayerDescription {
         layer.falloff = self
             .falloff
             .map(|(near, far)| Falloff::new(near, far).with_floor(self.falloff_floor));
-        layer.exclusion = self
-            .exclusion
-            .as_ref()
-            .map(|e| e.to_density(&mut handles.image));
+        layer.exclusion = match &self.exclusion {
+            Some(e) => Some(e.to_density(&mut handles.image)?),
+            None => None,
+        };
         layer.height_range = self.height_range;
         layer.max_slope = self.max_slope;
         layer.surfaces = self.surfaces;
@@ -635,7 +651,7 @@ impl ClassDescription {
         T: FnMut(&MaterialDescription) -> Handle<StandardMaterial>,
         I: FnMut(&str) -> Handle<Image>,
     {
-        let density = self.density.to_density(&mut handles.image);
+        let density = self.density.to_density(&mut handles.image)?;
         let mesh = handles.mesh(&self.mesh)?;
         let class = match &self.material {
             MaterialDescription::Instanced(m) => {

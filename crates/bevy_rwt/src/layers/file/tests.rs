@@ -319,3 +319,89 @@ fn what_a_file_cannot_name_is_a_typed_error() {
         "{err}"
     );
 }
+
+#[test]
+fn ground_stances_and_clumps_read_back_the_same() {
+    use crate::ground::SurfacePolicy;
+    use rwt_core::clumps::{ClumpKernel, ClumpParams, Clumps};
+    let names = NamedAssets::default();
+    names.insert_mesh("moss", uuid::<Mesh>(3));
+    names.insert_material("green", uuid::<StandardMaterial>(4));
+    let params = ClumpParams {
+        seed: 4,
+        clumps: 0.002,
+        per_clump: 20.0,
+        radius: 2.5,
+        kernel: ClumpKernel::Matern,
+    };
+    let density = LayerDensity::Clumps(Clumps::new(params).unwrap());
+    let class = ScatterClass::new(density, uuid::<Mesh>(3), uuid::<StandardMaterial>(4))
+        .with_stance(0.75, 0.05);
+    let layer = ScatterLayer::new(vec![class])
+        .on_surfaces(SurfacePolicy::Every)
+        .with_per_area(false);
+    let d = LayerDescription::describe(&layer, &names, |_| None).unwrap();
+    assert_eq!(d.ground, Some(HeightDescription::Surfaces));
+    let text = d.to_ron().unwrap();
+    for part in [
+        "Surfaces",
+        "Every",
+        "per_area: false",
+        "align: 0.75",
+        "Matern",
+    ] {
+        assert!(text.contains(part), "{part} missing from {text}");
+    }
+    let read = LayerDescription::from_ron(&text).unwrap();
+    assert_eq!(read, d);
+    let back = read
+        .to_layer(
+            &names,
+            |_| unreachable!(),
+            |_| unreachable!(),
+            |_| unreachable!(),
+        )
+        .unwrap();
+    assert!(matches!(back.height, HeightSource::Surfaces));
+    assert_eq!(
+        (back.surfaces, back.per_area),
+        (SurfacePolicy::Every, false)
+    );
+    assert_eq!(back.classes[0].stance, layer.classes[0].stance);
+    let LayerDensity::Clumps(c) = &back.classes[0].density else {
+        panic!("{:?}", back.classes[0].density);
+    };
+    assert_eq!(c.params(), params);
+    // Clump parameters out of range are refused when the file is read.
+    let bad = text.replace("radius: 2.5", "radius: -1.0");
+    assert!(matches!(
+        LayerDescription::from_ron(&bad),
+        Err(LayerFileError::Invalid(InvalidLayer::Clumps(_)))
+    ));
+}
+
+#[test]
+fn keep_outs_and_custom_grounds_are_not_describable() {
+    let names = NamedAssets::default();
+    names.insert_mesh("moss", uuid::<Mesh>(3));
+    names.insert_material("green", uuid::<StandardMaterial>(4));
+    let class = ScatterClass::new(
+        LayerDensity::Constant(1.0),
+        uuid::<Mesh>(3),
+        uuid::<StandardMaterial>(4),
+    );
+    let kept = ScatterLayer::new(vec![class.clone()]).with_keep_out(Entity::PLACEHOLDER, [1.0]);
+    let custom = ScatterLayer::new(vec![class]).with_height(HeightSource::Custom(
+        std::sync::Arc::new(crate::ground::FlatGround(1.0)),
+    ));
+    for (layer, what) in [
+        (kept, Undescribable::KeepOut),
+        (custom, Undescribable::CustomGround),
+    ] {
+        let e = LayerDescription::describe(&layer, &names, |_| None).unwrap_err();
+        assert!(
+            matches!(&e, LayerFileError::NotDescribable { what: w, .. } if *w == what),
+            "{e}"
+        );
+    }
+}
