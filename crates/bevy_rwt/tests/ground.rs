@@ -171,8 +171,9 @@ fn a_triangulated_heightfield_gives_the_points_of_its_function() {
     }
 }
 
-/// A level: a ground quad, a raised box (a rock: its top, and walls), a bridge deck above
-/// the ground with a gap under it, and a tilted roof steeper than the slope limit.
+/// A level: a ground quad, a raised box (a rock: its top, and walls), a bridge deck (a
+/// box, its top at 4) above the ground with a gap under it, and a tilted roof steeper than
+/// the slope limit.
 fn level(app: &mut App, rock_marker: ScatterSurface) -> [Entity; 4] {
     let ground = add_mesh(app, quad(Vec2::splat(-60.0), Vec2::splat(60.0), 0.0));
     let ground = spawn_surface(app, ground, Transform::IDENTITY, ScatterSurface::all());
@@ -183,8 +184,9 @@ fn level(app: &mut App, rock_marker: ScatterSurface) -> [Entity; 4] {
         Transform::from_xyz(-20.0, 1.5, -20.0),
         rock_marker,
     );
-    let deck = add_mesh(app, quad(Vec2::new(10.0, -4.0), Vec2::new(40.0, 4.0), 4.0));
-    let deck = spawn_surface(app, deck, Transform::IDENTITY, ScatterSurface::all());
+    let deck = add_mesh(app, Cuboid::new(30.0, 1.0, 8.0).mesh().build());
+    let deck_at = Transform::from_xyz(25.0, 3.5, 0.0);
+    let deck = spawn_surface(app, deck, deck_at, ScatterSurface::all());
     let roof = add_mesh(app, Plane3d::new(Vec3::Y, Vec2::splat(5.0)).mesh().build());
     let steep = Transform::from_xyz(0.0, 6.0, 30.0).with_rotation(Quat::from_rotation_x(1.2));
     let roof = spawn_surface(app, roof, steep, ScatterSurface::all());
@@ -274,22 +276,26 @@ fn instances_stand_on_the_meshes_and_never_on_walls() {
 
 #[test]
 fn a_surface_for_other_layers_covers_what_lies_under_it() {
-    let mut app = ground_app();
-    let moss_only = ScatterSurface::for_layers([Entity::PLACEHOLDER]);
-    let [_, rock, ..] = level(&mut app, moss_only);
-    app.world_mut().spawn(surface_layer(0.5));
-    spawn_viewer(&mut app, Vec3::ZERO);
-    tick_app(&mut app, 5_000);
-    let rock_at = app.world().get::<Transform>(rock).unwrap().translation.xz();
-    let placed = placed(&mut app);
-    assert!(placed.len() > 1_000);
-    for t in placed.values() {
-        let d = (t.translation.xz() - rock_at).abs();
-        assert!(
-            d.max_element() > 5.0,
-            "grass inside the rock at {}",
-            t.translation
-        );
+    // Under every policy: grass never grows inside a rock, though the ground goes on there.
+    for policy in [SurfacePolicy::TopMost, SurfacePolicy::Every] {
+        let mut app = ground_app();
+        let moss_only = ScatterSurface::for_layers([Entity::PLACEHOLDER]);
+        let [_, rock, ..] = level(&mut app, moss_only);
+        app.world_mut()
+            .spawn(surface_layer(0.5).on_surfaces(policy));
+        spawn_viewer(&mut app, Vec3::ZERO);
+        tick_app(&mut app, 5_000);
+        let rock_at = app.world().get::<Transform>(rock).unwrap().translation.xz();
+        let placed = placed(&mut app);
+        assert!(placed.len() > 1_000);
+        for t in placed.values() {
+            let d = (t.translation.xz() - rock_at).abs();
+            let p = t.translation;
+            assert!(
+                d.max_element() > 5.0,
+                "{policy:?}: grass inside the rock at {p}"
+            );
+        }
     }
 }
 

@@ -368,6 +368,7 @@ impl SurfaceMesh {
             height: height as f32,
             normal,
             entity: self.entity,
+            grows: true,
         })
     }
 

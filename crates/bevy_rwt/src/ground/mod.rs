@@ -37,6 +37,9 @@ pub struct SurfaceHit {
     pub normal: Vec3,
     /// The entity whose mesh this surface is; `None` for ground described in code.
     pub entity: Option<Entity>,
+    /// Whether the layer grows on it (otherwise it only covers what lies under it: a mesh
+    /// that is ground for other layers).
+    pub grows: bool,
 }
 
 impl SurfaceHit {
@@ -46,6 +49,7 @@ impl SurfaceHit {
             height,
             normal: Vec3::Y,
             entity: None,
+            grows: true,
         }
     }
 
@@ -56,6 +60,7 @@ impl SurfaceHit {
             height,
             normal: Vec3::new(-gradient.x, 1.0, -gradient.y).normalize_or(Vec3::Y),
             entity: None,
+            grows: true,
         }
     }
 
@@ -157,8 +162,9 @@ pub trait Ground: Send + Sync + 'static {
     /// (a hole, or a surface that is not the layer's ground lies on top).
     fn top(&self, p: Vec2) -> Option<SurfaceHit>;
 
-    /// Every surface of the layer's ground above `p`, in any order (a bridge's deck and the
-    /// ground under it). The default is [`Ground::top`] alone.
+    /// Every surface above `p`, in any order: the layer's ground (a bridge's deck and the
+    /// ground under it) and what covers it ([`SurfaceHit::grows`] false). The default is
+    /// [`Ground::top`] alone.
     fn hits(&self, p: Vec2, visit: &mut dyn FnMut(SurfaceHit)) {
         if let Some(hit) = self.top(p) {
             visit(hit);

@@ -200,12 +200,33 @@ impl GroundRule {
             }
             SurfacePolicy::Every => {
                 let mut sum = 0.0;
-                self.ground.hits(p, &mut |h| {
-                    if self.accepts(&h) {
-                        sum += self.weight(&h);
-                    }
-                });
+                self.open_hits(p, |h| sum += self.weight(&h));
                 (sum, None)
+            }
+        }
+    }
+
+    /// Calls `f` with every surface above `p` that the layer grows on, passes its filters
+    /// and is open to the sky or under a surface facing down (a bridge's underside): not
+    /// inside a solid, whose top faces up from within.
+    fn open_hits(&self, p: Vec2, mut f: impl FnMut(SurfaceHit)) {
+        const MOST: usize = 16;
+        let mut hits = [SurfaceHit::flat(0.0); MOST];
+        let mut n = 0;
+        self.ground.hits(p, &mut |h| {
+            if n < MOST {
+                hits[n] = h;
+                n += 1;
+            }
+        });
+        let hits = &hits[..n];
+        for h in hits.iter().filter(|h| h.grows && self.accepts(h)) {
+            let above = hits
+                .iter()
+                .filter(|o| o.height > h.height)
+                .min_by(|a, b| a.height.total_cmp(&b.height));
+            if above.is_none_or(|a| a.normal.y < 0.0) {
+                f(*h);
             }
         }
     }
@@ -245,8 +266,8 @@ impl GroundRule {
                 let total = self.area(p.position);
                 let mut left = p.id.unit(self.seed, SURFACE_SALT) * total;
                 let mut chosen = None;
-                self.ground.hits(at, &mut |h| {
-                    if chosen.is_none() && self.accepts(&h) {
+                self.open_hits(at, |h| {
+                    if chosen.is_none() {
                         left -= self.weight(&h);
                         if left < 0.0 {
                             chosen = Some(h);

@@ -72,20 +72,23 @@ impl SurfaceGround {
 
 impl Ground for SurfaceGround {
     fn top(&self, p: Vec2) -> Option<SurfaceHit> {
-        let mut best: Option<(SurfaceHit, bool)> = None;
-        for (mesh, grows) in self.near(p) {
-            mesh.hits(p, &mut |hit| {
-                if best.is_none_or(|(b, _)| hit.height > b.height) {
-                    best = Some((hit, *grows));
-                }
-            });
-        }
-        best.filter(|(_, grows)| *grows).map(|(hit, _)| hit)
+        let mut best: Option<SurfaceHit> = None;
+        self.hits(p, &mut |hit| {
+            if best.is_none_or(|b| hit.height > b.height) {
+                best = Some(hit);
+            }
+        });
+        best.filter(|hit| hit.grows)
     }
 
     fn hits(&self, p: Vec2, visit: &mut dyn FnMut(SurfaceHit)) {
-        for (mesh, _) in self.near(p).filter(|(_, grows)| *grows) {
-            mesh.hits(p, visit);
+        for (mesh, grows) in self.near(p) {
+            mesh.hits(p, &mut |hit| {
+                visit(SurfaceHit {
+                    grows: *grows,
+                    ..hit
+                })
+            });
         }
     }
 
