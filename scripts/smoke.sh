@@ -7,8 +7,10 @@
 # the painted maps and layer files, or (its `eye` view) the trees it chopped and the ground
 # its cabin cleared did not persist through a flight 3 km away and back, or its walker on
 # foot did not stop at a tree's trunk, or stipple_zoom lost a dot in view while zooming in
-# (or took fewer than its three screenshots, 1x, 30x and 1000x); and runs instanced_passes, which fails unless
-# instanced grass receives and casts shadows and is drawn with the prepasses, TAA and SSAO.
+# (or took fewer than its three screenshots, 1x, 30x and 1000x), or mesh_ground placed an
+# instance off its glTF level's surfaces (floating, buried, on a wall); and runs
+# instanced_passes, which fails unless instanced grass receives and casts shadows and is
+# drawn with the prepasses, TAA and SSAO.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -20,10 +22,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom instanced_passes)
+examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom instanced_passes)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -115,6 +117,16 @@ for run in "${runs[@]}"; do
         grep -E '^rwt-smoke: brush' "$out/$name.log" || true
         if ! grep -qE '^rwt-smoke: brush saved 4 maps, 2 layer files and [0-9]+ edits' "$out/$name.log"; then
             echo "FAIL $name: the brush did not save the painted maps and layer files"; failed=1
+        fi
+    fi
+    if [ "$ex" = mesh_ground ]; then
+        # Instances on the glTF level's surfaces, checked by vertical rays against its
+        # meshes: none floating, none inside a solid, none on a slope its layer refuses.
+        ground=$(grep -E '^rwt-smoke: ground instances' "$out/$name.log" || true)
+        echo "${ground:-FAIL $name: no ground line}"
+        read -r gi gs gf gb gw < <(sed -nE 's/^rwt-smoke: ground instances ([0-9]+) surfaces ([0-9]+) floating ([0-9]+) buried ([0-9]+) steep ([0-9]+)$/\1 \2 \3 \4 \5/p' <<<"$ground")
+        if [ -z "${gi:-}" ] || [ "$gi" -eq 0 ] || [ "$gs" -lt 2 ] || [ "$gf" -ne 0 ] || [ "$gb" -ne 0 ] || [ "$gw" -ne 0 ]; then
+            echo "FAIL $name: instances off the level's surfaces"; failed=1
         fi
     fi
     if [ "$ex" = stipple_zoom ]; then

@@ -299,6 +299,18 @@ fn a_surface_for_other_layers_covers_what_lies_under_it() {
     }
 }
 
+/// A square plane of half side `half` through the origin, turned by `tilt`, as ground.
+fn spawn_tilted_plane(app: &mut App, half: f32, tilt: Quat) {
+    let plane = Plane3d::new(Vec3::Y, Vec2::splat(half)).mesh().build();
+    let plane = add_mesh(app, plane);
+    spawn_surface(
+        app,
+        plane,
+        Transform::from_rotation(tilt),
+        ScatterSurface::all(),
+    );
+}
+
 /// Instances per unit of surface area on a plane tilted by `angle` about z, counted over
 /// the plane's middle.
 fn per_surface_area(angle: f32, on_mesh: bool) -> f64 {
@@ -306,16 +318,7 @@ fn per_surface_area(angle: f32, on_mesh: bool) -> f64 {
     let density = 2.0;
     let tilt = Quat::from_rotation_z(angle);
     let layer = if on_mesh {
-        let plane = add_mesh(
-            &mut app,
-            Plane3d::new(Vec3::Y, Vec2::splat(200.0)).mesh().build(),
-        );
-        spawn_surface(
-            &mut app,
-            plane,
-            Transform::from_rotation(tilt),
-            ScatterSurface::all(),
-        );
+        spawn_tilted_plane(&mut app, 200.0, tilt);
         surface_layer(density)
     } else {
         let rise = angle.tan();
@@ -356,16 +359,7 @@ fn density_counts_per_unit_of_surface_area() {
 fn stances_stand_along_the_normal_and_sink() {
     let mut app = ground_app();
     let tilt = Quat::from_rotation_z(0.5);
-    let plane = add_mesh(
-        &mut app,
-        Plane3d::new(Vec3::Y, Vec2::splat(100.0)).mesh().build(),
-    );
-    spawn_surface(
-        &mut app,
-        plane,
-        Transform::from_rotation(tilt),
-        ScatterSurface::all(),
-    );
+    spawn_tilted_plane(&mut app, 100.0, tilt);
     let mut layer = surface_layer(0.3);
     layer.classes[0] = layer.classes[0].clone().with_stance(1.0, 0.25);
     app.world_mut().spawn(layer);

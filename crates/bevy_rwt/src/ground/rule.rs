@@ -207,8 +207,9 @@ impl GroundRule {
     }
 
     /// Calls `f` with every surface above `p` that the layer grows on, passes its filters
-    /// and is open to the sky or under a surface facing down (a bridge's underside): not
-    /// inside a solid, whose top faces up from within.
+    /// and lies outside every solid: of the surfaces above it, as many face down (entering
+    /// a solid from below, as a bridge's underside) as face up (leaving one through its
+    /// top). Inside a rock, or a pier under a deck, more face up.
     fn open_hits(&self, p: Vec2, mut f: impl FnMut(SurfaceHit)) {
         const MOST: usize = 16;
         let mut hits = [SurfaceHit::flat(0.0); MOST];
@@ -221,11 +222,12 @@ impl GroundRule {
         });
         let hits = &hits[..n];
         for h in hits.iter().filter(|h| h.grows && self.accepts(h)) {
-            let above = hits
+            let winding: i32 = hits
                 .iter()
                 .filter(|o| o.height > h.height)
-                .min_by(|a, b| a.height.total_cmp(&b.height));
-            if above.is_none_or(|a| a.normal.y < 0.0) {
+                .map(|o| (o.normal.y > 0.0) as i32 - (o.normal.y < 0.0) as i32)
+                .sum();
+            if winding <= 0 {
                 f(*h);
             }
         }

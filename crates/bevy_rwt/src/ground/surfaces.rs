@@ -5,7 +5,7 @@ use super::{Ground, GroundBounds, SurfaceHit, SurfaceMesh};
 use bevy::prelude::*;
 use std::sync::Arc;
 
-/// Marks an entity's mesh, and the mesh of every entity below it (a glTF `SceneRoot`), as
+/// Marks an entity's mesh, and the mesh of every entity below it (a glTF `WorldAssetRoot`), as
 /// ground for the layers whose height source is [`crate::HeightSource::Surfaces`].
 ///
 /// A marked mesh is ground for the layers it names (all of them for

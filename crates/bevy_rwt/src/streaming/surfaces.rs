@@ -46,35 +46,46 @@ type Changed = Vec<(GroundPlane, Rect)>;
 pub(super) struct MarkedMeshes<'w, 's> {
     marked: Query<'w, 's, (Entity, &'static ScatterSurface)>,
     children: Query<'w, 's, &'static Children>,
+    parents: Query<'w, 's, &'static ChildOf>,
     meshes: Query<'w, 's, (&'static Mesh3d, &'static GlobalTransform)>,
     assets: Option<Res<'w, Assets<Mesh>>>,
     events: Option<Res<'w, Messages<AssetEvent<Mesh>>>>,
 }
 
 impl MarkedMeshes<'_, '_> {
-    /// Every marked mesh entity with what its ground is made from (an entity's own marker
-    /// before one above it).
+    /// Every marked mesh entity with what its ground is made from (the marker nearest
+    /// above it, its own first).
     fn sources(&self) -> HashMap<Entity, Source> {
         let mut out = HashMap::new();
-        for (root, marker) in &self.marked {
+        for (root, _) in &self.marked {
             let below = std::iter::once(root).chain(self.children.iter_descendants(root));
             for e in below {
-                let Ok((mesh, at)) = self.meshes.get(e) else {
-                    continue;
-                };
-                let own = self.marked.get(e).ok().map(|(_, m)| m);
-                if own.is_none() && out.contains_key(&e) {
+                if out.contains_key(&e) {
                     continue;
                 }
+                let (Ok((mesh, at)), Some(marker)) = (self.meshes.get(e), self.marker_of(e)) else {
+                    continue;
+                };
                 let source = Source {
                     mesh: mesh.id(),
                     transform: at.affine(),
-                    marker: own.unwrap_or(marker).clone(),
+                    marker: marker.clone(),
                 };
                 out.insert(e, source);
             }
         }
         out
+    }
+
+    /// The marker of `e` or of its nearest marked ancestor.
+    fn marker_of(&self, e: Entity) -> Option<&ScatterSurface> {
+        let mut at = e;
+        loop {
+            if let Ok((_, marker)) = self.marked.get(at) {
+                return Some(marker);
+            }
+            at = self.parents.get(at).ok()?.parent();
+        }
     }
 }
 

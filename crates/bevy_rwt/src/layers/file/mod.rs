@@ -325,7 +325,7 @@ pub struct ClassDescription {
     #[serde(default)]
     pub lod: Option<LodDescription>,
     /// How instances stand on their surface, e.g. `(align: 1.0, sink: 0.05)` (see
-    /// [`Stance`](crate::look::Stance)); upright when absent.
+    /// [`Stance`]); upright when absent.
     #[serde(default)]
     pub stance: Stance,
 }
