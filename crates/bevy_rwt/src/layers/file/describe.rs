@@ -3,10 +3,10 @@
 use super::{
     ClassDescription, DensityDescription, HeightDescription, InstancedShadingDescription,
     LayerDescription, LayerFileError, LayerPart, LodDescription, MapDescription,
-    MaterialDescription, MeshDescription, NamedAssets, Undescribable,
+    MaterialDescription, MeshDescription, NamedAssets, PromotionDescription, Undescribable,
 };
 use crate::layers::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
-use crate::look::ClassLook;
+use crate::look::{ClassLook, MeshLod};
 use bevy::prelude::*;
 
 /// How [`LayerDescription::describe`] names assets.
@@ -19,52 +19,68 @@ impl LayerDescription {
     /// The layer file of `layer`: what [`LayerDescription::to_layer`] turns back into the
     /// same layer. Meshes, materials and height functions are written by their name in
     /// `names`, else by their asset path; images by `image_path` when it gives one (e.g.
-    /// where a painted map was saved), else by their asset path. A layer using what has
-    /// neither (a mesh made in code without a name, a custom density or look) is a
-    /// [`LayerFileError::NotDescribable`] naming it.
+    /// where a painted map was saved), else by their asset path; promotions' inserters by
+    /// their name. A layer using what has none of these (a mesh made in code without a
+    /// name, a custom density, look or ground, an unnamed inserter, a keep-out) is a
+    /// [`LayerFileError::NotDescribable`] naming it: nothing is left out silently.
     pub fn describe(
         layer: &ScatterLayer,
         names: &NamedAssets,
         image_path: impl FnMut(&Handle<Image>) -> Option<String>,
     ) -> Result<Self, LayerFileError> {
+        // Every field, so that a new one cannot be forgotten here.
+        let ScatterLayer {
+            classes,
+            tile_size,
+            seed,
+            streaming,
+            falloff,
+            plane,
+            height,
+            surfaces,
+            per_area,
+            height_range,
+            max_slope,
+            exclusion,
+            keep_out,
+        } = layer;
         let mut namer = Namer {
             names,
             image: image_path,
         };
-        let classes = layer
-            .classes
+        let classes = classes
             .iter()
             .enumerate()
             .map(|(i, c)| namer.class(c).map_err(|e| not(LayerPart::Class(i), e)))
             .collect::<Result<_, _>>()?;
         let (height, ground) = namer
-            .height(&layer.height)
+            .height(height)
             .map_err(|e| not(LayerPart::Ground, e))?;
-        if !layer.keep_out.is_empty() {
+        if !keep_out.is_empty() {
             return Err(not(LayerPart::Ground, Undescribable::KeepOut));
         }
-        let streaming = &layer.streaming;
+        let exclusion = match exclusion {
+            Some(d) => Some(namer.density(d).map_err(|e| not(LayerPart::Exclusion, e))?),
+            None => None,
+        };
         Ok(Self {
             classes,
-            tile_size: layer.tile_size,
-            seed: layer.seed,
+            tile_size: *tile_size,
+            seed: *seed,
             chunk_size: Some(streaming.chunk_size),
             load_distance: Some(streaming.load_distance),
             unload_distance: Some(streaming.unload_distance),
             near_distance: Some(streaming.near_distance),
-            falloff: layer.falloff.map(|f| (f.near, f.far)),
-            falloff_floor: layer.falloff.map_or(0.0, |f| f.floor),
-            plane: layer.plane,
+            falloff: falloff.map(|f| (f.near, f.far)),
+            falloff_floor: falloff.map_or(0.0, |f| f.floor),
+            plane: *plane,
             height,
             ground,
-            surfaces: layer.surfaces,
-            per_area: layer.per_area,
-            height_range: layer.height_range,
-            max_slope: layer.max_slope,
-            exclusion: match &layer.exclusion {
-                Some(d) => Some(namer.density(d).map_err(|e| not(LayerPart::Exclusion, e))?),
-                None => None,
-            },
+            surfaces: *surfaces,
+            per_area: *per_area,
+            height_range: *height_range,
+            max_slope: *max_slope,
+            exclusion,
         })
     }
 }
@@ -79,7 +95,48 @@ fn asset_path<A: Asset>(handle: &Handle<A>) -> Option<String> {
 
 impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
     fn class(&mut self, c: &ScatterClass) -> Result<ClassDescription, Undescribable> {
-        let (mesh, material) = match &c.look {
+        // Every field, so that a new one cannot be forgotten here.
+        let ScatterClass {
+            density,
+            look,
+            scale,
+            scale_variation,
+            lod,
+            pick_bounds,
+            promotion,
+            stance,
+        } = c;
+        let (mesh, material, lod) = self.look(look, lod.as_ref())?;
+        let promotion = match promotion {
+            Some(p) => Some(PromotionDescription {
+                distance: p.distance,
+                insert: self
+                    .names
+                    .inserter_name(&p.insert)
+                    .ok_or(Undescribable::PromotionInserter)?,
+            }),
+            None => None,
+        };
+        Ok(ClassDescription {
+            density: self.density(density)?,
+            mesh,
+            material,
+            scale: *scale,
+            scale_variation: *scale_variation,
+            lod,
+            stance: *stance,
+            pick_bounds: *pick_bounds,
+            promotion,
+        })
+    }
+
+    /// A class's look and its far level of detail.
+    fn look(
+        &mut self,
+        look: &ClassLook,
+        lod: Option<&MeshLod>,
+    ) -> Result<(MeshDescription, MaterialDescription, Option<LodDescription>), Undescribable> {
+        let (mesh, material) = match look {
             ClassLook::Mesh { mesh, material } => (self.mesh(mesh)?, self.material(material)?),
             ClassLook::Instanced(look) => {
                 let mut material = InstancedShadingDescription::from(&look.material);
@@ -93,11 +150,11 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             }
             ClassLook::Custom(_) => return Err(Undescribable::CustomLook),
         };
-        let far = match &c.look {
+        let far = match look {
             ClassLook::Instanced(look) => look.far.as_ref(),
             _ => None,
         };
-        let lod = match (&c.lod, far) {
+        let lod = match (lod, far) {
             (_, Some(far)) => Some(LodDescription {
                 mesh: self.mesh(&far.mesh)?,
                 material: MaterialDescription::Instanced(InstancedShadingDescription::default()),
@@ -112,15 +169,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             }),
             (None, None) => None,
         };
-        Ok(ClassDescription {
-            density: self.density(&c.density)?,
-            mesh,
-            material,
-            scale: c.scale,
-            scale_variation: c.scale_variation,
-            lod,
-            stance: c.stance,
-        })
+        Ok((mesh, material, lod))
     }
 
     fn mesh(&self, mesh: &Handle<Mesh>) -> Result<MeshDescription, Undescribable> {

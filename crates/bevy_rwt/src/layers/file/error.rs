@@ -147,6 +147,9 @@ pub enum Undescribable {
     /// A height function without a name in `NamedAssets`.
     #[error("a height function without a name in NamedAssets")]
     HeightFunction,
+    /// A promotion whose inserter has no name in `NamedAssets`.
+    #[error("a promotion's inserter without a name in NamedAssets")]
+    PromotionInserter,
 }
 
 /// The kinds of assets a layer file names through `NamedAssets`.
@@ -158,6 +161,8 @@ pub enum NamedKind {
     Material,
     /// A height function.
     Height,
+    /// What a promoted instance gets (an [`InstanceInserter`](crate::look::InstanceInserter)).
+    Inserter,
 }
 
 impl std::fmt::Display for NamedKind {
@@ -166,6 +171,7 @@ impl std::fmt::Display for NamedKind {
             Self::Mesh => "mesh",
             Self::Material => "material",
             Self::Height => "height",
+            Self::Inserter => "inserter",
         })
     }
 }

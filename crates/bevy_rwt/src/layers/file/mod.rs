@@ -24,6 +24,23 @@
 //! )
 //! ```
 //!
+//! A layer on the game's meshes (see [`crate::ground`]), with clumped flowers and moss
+//! standing along the surface:
+//!
+//! ```ron
+//! (
+//!     ground: Surfaces,
+//!     surfaces: Every,
+//!     max_slope: 0.7,
+//!     classes: [
+//!         (density: Clumps(seed: 4, clumps: 0.008, per_clump: 30.0, radius: 2.2, kernel: Thomas),
+//!          mesh: Named("flower"), material: Instanced(tip: (0.8, 0.2, 0.4))),
+//!         (density: Constant(5.0), mesh: Named("tuft"), material: Named("moss"),
+//!          stance: (align: 1.0, sink: 0.02)),
+//!     ],
+//! )
+//! ```
+//!
 //! In code, a file is parsed and checked by [`LayerDescription::from_ron`], becomes a
 //! layer with [`LayerDescription::to_layer`], and a layer becomes a file again with
 //! [`LayerDescription::describe`] and [`LayerDescription::to_ron`]:
@@ -71,7 +88,7 @@ pub use loader::ScatterLayerLoader;
 pub use names::NamedAssets;
 
 use super::{
-    DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap, HeightSource, LayerDensity,
+    DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap, HeightSource, LayerDensity, Promotion,
     ScatterClass, ScatterLayer,
 };
 use crate::ground::SurfacePolicy;
@@ -328,6 +345,24 @@ pub struct ClassDescription {
     /// [`Stance`]); upright when absent.
     #[serde(default)]
     pub stance: Stance,
+    /// Bounds `(min, max)` of one instance at scale 1 for picking (see
+    /// [`ScatterClass::pick_bounds`]).
+    #[serde(default)]
+    pub pick_bounds: Option<(Vec3, Vec3)>,
+    /// Near instances become entities (see [`crate::Promotion`]), e.g.
+    /// `(distance: 12.0, insert: "tree collider")`.
+    #[serde(default)]
+    pub promotion: Option<PromotionDescription>,
+}
+
+/// A promotion in a layer file: its distance, and what promoted instances get by the name
+/// the game registered in [`NamedAssets::insert_inserter`].
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct PromotionDescription {
+    /// Ground distance to the nearest viewer within which instances are entities.
+    pub distance: f32,
+    /// The inserter's name.
+    pub insert: String,
 }
 
 /// The far level of detail of a class in a layer file (see [`MeshLod`]; for an instanced
@@ -642,6 +677,19 @@ where
 }
 
 impl ClassDescription {
+    fn promotion(&self, names: &NamedAssets) -> Result<Option<Promotion>, LayerFileError> {
+        let Some(p) = &self.promotion else {
+            return Ok(None);
+        };
+        let insert = names
+            .inserter(&p.insert)
+            .ok_or_else(|| unknown(NamedKind::Inserter, &p.insert))?;
+        Ok(Some(Promotion {
+            distance: p.distance,
+            insert,
+        }))
+    }
+
     fn to_class<M, T, I>(
         &self,
         handles: &mut Handles<M, T, I>,
@@ -667,6 +715,8 @@ impl ClassDescription {
                     scale: self.scale,
                     scale_variation: self.scale_variation,
                     stance: self.stance,
+                    pick_bounds: self.pick_bounds,
+                    promotion: self.promotion(handles.names)?,
                     ..class.with_instanced_far(far, lod.distance)
                 });
             }
@@ -683,6 +733,8 @@ impl ClassDescription {
             scale_variation: self.scale_variation,
             lod,
             stance: self.stance,
+            pick_bounds: self.pick_bounds,
+            promotion: self.promotion(handles.names)?,
             ..class
         })
     }

@@ -2,11 +2,12 @@
 //! can be written as layer files.
 
 use crate::layers::{HeightFn, HeightSource};
+use crate::look::InstanceInserter;
 use bevy::prelude::*;
 use std::collections::HashMap;
 use std::sync::{Arc, PoisonError, RwLock};
 
-/// Meshes, materials and height functions a game gives names: a layer file says
+/// Meshes, materials, height functions and promotion inserters a game gives names: a layer file says
 /// `mesh: Named("spruce")`, `material: Named("bark")` or `ground: Named("terrain")`, and
 /// [`super::LayerDescription::describe`] writes these names for the handles it meets.
 ///
@@ -35,6 +36,7 @@ struct Registry {
     meshes: HashMap<String, Handle<Mesh>>,
     materials: HashMap<String, Handle<StandardMaterial>>,
     heights: HashMap<String, HeightFn>,
+    inserters: HashMap<String, InstanceInserter>,
 }
 
 impl std::fmt::Debug for Registry {
@@ -48,6 +50,7 @@ impl std::fmt::Debug for Registry {
             .field("meshes", &names(self.meshes.keys().collect()))
             .field("materials", &names(self.materials.keys().collect()))
             .field("heights", &names(self.heights.keys().collect()))
+            .field("inserters", &names(self.inserters.keys().collect()))
             .finish()
     }
 }
@@ -77,6 +80,22 @@ impl NamedAssets {
         if let HeightSource::Function(f) = height {
             self.write(|r| _ = r.heights.insert(name.into(), f.clone()));
         }
+    }
+
+    /// Names what promoted instances get (a [`crate::Promotion`]'s inserter): promotions
+    /// inserting this very function are written with this name.
+    pub fn insert_inserter(&self, name: impl Into<String>, inserter: &InstanceInserter) {
+        self.write(|r| _ = r.inserters.insert(name.into(), inserter.clone()));
+    }
+
+    /// The inserter of this name.
+    pub fn inserter(&self, name: &str) -> Option<InstanceInserter> {
+        self.read(|r| r.inserters.get(name).cloned())
+    }
+
+    /// The name of an inserter registered as this very function.
+    pub fn inserter_name(&self, inserter: &InstanceInserter) -> Option<String> {
+        self.read(|r| first_name(&r.inserters, |i| Arc::ptr_eq(i, inserter)))
     }
 
     /// The mesh of this name.

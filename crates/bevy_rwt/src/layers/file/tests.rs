@@ -335,21 +335,30 @@ fn ground_stances_and_clumps_read_back_the_same() {
         kernel: ClumpKernel::Matern,
     };
     let density = LayerDensity::Clumps(Clumps::new(params).unwrap());
-    let class = ScatterClass::new(density, uuid::<Mesh>(3), uuid::<StandardMaterial>(4))
-        .with_stance(0.75, 0.05);
+    let collider: crate::look::InstanceInserter = std::sync::Arc::new(|_| {});
+    names.insert_inserter("collider", &collider);
+    let mut class = ScatterClass::new(density, uuid::<Mesh>(3), uuid::<StandardMaterial>(4))
+        .with_stance(0.75, 0.05)
+        .with_pick_bounds(Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 2.0, 0.5));
+    class.promotion = Some(crate::Promotion {
+        distance: 12.0,
+        insert: collider.clone(),
+    });
     let layer = ScatterLayer::new(vec![class])
         .on_surfaces(SurfacePolicy::Every)
         .with_per_area(false);
     let d = LayerDescription::describe(&layer, &names, |_| None).unwrap();
     assert_eq!(d.ground, Some(HeightDescription::Surfaces));
     let text = d.to_ron().unwrap();
-    for part in [
+    let parts = [
         "Surfaces",
         "Every",
         "per_area: false",
         "align: 0.75",
         "Matern",
-    ] {
+        "collider",
+    ];
+    for part in parts {
         assert!(text.contains(part), "{part} missing from {text}");
     }
     let read = LayerDescription::from_ron(&text).unwrap();
@@ -372,6 +381,27 @@ fn ground_stances_and_clumps_read_back_the_same() {
         panic!("{:?}", back.classes[0].density);
     };
     assert_eq!(c.params(), params);
+    assert_eq!(back.classes[0].pick_bounds, layer.classes[0].pick_bounds);
+    let promotion = back.classes[0].promotion.as_ref().unwrap();
+    assert_eq!(promotion.distance, 12.0);
+    assert!(std::sync::Arc::ptr_eq(&promotion.insert, &collider));
+    // An inserter without a name cannot be written, and says so.
+    let mut unnamed = layer.clone();
+    unnamed.classes[0].promotion = Some(crate::Promotion {
+        distance: 3.0,
+        insert: std::sync::Arc::new(|_| {}),
+    });
+    let e = LayerDescription::describe(&unnamed, &names, |_| None).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            LayerFileError::NotDescribable {
+                what: Undescribable::PromotionInserter,
+                ..
+            }
+        ),
+        "{e}"
+    );
     // Clump parameters out of range are refused when the file is read.
     let bad = text.replace("radius: 2.5", "radius: -1.0");
     assert!(matches!(
