@@ -377,6 +377,42 @@ fn stances_stand_along_the_normal_and_sink() {
     }
 }
 
+#[test]
+fn instanced_classes_stand_along_the_normal_too() {
+    let mut app = ground_app();
+    let tilt = Quat::from_rotation_z(0.5);
+    spawn_tilted_plane(&mut app, 100.0, tilt);
+    let class = ScatterClass::instanced(
+        LayerDensity::Constant(0.3),
+        Handle::default(),
+        InstancedShading::default(),
+    )
+    .with_stance(1.0, 0.25);
+    let layer = layer(LayerDensity::Constant(0.0)).on_surfaces(SurfacePolicy::TopMost);
+    app.world_mut().spawn(ScatterLayer {
+        classes: vec![class],
+        ..layer
+    });
+    spawn_viewer(&mut app, Vec3::ZERO);
+    tick_app(&mut app, 5_000);
+    let normal = tilt * Vec3::Y;
+    let mut q = app
+        .world_mut()
+        .query::<(&bevy_rwt::InstancedChunk, &Transform)>();
+    let mut n = 0;
+    for (chunk, at) in q.iter(app.world()) {
+        for i in &chunk.buffer.instances {
+            n += 1;
+            let up = i.up();
+            assert!(up.distance(normal) < 0.02, "up {up}, normal {normal}");
+            // Its root sunk a quarter unit below the plane, along the normal.
+            let root = at.translation + Vec3::from_array(i.offset);
+            assert!((-root.dot(normal) - 0.25).abs() < 1e-3, "{root}");
+        }
+    }
+    assert!(n > 500, "{n} instances");
+}
+
 /// Chunks loaded for `layer` whose rectangles overlap `rect` (min, max on the ground).
 fn chunks_over(app: &App, layer: Entity, rects: &[(Vec2, Vec2)]) -> usize {
     let status = app.world().get::<ScatterLayerStatus>(layer).unwrap();

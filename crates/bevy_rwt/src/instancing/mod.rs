@@ -90,8 +90,9 @@ pub struct GpuInstance {
     pub appear: u16,
     /// Colour variation hashed from the point, `0..=u16::MAX` for 0..=1.
     pub tint: u16,
-    /// Padding (keeps the stride a multiple of 8).
-    pub reserved: u16,
+    /// The instance's up axis, tilted from y (a class's [`crate::Stance`]): its x and z
+    /// components as two signed bytes (low byte x, high byte z, in 127ths); 0 is upright.
+    pub tilt: u16,
 }
 
 /// Bytes per instance on the GPU.
@@ -106,6 +107,25 @@ impl GpuInstance {
     /// The level-of-detail factor at which the instance appears, 0..=1.
     pub fn appear_factor(&self) -> f32 {
         self.appear as f32 / u16::MAX as f32
+    }
+
+    /// The packed form of a unit up axis (see [`GpuInstance::tilt`]); the axis the shader
+    /// and [`GpuInstance::up`] read back is within 1/127 of it in x and z.
+    pub fn pack_up(up: Vec3) -> u16 {
+        let byte = |c: f32| ((c.clamp(-1.0, 1.0) * 127.0).round() as i8) as u8 as u16;
+        byte(up.x) | (byte(up.z) << 8)
+    }
+
+    /// The instance's up axis (unit), as the shader reads it.
+    pub fn up(&self) -> Vec3 {
+        let signed = |b: u16| (b as u8 as i8) as f32 / 127.0;
+        let (x, z) = (signed(self.tilt & 0xff), signed(self.tilt >> 8));
+        Vec3::new(x, (1.0 - x * x - z * z).max(0.0).sqrt(), z).normalize_or(Vec3::Y)
+    }
+
+    /// The instance's turn: its yaw about y, then its tilt onto its up axis.
+    pub fn rotation(&self) -> Quat {
+        Quat::from_rotation_arc(Vec3::Y, self.up()) * Quat::from_rotation_y(self.yaw_radians())
     }
 }
 
@@ -173,8 +193,11 @@ impl InstancedChunk {
         let (mesh_lo, mesh_hi) = mesh;
         let reach = mesh_lo.abs().max(mesh_hi.abs());
         let s = self.max_scale;
-        let horizontal = (reach.x.max(reach.z) * std::f32::consts::SQRT_2 + reach.y) * s;
-        let min = lo + Vec3::new(-horizontal, mesh_lo.y.min(0.0) * s, -horizontal);
+        let across = reach.x.max(reach.z) * std::f32::consts::SQRT_2;
+        let horizontal = (across + reach.y) * s;
+        // A tilted instance (up to 75.5 degrees) lowers its side by up to its reach across.
+        let below = (mesh_lo.y.min(0.0) - across) * s;
+        let min = lo + Vec3::new(-horizontal, below, -horizontal);
         let max = hi + Vec3::new(horizontal, mesh_hi.y.max(0.0) * s, horizontal);
         Aabb::from_min_max(min, max)
     }
@@ -184,4 +207,45 @@ impl InstancedChunk {
 pub(crate) fn distance_to_box(aabb: &Aabb, point: Vec3) -> f32 {
     let d = (Vec3::from(aabb.center) - point).abs() - Vec3::from(aabb.half_extents);
     d.max(Vec3::ZERO).length()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `instanced.wgsl`'s `tilt`, written out on the CPU.
+    fn shader_tilt(v: Vec3, up: Vec3) -> Vec3 {
+        let w = Vec3::new(up.z, 0.0, -up.x);
+        let wv = w.cross(v);
+        v + wv + w.cross(wv) / (1.0 + up.y)
+    }
+
+    #[test]
+    fn a_packed_tilt_turns_as_the_entity_path_does() {
+        for (i, up) in [
+            Vec3::Y,
+            Vec3::new(0.3, 1.0, -0.2),
+            Vec3::new(-1.0, 0.4, 0.0),
+            Vec3::new(0.0, 0.26, 0.97),
+        ]
+        .map(Vec3::normalize)
+        .into_iter()
+        .enumerate()
+        {
+            let g = GpuInstance {
+                yaw: 12_000 * i as u16,
+                tilt: GpuInstance::pack_up(up),
+                ..default()
+            };
+            // Read back within a byte's step of the axis it packed.
+            assert!(g.up().distance(up) < 0.02, "{up} read back as {}", g.up());
+            // The shader's rotation of every axis is the promoted entity's rotation.
+            let yaw = Quat::from_rotation_y(g.yaw_radians());
+            for v in [Vec3::X, Vec3::Y, Vec3::Z, Vec3::new(0.3, 0.7, -0.2)] {
+                let shader = shader_tilt(yaw * v, g.up());
+                assert!(shader.distance(g.rotation() * v) < 1e-5, "{up}: {v}");
+            }
+        }
+        assert_eq!(GpuInstance::pack_up(Vec3::Y), 0);
+    }
 }

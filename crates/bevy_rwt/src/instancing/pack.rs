@@ -147,7 +147,7 @@ impl InstancedClasses {
             yaw: unit_u16(pose.yaw / std::f64::consts::TAU),
             appear: unit_u16(appear),
             tint: unit_u16(p.id.unit(self.seed, TINT_SALT)),
-            reserved: 0,
+            tilt: GpuInstance::pack_up(footing.up),
         }
     }
 }

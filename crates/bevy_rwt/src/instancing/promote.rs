@@ -128,7 +128,7 @@ impl Moved<'_> {
         id: PointId,
     ) -> Entity {
         let translation = corner + Vec3::from_array(g.offset);
-        let rotation = Quat::from_rotation_y(g.yaw_radians());
+        let rotation = g.rotation();
         let scale = g.scale;
         let transform = Transform {
             translation,

@@ -65,7 +65,8 @@ struct Vertex {
 #endif
     // Offset from the chunk corner (xyz), scale (w).
     @location(8) offset_scale: vec4<f32>,
-    // Yaw (turns), appearance factor, tint, unused.
+    // Yaw (turns), appearance factor, tint, tilt (the up axis's x and z as two signed
+    // bytes of a 16-bit unorm: low byte x, high byte z, in 127ths).
     @location(9) yaw_appear_tint: vec4<f32>,
 };
 
@@ -169,6 +170,24 @@ struct Placed {
     t: f32,
 };
 
+// The instance's up axis from its packed tilt (0: straight up).
+fn instance_up(packed: f32) -> vec3<f32> {
+    let bits = u32(round(packed * 65535.0));
+    let lo = f32(bits & 255u);
+    let hi = f32(bits >> 8u);
+    // Two's complement bytes, without a branch: 256 less from 128 on.
+    let x = (lo - 256.0 * step(128.0, lo)) / 127.0;
+    let z = (hi - 256.0 * step(128.0, hi)) / 127.0;
+    return normalize(vec3<f32>(x, sqrt(max(1.0 - x * x - z * z, 0.0)), z));
+}
+
+// `v` turned by the rotation that takes y onto `up` (Rodrigues, with w = y x up).
+fn tilt(v: vec3<f32>, up: vec3<f32>) -> vec3<f32> {
+    let w = vec3<f32>(up.z, 0.0, -up.x);
+    let wv = cross(w, v);
+    return v + wv + cross(w, wv) / (1.0 + up.y);
+}
+
 fn place(in: Vertex, time: f32) -> Placed {
     let root = chunk.origin.xyz + in.offset_scale.xyz;
     let yaw = in.yaw_appear_tint.x * 6.2831853;
@@ -184,6 +203,10 @@ fn place(in: Vertex, time: f32) -> Placed {
 #else
     var normal = vec3<f32>(0.0, 1.0, 0.0);
 #endif
+    // Standing along the surface (a class's stance); upright instances turn by nothing.
+    let up = instance_up(in.yaw_appear_tint.w);
+    turned = tilt(turned, up);
+    normal = tilt(normal, up);
     // Where a bender passed, the blade falls away from it, up to 80 degrees.
     let lean = lean_at(root);
     let amount = length(lean);
