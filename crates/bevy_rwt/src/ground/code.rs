@@ -26,8 +26,8 @@ impl Ground for FlatGround {
     }
 }
 
-/// Ground whose height is a function of the ground position; its normal comes from central
-/// differences over [`FunctionGround::STEP`].
+/// Ground whose height is a function of the ground position; its normal comes from forward
+/// differences over [`FunctionGround::STEP`] (three evaluations a point, exact on planes).
 #[derive(Clone)]
 pub struct FunctionGround {
     height: Arc<dyn Fn(Vec2) -> f32 + Send + Sync>,
@@ -35,7 +35,7 @@ pub struct FunctionGround {
 }
 
 impl FunctionGround {
-    /// Half the distance of the central differences that give the normal.
+    /// The distance of the differences that give the normal.
     pub const STEP: f32 = 0.25;
 
     /// Ground of height `height(p)`, of unknown bounds.
@@ -52,23 +52,18 @@ impl FunctionGround {
         self.max_slope = Some(max_slope.abs()).filter(|s| s.is_finite());
         self
     }
-
-    /// The gradient at `p` by central differences.
-    fn gradient(&self, p: Vec2) -> Vec2 {
-        let h = &self.height;
-        let s = Self::STEP;
-        let dx = h(p + Vec2::X * s) - h(p - Vec2::X * s);
-        let dz = h(p + Vec2::Y * s) - h(p - Vec2::Y * s);
-        Vec2::new(dx, dz) / (2.0 * s)
-    }
 }
 
 impl Ground for FunctionGround {
     fn top(&self, p: Vec2) -> Option<SurfaceHit> {
-        let height = (self.height)(p);
-        height
-            .is_finite()
-            .then(|| SurfaceHit::with_gradient(height, self.gradient(p)))
+        let h = &self.height;
+        let height = h(p);
+        if !height.is_finite() {
+            return None;
+        }
+        let s = Self::STEP;
+        let gradient = Vec2::new(h(p + Vec2::X * s) - height, h(p + Vec2::Y * s) - height) / s;
+        Some(SurfaceHit::with_gradient(height, gradient))
     }
 
     fn bounds(&self, min: Vec2, max: Vec2) -> GroundBounds {
