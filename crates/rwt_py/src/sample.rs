@@ -8,6 +8,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
+use rwt_core::clumps::{ClumpKernel, ClumpParams, Clumps};
 use rwt_core::density::{Constant, Density, ImageDensity, Placement};
 use rwt_core::query::{DEFAULT_BUDGET, Point, QueryError, Rect, Sampler};
 use std::path::PathBuf;
@@ -38,6 +39,9 @@ pub enum DensityArg<'py> {
     Constant(f64),
     /// A map, bilinearly interpolated between texel centres.
     Map(PyReadonlyArray2<'py, f64>),
+    /// Clumps: `(seed, clumps per unit area, points per clump, radius, kernel)`, the kernel
+    /// `"thomas"` or `"matern"` (see `rwt_core::clumps`).
+    Clumps((u64, f64, f64, f64, String)),
 }
 
 /// `(x0, y0, x1, y1)`.
@@ -91,6 +95,7 @@ pub fn query<'py>(
             let over = rect_of(extent.unwrap_or(corners(&rect)), "extent")?;
             Box::new(map_density(&values, over, scale)?)
         }
+        DensityArg::Clumps(params) => Box::new(clumps(params, scale)?),
     };
     let sampler = tiles::sampler(tileset.as_deref(), seed)?
         .with_tile_size(tile_size)
@@ -99,6 +104,30 @@ pub fn query<'py>(
         .detach(|| collect(&sampler, rect, &*density))
         .map_err(query_error)?;
     Ok(arrays(py, &points, &*density, seed))
+}
+
+/// The clumps density of Python's parameters, its points per clump times `scale`.
+fn clumps(
+    (seed, clumps, per_clump, radius, kernel): (u64, f64, f64, f64, String),
+    scale: f64,
+) -> PyResult<Clumps> {
+    let kernel = match kernel.as_str() {
+        "thomas" => ClumpKernel::Thomas,
+        "matern" => ClumpKernel::Matern,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "clump kernel must be \"thomas\" or \"matern\", got {other:?}"
+            )));
+        }
+    };
+    let params = ClumpParams {
+        seed,
+        clumps,
+        per_clump: per_clump * scale,
+        radius,
+        kernel,
+    };
+    Clumps::new(params).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// The points of `rect`: serially, on all cores by base tiles (the serial order), or on all

@@ -12,12 +12,13 @@ only adds points. numpy in and out; the work runs in Rust with the GIL released.
 
 from ._analyse import Analysis, analyse
 from ._rwt import BudgetError
-from ._sample import DEFAULT_BUDGET, Sample, auto_tile_size, sample
+from ._sample import DEFAULT_BUDGET, Clumps, Sample, auto_tile_size, sample
 from ._stipple import Stipple, stipple
 
 __all__ = [
     "Analysis",
     "BudgetError",
+    "Clumps",
     "DEFAULT_BUDGET",
     "Sample",
     "Stipple",

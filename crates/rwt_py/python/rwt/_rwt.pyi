@@ -13,7 +13,7 @@ class BudgetError(ValueError):
 
 def query(
     rect: Corners,
-    density: Union[float, np.ndarray],
+    density: Union[float, np.ndarray, Tuple[int, float, float, float, str]],
     *,
     scale: float = 1.0,
     extent: Optional[Corners] = None,
