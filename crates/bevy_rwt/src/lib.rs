@@ -168,8 +168,8 @@ pub use instancing::{Bender, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, Rwt
 pub use layers::RwtLayersPlugin;
 pub use layers::{
     AssetFailure, AssetProblem, AssetStatus, DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap,
-    HeightSource, KeepOut, LayerAsset, LayerDensity, Promotion, ScatterClass, ScatterEntity,
-    ScatterLayer, ScatterLayerStatus,
+    HeightSource, KeepOut, LayerAsset, LayerDensity, LayerRef, Promotion, ScatterClass,
+    ScatterEntity, ScatterLayer, ScatterLayerStatus,
 };
 pub use look::{
     ClassLook, Footing, GroundPlane, InstanceInserter, InstancedLook, InstancedShading,

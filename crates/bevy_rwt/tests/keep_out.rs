@@ -13,6 +13,11 @@ const RADIUS: f32 = 1.5;
 /// A world of trees (class 0, cleared around) and stumps (class 1, never cleared around)
 /// and a grass layer that keeps out of them; `tasks` generation tasks at once per layer.
 fn world(seed: u64, tasks: usize) -> (App, Entity, Entity) {
+    world_with(seed, tasks, false)
+}
+
+/// [`world`], the grass naming the trees by their entity's `Name` when `by_name`.
+fn world_with(seed: u64, tasks: usize, by_name: bool) -> (App, Entity, Entity) {
     let mut app = bevy_rwt::testing::headless_app(
         RwtPlugins::default()
             .with_spawn_budget(50_000)
@@ -35,10 +40,12 @@ fn world(seed: u64, tasks: usize) -> (App, Entity, Entity) {
             chunk_size: 24.0,
             ..streaming()
         });
-    let trees = app.world_mut().spawn(trees).id();
-    let grass = layer(LayerDensity::Constant(1.0))
-        .with_seed(seed + 100)
-        .with_keep_out(trees, [RADIUS, 0.0]);
+    let trees = app.world_mut().spawn((trees, Name::new("trees"))).id();
+    let grass = layer(LayerDensity::Constant(1.0)).with_seed(seed + 100);
+    let grass = match by_name {
+        true => grass.with_keep_out("trees", [RADIUS, 0.0]),
+        false => grass.with_keep_out(trees, [RADIUS, 0.0]),
+    };
     let grass = app.world_mut().spawn(grass).id();
     spawn_viewer(&mut app, Vec3::ZERO);
     tick_app(&mut app, 10_000);
@@ -101,6 +108,13 @@ fn no_grass_within_a_trees_radius_in_any_completion_order() {
 fn the_same_world_whichever_chunk_finishes_first() {
     let (mut a, _, grass_a) = world(7, 1);
     let (mut b, _, grass_b) = world(7, 64);
+    assert_eq!(of_layer(&mut a, grass_a), of_layer(&mut b, grass_b));
+}
+
+#[test]
+fn a_layer_named_keeps_the_same_grass_out() {
+    let (mut a, _, grass_a) = world_with(5, 8, false);
+    let (mut b, _, grass_b) = world_with(5, 8, true);
     assert_eq!(of_layer(&mut a, grass_a), of_layer(&mut b, grass_b));
 }
 

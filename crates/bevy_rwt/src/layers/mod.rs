@@ -391,10 +391,32 @@ pub struct ScatterLayer {
 #[derive(Clone, Debug, PartialEq, Reflect)]
 #[reflect(Clone, Debug, PartialEq)]
 pub struct KeepOut {
-    /// The layer entity whose instances clear this layer.
-    pub layer: Entity,
+    /// The layer whose instances clear this layer.
+    pub layer: LayerRef,
     /// Per class of that layer, how far its instances clear (0 or missing: not at all).
     pub radii: Vec<f32>,
+}
+
+/// Another layer: its entity, or the [`Name`] of its entity (what layer files write).
+#[derive(Clone, Debug, PartialEq, Eq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
+pub enum LayerRef {
+    /// The layer entity.
+    Entity(Entity),
+    /// The layer entity that has this `Name`.
+    Named(String),
+}
+
+impl From<Entity> for LayerRef {
+    fn from(e: Entity) -> Self {
+        Self::Entity(e)
+    }
+}
+
+impl From<&str> for LayerRef {
+    fn from(name: &str) -> Self {
+        Self::Named(name.to_string())
+    }
 }
 
 /// A layer's tile size (world units per base tile) unless set: in code and in layer files.
@@ -495,9 +517,9 @@ impl ScatterLayer {
 
     /// Keeps this layer out of the instances of `layer`: none within `radii[c]` of one of
     /// its class `c` (see [`KeepOut`]).
-    pub fn with_keep_out(mut self, layer: Entity, radii: impl Into<Vec<f32>>) -> Self {
+    pub fn with_keep_out(mut self, layer: impl Into<LayerRef>, radii: impl Into<Vec<f32>>) -> Self {
         self.keep_out.push(KeepOut {
-            layer,
+            layer: layer.into(),
             radii: radii.into(),
         });
         self

@@ -8,7 +8,7 @@
 use super::LayerState;
 use super::generate::{Changes, Generator};
 use crate::edits::EditSet;
-use crate::layers::{KeepOut, ScatterLayer};
+use crate::layers::{KeepOut, LayerRef, ScatterLayer};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use glam::DVec2;
@@ -106,10 +106,19 @@ struct Source {
 /// Gives every layer with keep-outs the current state of the layers that clear it; where
 /// their edits changed, or the layers themselves, the chunks within reach are generated
 /// again. A layer waits while a layer that clears it is not ready.
-pub(super) fn track_keep_out(mut layers: Query<(Entity, &ScatterLayer, &mut LayerState)>) {
+pub(super) fn track_keep_out(
+    mut layers: Query<(Entity, &ScatterLayer, &mut LayerState)>,
+    names: Query<(Entity, &Name), With<ScatterLayer>>,
+) {
     if layers.iter().all(|(_, l, _)| l.keep_out.is_empty()) {
         return;
     }
+    let named = |name: &str| {
+        names
+            .iter()
+            .find(|(_, n)| n.as_str() == name)
+            .map(|(e, _)| e)
+    };
     let sources: HashMap<Entity, Source> = layers
         .iter()
         .map(|(e, layer, state)| {
@@ -128,7 +137,12 @@ pub(super) fn track_keep_out(mut layers: Query<(Entity, &ScatterLayer, &mut Laye
         let mut clearings = Vec::new();
         let mut ready = true;
         for keep in &layer.keep_out {
-            match sources.get(&keep.layer).filter(|_| keep.layer != entity) {
+            let other = match &keep.layer {
+                LayerRef::Entity(e) => Some(*e),
+                LayerRef::Named(name) => named(name),
+            };
+            let source = other.filter(|e| *e != entity).and_then(|e| sources.get(&e));
+            match source {
                 Some(Source {
                     generator: Some(generator),
                     chunk_size,
@@ -150,7 +164,7 @@ pub(super) fn track_keep_out(mut layers: Query<(Entity, &ScatterLayer, &mut Laye
 
 fn warn_once(entity: Entity, keep: &KeepOut) {
     bevy::log::warn_once!(
-        "scatter layer {entity}: keeps out of {}, which is not a scatter layer",
+        "scatter layer {entity}: keeps out of {:?}, which is not another scatter layer",
         keep.layer
     );
 }

@@ -2,10 +2,11 @@
 
 use super::{
     ClassDescription, DensityDescription, HeightDescription, InstancedShadingDescription,
-    LayerDescription, LayerFileError, LayerPart, LodDescription, MapDescription,
-    MaterialDescription, MeshDescription, NamedAssets, PromotionDescription, Undescribable,
+    KeepOutDescription, LayerDescription, LayerFileError, LayerPart, LodDescription,
+    MapDescription, MaterialDescription, MeshDescription, NamedAssets, PromotionDescription,
+    Undescribable,
 };
-use crate::layers::{HeightSource, LayerDensity, ScatterClass, ScatterLayer};
+use crate::layers::{HeightSource, LayerDensity, LayerRef, ScatterClass, ScatterLayer};
 use crate::look::{ClassLook, MeshLod};
 use bevy::prelude::*;
 
@@ -56,9 +57,16 @@ impl LayerDescription {
         let (height, ground) = namer
             .height(height)
             .map_err(|e| not(LayerPart::Ground, e))?;
-        if !keep_out.is_empty() {
-            return Err(not(LayerPart::Ground, Undescribable::KeepOut));
-        }
+        let keep_out = keep_out
+            .iter()
+            .map(|k| match &k.layer {
+                LayerRef::Named(name) => Ok(KeepOutDescription {
+                    layer: name.clone(),
+                    radii: k.radii.clone(),
+                }),
+                LayerRef::Entity(_) => Err(not(LayerPart::Ground, Undescribable::KeepOut)),
+            })
+            .collect::<Result<_, _>>()?;
         let exclusion = match exclusion {
             Some(d) => Some(namer.density(d).map_err(|e| not(LayerPart::Exclusion, e))?),
             None => None,
@@ -81,6 +89,7 @@ impl LayerDescription {
             height_range: *height_range,
             max_slope: *max_slope,
             exclusion,
+            keep_out,
         })
     }
 }

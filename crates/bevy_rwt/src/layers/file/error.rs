@@ -138,8 +138,8 @@ pub enum Undescribable {
     /// An image (density map, heightmap, texture) without a path.
     #[error("image {0:?} has no asset path")]
     Image(AssetId<Image>),
-    /// Keep-outs name other layers by entity, which a file cannot.
-    #[error("keep-outs name other layers by entity, which a layer file cannot")]
+    /// A keep-out names another layer by entity, which a file cannot (a `Name` it can).
+    #[error("a keep-out names another layer by entity, which a layer file cannot (use a Name)")]
     KeepOut,
     /// A ground made in code ([`HeightSource::Custom`](crate::HeightSource::Custom)).
     #[error("a custom ground (code) has no file form")]

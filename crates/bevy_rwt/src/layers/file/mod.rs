@@ -88,8 +88,8 @@ pub use loader::ScatterLayerLoader;
 pub use names::NamedAssets;
 
 use super::{
-    DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap, HeightSource, LayerDensity, Promotion,
-    ScatterClass, ScatterLayer,
+    DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap, HeightSource, KeepOut, LayerDensity,
+    LayerRef, Promotion, ScatterClass, ScatterLayer,
 };
 use crate::ground::SurfacePolicy;
 use crate::look::{GroundPlane, InstancedShading, InstancedShadows, MeshLod, Stance, blade_mesh};
@@ -450,6 +450,19 @@ pub struct LayerDescription {
     /// No instances where this is 0.5 or more (e.g. `Image(path: "roads.png", .., scale: 1.0)`).
     #[serde(default)]
     pub exclusion: Option<DensityDescription>,
+    /// Other layers, by the `Name` of their entity, whose instances clear this one, e.g.
+    /// `[(layer: "trees", radii: [1.2, 0.0])]` (see [`KeepOut`]).
+    #[serde(default)]
+    pub keep_out: Vec<KeepOutDescription>,
+}
+
+/// A keep-out in a layer file: the other layer's entity `Name` and a radius per class.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct KeepOutDescription {
+    /// The `Name` of the layer entity whose instances clear this layer.
+    pub layer: String,
+    /// Per class of that layer, how far its instances clear.
+    pub radii: Vec<f32>,
 }
 
 impl DensityDescription {
@@ -607,6 +620,14 @@ impl LayerDescription {
         layer.max_slope = self.max_slope;
         layer.surfaces = self.surfaces;
         layer.per_area = self.per_area;
+        layer.keep_out = self
+            .keep_out
+            .iter()
+            .map(|k| KeepOut {
+                layer: LayerRef::Named(k.layer.clone()),
+                radii: k.radii.clone(),
+            })
+            .collect();
         Ok(layer)
     }
 

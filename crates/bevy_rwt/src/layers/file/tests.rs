@@ -346,7 +346,8 @@ fn ground_stances_and_clumps_read_back_the_same() {
     });
     let layer = ScatterLayer::new(vec![class])
         .on_surfaces(SurfacePolicy::Every)
-        .with_per_area(false);
+        .with_per_area(false)
+        .with_keep_out("trees", [1.2, 0.0]);
     let d = LayerDescription::describe(&layer, &names, |_| None).unwrap();
     assert_eq!(d.ground, Some(HeightDescription::Surfaces));
     let text = d.to_ron().unwrap();
@@ -357,6 +358,7 @@ fn ground_stances_and_clumps_read_back_the_same() {
         "align: 0.75",
         "Matern",
         "collider",
+        "trees",
     ];
     for part in parts {
         assert!(text.contains(part), "{part} missing from {text}");
@@ -376,6 +378,7 @@ fn ground_stances_and_clumps_read_back_the_same() {
         (back.surfaces, back.per_area),
         (SurfacePolicy::Every, false)
     );
+    assert_eq!(back.keep_out, layer.keep_out);
     assert_eq!(back.classes[0].stance, layer.classes[0].stance);
     let LayerDensity::Clumps(c) = &back.classes[0].density else {
         panic!("{:?}", back.classes[0].density);
