@@ -437,30 +437,19 @@ fn moving_a_ground_mesh_rescatters_the_chunks_under_it_only() {
     let layer = app.world_mut().spawn(surface_layer(0.5)).id();
     spawn_viewer(&mut app, Vec3::ZERO);
     tick_app(&mut app, 5_000);
-    app.world_mut()
-        .resource_mut::<Messages<ChunkLoaded>>()
-        .clear();
+    reloaded(&mut app, layer);
     let to = Transform::from_xyz(22.0, 1.5, -26.0);
     app.world_mut()
         .entity_mut(rock)
         .insert((to, GlobalTransform::from(to)));
     tick_app(&mut app, 5_000);
-    let reloaded: Vec<_> = app
-        .world_mut()
-        .resource_mut::<Messages<ChunkLoaded>>()
-        .drain()
-        .filter(|m| m.layer == layer)
-        .map(|m| m.chunk)
-        .collect();
+    let again = reloaded(&mut app, layer);
     // The rock's 10 x 10 ground rectangle before and after.
     let old = (Vec2::new(-25.0, -25.0), Vec2::new(-15.0, -15.0));
     let new = (Vec2::new(17.0, -31.0), Vec2::new(27.0, -21.0));
     let expected = chunks_over(&app, layer, &[old, new]);
     assert!(expected >= 2);
-    let mut unique = reloaded.clone();
-    unique.sort_by_key(|c| (c.x, c.y));
-    unique.dedup();
-    assert_eq!(unique.len(), expected, "re-scattered {reloaded:?}");
+    assert_eq!(again.len(), expected, "re-scattered {again:?}");
 
     // The same world as a fresh start with the rock where it ended.
     let mut fresh = ground_app();
@@ -476,6 +465,49 @@ fn moving_a_ground_mesh_rescatters_the_chunks_under_it_only() {
     assert_eq!(a.len(), b.len());
     for (id, t) in &a {
         assert_eq!(Some(t), b.get(id), "{id:?}");
+    }
+}
+
+/// The distinct chunks of `layer` loaded again since the messages were last drained.
+fn reloaded(app: &mut App, layer: Entity) -> Vec<(i64, i64)> {
+    let mut chunks: Vec<_> = app
+        .world_mut()
+        .resource_mut::<Messages<ChunkLoaded>>()
+        .drain()
+        .filter(|m| m.layer == layer)
+        .map(|m| (m.chunk.x, m.chunk.y))
+        .collect();
+    chunks.sort();
+    chunks.dedup();
+    chunks
+}
+
+#[test]
+fn adding_or_removing_a_ground_mesh_rescatters_the_chunks_under_it_only() {
+    let mut app = ground_app();
+    level(&mut app, ScatterSurface::all());
+    let layer = app.world_mut().spawn(surface_layer(0.5)).id();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    tick_app(&mut app, 5_000);
+    reloaded(&mut app, layer);
+    // A 6 x 6 box over -12..-6 (x) and 6..12 (z): inside one chunk, and over two.
+    for (x, expected) in [(-9.0, 1), (-1.0, 2)] {
+        let rock = add_mesh(&mut app, Cuboid::new(6.0, 2.0, 6.0).mesh().build());
+        let at = Transform::from_xyz(x, 0.5, 9.0);
+        let rock = spawn_surface(&mut app, rock, at, ScatterSurface::all());
+        tick_app(&mut app, 5_000);
+        assert_eq!(
+            reloaded(&mut app, layer).len(),
+            expected,
+            "adding at x = {x}"
+        );
+        app.world_mut().entity_mut(rock).despawn();
+        tick_app(&mut app, 5_000);
+        assert_eq!(
+            reloaded(&mut app, layer).len(),
+            expected,
+            "removing at x = {x}"
+        );
     }
 }
 
