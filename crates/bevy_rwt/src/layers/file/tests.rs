@@ -388,23 +388,6 @@ fn ground_stances_and_clumps_read_back_the_same() {
     let promotion = back.classes[0].promotion.as_ref().unwrap();
     assert_eq!(promotion.distance, 12.0);
     assert!(std::sync::Arc::ptr_eq(&promotion.insert, &collider));
-    // An inserter without a name cannot be written, and says so.
-    let mut unnamed = layer.clone();
-    unnamed.classes[0].promotion = Some(crate::Promotion {
-        distance: 3.0,
-        insert: std::sync::Arc::new(|_| {}),
-    });
-    let e = LayerDescription::describe(&unnamed, &names, |_| None).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            LayerFileError::NotDescribable {
-                what: Undescribable::PromotionInserter,
-                ..
-            }
-        ),
-        "{e}"
-    );
     // Clump parameters out of range are refused when the file is read.
     let bad = text.replace("radius: 2.5", "radius: -1.0");
     assert!(matches!(
@@ -414,7 +397,7 @@ fn ground_stances_and_clumps_read_back_the_same() {
 }
 
 #[test]
-fn keep_outs_and_custom_grounds_are_not_describable() {
+fn keep_outs_by_entity_custom_grounds_and_unnamed_inserters_are_reported() {
     let names = NamedAssets::default();
     names.insert_mesh("moss", uuid::<Mesh>(3));
     names.insert_material("green", uuid::<StandardMaterial>(4));
@@ -427,10 +410,19 @@ fn keep_outs_and_custom_grounds_are_not_describable() {
     let custom = ScatterLayer::new(vec![class]).with_height(HeightSource::Custom(
         std::sync::Arc::new(crate::ground::FlatGround(1.0)),
     ));
-    for (layer, what) in [
+    // A promotion whose inserter has no name cannot be written either.
+    let mut promoted = custom.clone();
+    promoted.height = HeightSource::Constant(0.0);
+    promoted.classes[0].promotion = Some(crate::Promotion {
+        distance: 3.0,
+        insert: std::sync::Arc::new(|_| {}),
+    });
+    let cases = [
         (kept, Undescribable::KeepOut),
         (custom, Undescribable::CustomGround),
-    ] {
+        (promoted, Undescribable::PromotionInserter),
+    ];
+    for (layer, what) in cases {
         let e = LayerDescription::describe(&layer, &names, |_| None).unwrap_err();
         assert!(
             matches!(&e, LayerFileError::NotDescribable { what: w, .. } if *w == what),
