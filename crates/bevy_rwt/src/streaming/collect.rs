@@ -17,7 +17,6 @@ pub(super) fn collect_results(
 ) {
     for (entity, layer, mut state) in &mut layers {
         let classes = layer.classes.len();
-        let generator = state.generator(layer);
         let state = &mut *state;
         let mut finished = Vec::new();
         for (chunk, c) in state.states.iter_mut() {
@@ -63,7 +62,8 @@ pub(super) fn collect_results(
                 }
                 c.stale = true;
             }
-            if let Some(generator) = generator.as_ref().filter(|_| reground) {
+            // Only a chunk whose ground changed moves the entities it keeps.
+            if reground && let Some(generator) = state.generator(layer) {
                 let spawner = Spawner {
                     entity,
                     layer,

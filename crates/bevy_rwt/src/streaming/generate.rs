@@ -132,7 +132,7 @@ impl Generator {
             clearing.clear(rect, out)?;
         }
         if let Some(edits) = &changes.edits {
-            EditSet::apply(edits, out, self.classes);
+            self.edit(edits, out);
         }
         if !changes.footprints.is_empty() {
             let cleared = |p: &Point| {

@@ -184,17 +184,21 @@ impl LayerState {
     /// How the layer's chunks are generated (`None` until its sampler and sources are
     /// made).
     fn generator(&self, layer: &ScatterLayer) -> Option<Generator> {
-        let keep_out = match &self.keep_out {
-            Some(k) => k.clone(),
-            None if layer.keep_out.is_empty() => Arc::from([]),
-            None => return None,
-        };
         Some(Generator::new(
             layer,
             self.sampler.clone()?,
             &self.sources.ready()?,
-            keep_out,
+            self.keep_out_for(layer)?,
         ))
+    }
+
+    /// The layers that clear this one, as its tasks generate with them; `None` while one
+    /// of the layers it names is not ready.
+    fn keep_out_for(&self, layer: &ScatterLayer) -> Option<Arc<[keep_out::Clearing]>> {
+        match &self.keep_out {
+            Some(k) => Some(k.clone()),
+            None => layer.keep_out.is_empty().then(|| Arc::from([])),
+        }
     }
 
     /// The layer's sampler, made on first use.

@@ -62,10 +62,7 @@ pub(super) fn plan_chunks(
         }
         mark_band_changes(layer, state, viewers);
         // A layer that other layers clear waits until they are ready.
-        let keep_out = match &state.keep_out {
-            Some(k) => Some(k.clone()),
-            None => layer.keep_out.is_empty().then(|| Arc::from([])),
-        };
+        let keep_out = state.keep_out_for(layer);
         let free = match keep_out {
             Some(_) => inputs
                 .settings
