@@ -251,6 +251,7 @@ pub fn stipple(data: &[u8]) -> bool {
         limits: StippleLimits {
             max_dots: 500,
             max_raster_pixels: 1 << 10,
+            max_image_pixels: 1 << 10,
         },
     };
     let values = (0..w * h).map(|_| b.number() as f32).collect();

@@ -73,7 +73,8 @@ fn every_nth(points: &[bevy_rwt::rwt_core::Point], count: usize) -> EditSet {
     if count > 0 {
         let step = points.len() as f64 / count as f64;
         for k in 0..count {
-            set.set(points[(k as f64 * step) as usize].id, Edit::Remove);
+            set.set(points[(k as f64 * step) as usize].id, Edit::Remove)
+                .unwrap();
         }
     }
     set
@@ -90,7 +91,7 @@ fn generation(set: &TileSet, edits: &EditSet) -> (f64, f64) {
     });
     let mut by_chunk: HashMap<ChunkCoord, EditSet> = HashMap::new();
     for (chunk, id, e) in located {
-        by_chunk.entry(chunk).or_default().set(id, e);
+        by_chunk.entry(chunk).or_default().set(id, e).unwrap();
     }
     let time = |with: bool| {
         let mut best = f64::INFINITY;

@@ -115,6 +115,9 @@ pub enum EditError {
         /// The layer's classes.
         classes: usize,
     },
+    /// The edit set refused it (more than `rwt_core::edits::MAX_EDITS` edits).
+    #[error(transparent)]
+    Refused(#[from] rwt_core::edits::EditsError),
 }
 
 /// The edits of a layer, on its entity (added with the [`crate::ScatterLayer`], kept when the
@@ -151,19 +154,20 @@ impl ScatterEdits {
         self.0.is_empty()
     }
 
-    /// Applies one edit to the set.
-    pub(crate) fn apply(&mut self, id: PointId, edit: InstanceEdit) {
-        edit.apply_to(&mut self.0, id);
+    /// Applies one edit to the set; a refused one changes nothing.
+    pub(crate) fn apply(&mut self, id: PointId, edit: InstanceEdit) -> Result<(), EditError> {
+        edit.apply_to(&mut self.0, id)
     }
 }
 
 impl InstanceEdit {
     /// Applies this edit of point `id` to `set` (a layer's, or one chunk's share of it).
-    pub(crate) fn apply_to(self, set: &mut EditSet, id: PointId) {
+    pub(crate) fn apply_to(self, set: &mut EditSet, id: PointId) -> Result<(), EditError> {
         match self {
-            InstanceEdit::Remove => set.set(id, Edit::Remove),
-            InstanceEdit::Reclass(class) => set.set(id, Edit::Reclass(class)),
+            InstanceEdit::Remove => set.set(id, Edit::Remove)?,
+            InstanceEdit::Reclass(class) => set.set(id, Edit::Reclass(class))?,
             InstanceEdit::Restore => set.restore(&id),
         };
+        Ok(())
     }
 }

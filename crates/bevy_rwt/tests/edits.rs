@@ -169,7 +169,7 @@ fn replacing_the_edit_set_regenerates_what_it_touches() {
         .into_iter()
         .chain(nearest(&before, TREE, 3))
     {
-        set.set(id, Edit::Remove);
+        set.set(id, Edit::Remove).unwrap();
     }
     let edits = ScatterEdits::new(set);
     app.world_mut().entity_mut(layer).insert(edits.clone());

@@ -1,6 +1,6 @@
 //! `rwt analyse`: quality figures of a point set beside references computed in the same run.
 
-use crate::draw::Canvas;
+use crate::draw::{Canvas, Format, format_of};
 use glam::DVec2;
 use rwt_core::analysis::{Spectrum, WindowAnalysis, WindowGrid, reference};
 use std::path::Path;
@@ -80,15 +80,35 @@ pub fn print_table(rows: &[Row]) {
     }
 }
 
+/// Longest line of a point file read.
+const MAX_LINE: usize = 4096;
+
 /// Calls `f` with every point of the file (`x y` first on each line; lines with fewer than
 /// two fields are skipped), streaming it; returns how many.
 fn for_each_point(path: &Path, mut f: impl FnMut(DVec2)) -> Result<usize, String> {
-    use std::io::BufRead;
-    let file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut count = 0;
-    for (n, line) in std::io::BufReader::new(file).lines().enumerate() {
-        let line = line.map_err(|e| format!("{}: line {}: {e}", path.display(), n + 1))?;
-        let mut it = line.split_whitespace();
+    use std::io::{BufRead, Read};
+    let file = rwt_core::files::open_regular(path).map_err(|e| e.to_string())?;
+    let mut reader = std::io::BufReader::new(file);
+    let (mut count, mut line, mut n) = (0, Vec::new(), 0);
+    loop {
+        line.clear();
+        n += 1;
+        // One line at a time, at most MAX_LINE bytes of it.
+        let read = (&mut reader)
+            .take(MAX_LINE as u64 + 1)
+            .read_until(b'\n', &mut line)
+            .map_err(|e| format!("{}: line {n}: {e}", path.display()))?;
+        if read == 0 {
+            break;
+        }
+        if line.len() > MAX_LINE {
+            return Err(format!(
+                "{}: line {n} is longer than {MAX_LINE} bytes: not a point file",
+                path.display()
+            ));
+        }
+        let text = String::from_utf8_lossy(&line);
+        let mut it = text.split_whitespace();
         let (Some(x), Some(y)) = (it.next(), it.next()) else {
             continue;
         };
@@ -106,6 +126,9 @@ fn for_each_point(path: &Path, mut f: impl FnMut(DVec2)) -> Result<usize, String
 
 /// `rwt analyse FILE [--plot out.png]`.
 pub fn run(path: &Path, plot: Option<&Path>) -> Result<(), String> {
+    if let Some(out) = plot {
+        format_of(out, &[Format::Png])?;
+    }
     // Two passes over the file: its extent, then the points of the windows.
     let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     let count = for_each_point(path, |p| {
@@ -118,9 +141,7 @@ pub fn run(path: &Path, plot: Option<&Path>) -> Result<(), String> {
             path.display()
         ));
     }
-    let Some(grid) = WindowGrid::new(lo, hi, count) else {
-        return Err("points span no area".into());
-    };
+    let grid = WindowGrid::new(lo, hi, count).map_err(|e| format!("{}: {e}", path.display()))?;
     let (side, density) = (grid.side, grid.density);
     let mut windows = grid.split(std::iter::empty());
     for_each_point(path, |p| {

@@ -3,6 +3,48 @@
 use image::{ExtendedColorType, ImageEncoder, Rgb, RgbImage};
 use std::path::Path;
 
+/// A picture format an output's extension names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// `.png`.
+    Png,
+    /// `.svg`.
+    Svg,
+}
+
+impl Format {
+    fn extension(self) -> &'static str {
+        match self {
+            Format::Png => "png",
+            Format::Svg => "svg",
+        }
+    }
+}
+
+/// The format `path`'s extension names, among those a command writes; anything else is an
+/// error naming them (a picture is never written under another format's name).
+pub fn format_of(path: &Path, writes: &[Format]) -> Result<Format, String> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    writes
+        .iter()
+        .copied()
+        .find(|f| f.extension() == ext)
+        .ok_or_else(|| {
+            let names: Vec<String> = writes
+                .iter()
+                .map(|f| format!(".{}", f.extension()))
+                .collect();
+            format!(
+                "{}: the format follows the extension; this writes {}",
+                path.display(),
+                names.join(" or ")
+            )
+        })
+}
+
 /// Writes pixels as a PNG, atomically: on any error an existing file keeps its bytes.
 pub fn save_png(
     path: &Path,

@@ -42,7 +42,7 @@ enum Command {
     /// Points of a rectangle for a density: `x y class rotation level:x:y:index` per line.
     Points {
         /// The rectangle: x0 y0 x1 y1.
-        #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true)]
+        #[arg(long, required = true, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true, value_parser = finite)]
         rect: Vec<f64>,
         /// `const:V` (points per unit area), `image:PATH[:V]`, `dark:PATH[:V]` or
         /// `noise:V[:FREQ[:OCTAVES[:SEED]]]`; images are stretched over the rectangle, their
@@ -54,7 +54,7 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
         /// Width of a base tile in world units.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, value_parser = finite)]
         tile_size: f64,
         /// Refuse queries that may produce more points than this.
         #[arg(long, default_value_t = rwt_core::query::DEFAULT_BUDGET)]
@@ -86,19 +86,19 @@ enum Command {
         #[arg(long, conflicts_with = "radius")]
         points: Option<usize>,
         /// Dot radius in image pixels (the number of dots follows).
-        #[arg(long)]
+        #[arg(long, value_parser = finite)]
         radius: Option<f64>,
         /// Darkness exponent: darkness = (contrast * (1 - grey))^gamma.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, value_parser = finite)]
         gamma: f64,
         /// Darkness multiplier (see --gamma).
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, value_parser = finite)]
         contrast: f64,
         /// Tiling seed.
         #[arg(long, default_value_t = 0)]
         seed: u64,
         /// Output pixels per image pixel.
-        #[arg(long, default_value_t = 2.0)]
+        #[arg(long, default_value_t = 2.0, value_parser = finite)]
         scale: f64,
         /// Refuse stipples of more dots than this.
         #[arg(long, default_value_t = rwt_core::stipple::DEFAULT_MAX_DOTS)]
@@ -106,6 +106,9 @@ enum Command {
         /// Refuse rendered rasters of more pixels than this.
         #[arg(long, default_value_t = rwt_core::stipple::DEFAULT_MAX_RASTER_PIXELS)]
         max_raster_pixels: u64,
+        /// Refuse images of more pixels than this.
+        #[arg(long, default_value_t = rwt_core::stipple::DEFAULT_MAX_IMAGE_PIXELS)]
+        max_image_pixels: u64,
     },
     /// Throughput and scaling of queries, as ratios measured in one run.
     Bench {
@@ -140,7 +143,7 @@ enum TilesetAction {
         /// Tile set file.
         file: PathBuf,
         /// Also fail when a prefix's normalized minimum distance is below this.
-        #[arg(long)]
+        #[arg(long, value_parser = finite)]
         min_rho: Option<f64>,
     },
     /// Draw the tiles (seams, origins, edge colours) and a two-level subdivision.
@@ -154,6 +157,13 @@ enum TilesetAction {
 }
 
 fn main() -> ExitCode {
+    // Ctrl-C, SIGTERM and SIGHUP end the program without leaving half-written files: the
+    // targets keep their previous bytes.
+    let _ = ctrlc::set_handler(|| {
+        rwt_core::files::remove_temporaries();
+        eprintln!("interrupted: no output was changed");
+        std::process::exit(130);
+    });
     let result = match Cli::parse().command {
         Command::Tileset { action } => tileset(action),
         Command::Points {
@@ -186,6 +196,7 @@ fn main() -> ExitCode {
             scale,
             max_dots,
             max_raster_pixels,
+            max_image_pixels,
         } => stipple_cmd::run(&stipple_cmd::StippleArgs {
             image: &image,
             out: &out,
@@ -197,6 +208,7 @@ fn main() -> ExitCode {
             limits: rwt_core::stipple::StippleLimits {
                 max_dots,
                 max_raster_pixels,
+                max_image_pixels,
             },
         })
         .map(|()| true),
@@ -209,6 +221,16 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::from(2)
         }
+    }
+}
+
+/// A number option's value: finite (NaN and infinities are refused where they are typed,
+/// not turned into nonsense later).
+fn finite(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) => Err(format!("{v} is not a finite number")),
+        Err(e) => Err(e.to_string()),
     }
 }
 

@@ -10,7 +10,7 @@
 use glam::DVec2;
 use rwt_core::density::Placement;
 use rwt_core::density::{
-    Constant, Density, ImageDensity, ImageDensityError, NoiseDensity, NoiseParams, open_image,
+    Constant, Density, ImageDensity, ImageDensityError, NoiseDensity, NoiseParams,
 };
 use std::path::PathBuf;
 
@@ -132,10 +132,8 @@ pub fn parse(spec: &str, rect: (DVec2, DVec2)) -> Result<BoxedDensity, SpecError
                 path: path.clone(),
                 error,
             };
-            let img = open_image(&path).map_err(image_err)?;
-            let d = ImageDensity::from_image(
-                &img,
-                None,
+            let d = ImageDensity::open(
+                &path,
                 kind == "dark",
                 Placement {
                     min: rect.0,

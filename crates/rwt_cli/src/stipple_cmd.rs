@@ -1,6 +1,7 @@
 //! `rwt stipple`: blue-noise stippling of an image whose blurred dots keep the image's tone
 //! (paper figure 11), with the tone error printed next to a white-noise stipple's.
 
+use crate::draw::{Format, format_of};
 use rwt_core::density::open_image;
 use rwt_core::stipple::{
     DotCount, Grey, Stipple, StippleLimits, StippleSettings, ToneMap, stipple,
@@ -45,11 +46,13 @@ pub fn run(args: &StippleArgs) -> Result<(), String> {
         scale: args.scale,
         limits: args.limits,
     };
+    let format = format_of(args.out, &[Format::Png, Format::Svg])?;
     let named = |e: &dyn std::fmt::Display| format!("{}: {e}", args.image.display());
     // Settings, raster and dot count are admitted from the header, before decoding; the
-    // image itself is at most rwt_core's MAX_IMAGE_PIXELS.
-    let (w, h) = image::ImageReader::open(args.image)
-        .and_then(|r| r.with_guessed_format())
+    // image itself is at most StippleLimits::max_image_pixels.
+    let file = rwt_core::files::open_regular(args.image).map_err(|e| e.to_string())?;
+    let (w, h) = image::ImageReader::new(std::io::BufReader::new(file))
+        .with_guessed_format()
         .map_err(|e| named(&e))?
         .into_dimensions()
         .map_err(|e| named(&e))?;
@@ -69,14 +72,14 @@ pub fn run(args: &StippleArgs) -> Result<(), String> {
     );
     // Rendered once: the tone figures and the PNG are of the same raster.
     let ink = s.render(&s.dots, args.scale).map_err(|e| e.to_string())?;
-    report_tone(&s, &grey, &ink, args.seed);
-    write(&s, &ink, args.out, args.scale)?;
+    report_tone(&s, &grey, &ink, args.seed)?;
+    write(&s, &ink, args.out, format, args.scale)?;
     say!("wrote {}", args.out.display());
     Ok(())
 }
 
 /// Prints the mean grey and the tone error of the stipple and of a white-noise stipple.
-fn report_tone(s: &Stipple, grey: &Grey, rendered: &Grey, seed: u64) {
+fn report_tone(s: &Stipple, grey: &Grey, rendered: &Grey, seed: u64) -> Result<(), String> {
     let target = 1.0 - s.target.mean();
     let mapped = if (target - grey.mean()).abs() > 5e-4 {
         format!(", after --gamma/--contrast {target:.3}")
@@ -88,7 +91,7 @@ fn report_tone(s: &Stipple, grey: &Grey, rendered: &Grey, seed: u64) {
         grey.mean(),
         1.0 - rendered.mean()
     );
-    let r = s.tone_report(rendered, seed);
+    let r = s.tone_report(rendered, seed).map_err(|e| e.to_string())?;
     say!(
         "tone error (blur {:.2} px, the mean dot spacing): blue noise {:.4} (PSNR {:.2} dB), white noise {:.4} (PSNR {:.2} dB), {:+.2} dB",
         r.sigma,
@@ -98,17 +101,13 @@ fn report_tone(s: &Stipple, grey: &Grey, rendered: &Grey, seed: u64) {
         r.white.psnr,
         r.blue.psnr - r.white.psnr
     );
+    Ok(())
 }
 
 /// Writes the stipple as antialiased PNG (`ink`, its rendering) or as SVG circles,
 /// atomically: on any error an existing file keeps its bytes.
-fn write(s: &Stipple, ink: &Grey, out: &Path, scale: f64) -> Result<(), String> {
-    let ext = out
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    if ext == "svg" {
+fn write(s: &Stipple, ink: &Grey, out: &Path, format: Format, scale: f64) -> Result<(), String> {
+    if format == Format::Svg {
         rwt_core::files::write_atomic_with(out, |w| write_svg(s, scale, w))
             .map_err(|e| e.to_string())
     } else {

@@ -231,6 +231,7 @@ fn edge_bars(c: &mut Canvas, set: &TileSet, t: usize, x: f64, y: f64, s: f64, w:
 /// subdivided twice with the edge colours of every level (figure 6); and a corner of that
 /// tile where its points sit exactly on points of its subdivision (figure 7).
 pub fn render_cmd(path: &Path, out: &Path) -> Result<(), String> {
+    crate::draw::format_of(out, &[crate::draw::Format::Png])?;
     let set = load(path)?;
     let cols = (set.tiles.len() as f64).sqrt().ceil() as usize;
     let s = 220.0;

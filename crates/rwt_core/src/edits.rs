@@ -19,8 +19,8 @@
 //! sampler.query(rect, &Constant(50.0), &mut points).unwrap();
 //!
 //! let mut edits = EditSet::default();
-//! edits.set(points[0].id, Edit::Remove);
-//! edits.set(points[1].id, Edit::Reclass(2));
+//! edits.set(points[0].id, Edit::Remove).unwrap();
+//! edits.set(points[1].id, Edit::Reclass(2)).unwrap();
 //! let stamp = EditStamp::of(&sampler);
 //! let bytes = edits.to_bytes(&stamp);
 //! assert_eq!(EditSet::from_bytes(&bytes, &stamp).unwrap(), edits);
@@ -64,7 +64,13 @@ impl EditStamp {
     }
 }
 
-/// Largest edits file read (4 M edits at their largest).
+/// Most edits an [`EditSet`] holds and an edits file may declare: 4 million, 230 MB in
+/// memory (an edit takes about 57 bytes of its ordered map, measured).
+pub const MAX_EDITS: usize = 4_000_000;
+
+/// Largest edits file read: 64 MiB, room for [`MAX_EDITS`] edits of 16 bytes each (a record
+/// takes 2 to 28 bytes; a file that declares more edits than [`MAX_EDITS`] is refused from
+/// its count, before any is decoded).
 pub const MAX_EDITS_FILE_BYTES: u64 = 64 << 20;
 
 /// First bytes of an edits file.
@@ -107,6 +113,27 @@ pub enum EditsError {
         /// The stamp of the point set they were read for.
         expected: EditStamp,
     },
+    /// More edits than [`MAX_EDITS`], in a file's count or in a set being edited.
+    #[error("{count} edits, over the limit of {limit}")]
+    TooMany {
+        /// Edits there would be.
+        count: u64,
+        /// The limit.
+        limit: usize,
+    },
+    /// A point identity the file format cannot hold (a level past the deepest a query
+    /// reaches): refused when it is set, so that every set saves to a file that loads.
+    #[error("point {level}:{x}:{y}:{index} has level {level}, past the deepest ({MAX_LEVEL})")]
+    Unstorable {
+        /// Its level.
+        level: u8,
+        /// Its column.
+        x: i64,
+        /// Its row.
+        y: i64,
+        /// Its index.
+        index: u16,
+    },
     /// The checksum holds but a record is malformed (written by another program).
     #[error("edit record {record} is malformed: {what}")]
     Record {
@@ -130,9 +157,20 @@ pub enum EditsError {
 pub struct EditSet(BTreeMap<PointId, Edit>);
 
 impl EditSet {
-    /// Sets the edit of `id`; returns the one it replaces.
-    pub fn set(&mut self, id: PointId, edit: Edit) -> Option<Edit> {
-        self.0.insert(id, edit)
+    /// Sets the edit of `id`; returns the one it replaces. An identity the file format
+    /// cannot hold, or a new edit past [`MAX_EDITS`], is refused and changes nothing.
+    pub fn set(&mut self, id: PointId, edit: Edit) -> Result<Option<Edit>, EditsError> {
+        if id.level as u32 > MAX_LEVEL {
+            let PointId { level, x, y, index } = id;
+            return Err(EditsError::Unstorable { level, x, y, index });
+        }
+        if self.0.len() >= MAX_EDITS && !self.0.contains_key(&id) {
+            return Err(EditsError::TooMany {
+                count: self.0.len() as u64 + 1,
+                limit: MAX_EDITS,
+            });
+        }
+        Ok(self.0.insert(id, edit))
     }
 
     /// Drops the edit of `id` (the point is as its densities make it again); returns it.
@@ -319,6 +357,12 @@ fn decode_records(bytes: &[u8]) -> Result<EditSet, EditsError> {
     let mut r = Reader { bytes, at: 0 };
     let malformed = |record, what| EditsError::Record { record, what };
     let count = r.varint().ok_or(malformed(0, "no record count"))?;
+    if count > MAX_EDITS as u64 {
+        return Err(EditsError::TooMany {
+            count,
+            limit: MAX_EDITS,
+        });
+    }
     let mut set = BTreeMap::new();
     let mut previous: Option<PointId> = None;
     for record in 0..count as usize {

@@ -90,6 +90,15 @@ pub enum FileError {
         /// The limit in bytes.
         limit: u64,
     },
+    /// The path names something that is not a regular file (a folder, a FIFO, a device, a
+    /// socket): readers refuse it rather than block on it or read it without end.
+    #[error("{}: is {what}, not a regular file", path.display())]
+    NotAFile {
+        /// The path.
+        path: PathBuf,
+        /// What it is instead: "a folder", "a FIFO", "a device", "a socket".
+        what: &'static str,
+    },
     /// A transaction was asked to write one file twice.
     #[error("{}: written twice in one save", path.display())]
     Duplicate {
@@ -110,29 +119,122 @@ impl FileError {
     }
 }
 
-/// The file a write to `path` replaces: the target of a link (followed to the end), else
-/// `path` itself.
-fn resolve_target(path: &Path) -> PathBuf {
-    match std::fs::symlink_metadata(path) {
-        Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(path).unwrap_or_else(|_| {
-            // A dangling link: write where it points.
-            std::fs::read_link(path)
-                .map(|t| path.parent().unwrap_or(Path::new("")).join(t))
-                .unwrap_or_else(|_| path.to_path_buf())
-        }),
-        _ => path.to_path_buf(),
+/// The file a write to `path` replaces: the target of a link, followed link by link to the
+/// end (a dangling chain writes where its last link points), else `path` itself. A loop
+/// of links is an error, as the system's own open reports it.
+fn resolve_target(path: &Path) -> Result<PathBuf, FileError> {
+    /// Links followed before a chain counts as a loop (Linux's limit).
+    const MAX_LINKS: usize = 40;
+    let mut at = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match std::fs::symlink_metadata(&at) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let to = std::fs::read_link(&at)
+                    .map_err(|e| FileError::io(path, FileAction::Create, &e))?;
+                at = at.parent().unwrap_or(Path::new("")).join(to);
+            }
+            _ => return Ok(at),
+        }
     }
+    Err(FileError::Io {
+        path: path.to_path_buf(),
+        action: FileAction::Create,
+        kind: io::ErrorKind::Other,
+        reason: format!("more than {MAX_LINKS} links in a row (a loop of links?)"),
+    })
+}
+
+/// Longest file name the systems rwt runs on accept, in bytes.
+const NAME_MAX: usize = 255;
+
+/// The start of every temporary file name beside `target`: `.NAME.`, where a name too long
+/// to take the rest of a temporary name is cut (at a character) and ends in a hash of
+/// itself, so that a temporary name fits wherever the target's name fits.
+fn temp_prefix(target: &Path) -> std::ffi::OsString {
+    let name = target.file_name().unwrap_or_default();
+    // `.`, `.`, a process id and counter (at most 10 + 1 + 20) and the suffix.
+    let room = NAME_MAX - 2 - 31 - TEMP_SUFFIX.len();
+    let mut prefix = std::ffi::OsString::from(".");
+    if name.len() <= room {
+        prefix.push(name);
+    } else {
+        let text = name.to_string_lossy();
+        let mut cut = room - 17;
+        while !text.is_char_boundary(cut.min(text.len())) {
+            cut -= 1;
+        }
+        let hash = name
+            .as_encoded_bytes()
+            .iter()
+            .fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+                (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+            });
+        prefix.push(format!("{}~{hash:016x}", &text[..cut.min(text.len())]));
+    }
+    prefix.push(".");
+    prefix
 }
 
 /// A temporary file name beside `target`, unique within this process.
 fn temp_beside(target: &Path) -> PathBuf {
     static NEXT: AtomicU64 = AtomicU64::new(0);
-    let name = target
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
     let n = NEXT.fetch_add(1, Ordering::Relaxed);
-    target.with_file_name(format!(".{name}.{}-{n}{TEMP_SUFFIX}", std::process::id()))
+    let mut name = temp_prefix(target);
+    name.push(format!("{}-{n}{TEMP_SUFFIX}", std::process::id()));
+    target.with_file_name(name)
+}
+
+/// Removes the temporary files that writers to `target` which died without cleaning up
+/// (`kill -9`, a power cut) left beside it. A live writer holds a lock on its temporary
+/// file, so only abandoned ones are removed, whichever process made them.
+fn remove_stale_temporaries(target: &Path) {
+    let prefix = temp_prefix(target);
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let bytes = name.as_encoded_bytes();
+        if !(bytes.starts_with(prefix.as_encoded_bytes())
+            && bytes.ends_with(TEMP_SUFFIX.as_bytes()))
+        {
+            continue;
+        }
+        let abandoned = File::options()
+            .write(true)
+            .open(entry.path())
+            .is_ok_and(|f| f.try_lock().is_ok());
+        if abandoned {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Temporary files being written by this process, for [`remove_temporaries`].
+static LIVE: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Removes every temporary file this process is writing: what a program calls when a
+/// signal (Ctrl-C, `SIGTERM`, `SIGHUP`) is about to end it, so that no half-written file
+/// outlives it. The targets keep their previous bytes. The `rwt` command line does this on
+/// those signals; a `kill -9` cannot be caught, and the next write to the same target
+/// removes what it left.
+pub fn remove_temporaries() {
+    for temp in live().drain(..) {
+        let _ = std::fs::remove_file(temp);
+    }
+}
+
+/// Forgets a temporary file that is renamed or removed.
+fn forget(temp: &Path) {
+    live().retain(|t| t != temp);
 }
 
 /// Syncs a folder, so that renames in it survive a crash (best effort: not every system
@@ -165,7 +267,7 @@ pub struct AtomicFile {
 impl AtomicFile {
     /// Starts replacing `path` (creating its folder when missing).
     pub fn create(path: &Path) -> Result<Self, FileError> {
-        let target = resolve_target(path);
+        let target = resolve_target(path)?;
         if std::fs::metadata(&target).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
             let file = File::options()
                 .write(true)
@@ -187,12 +289,19 @@ impl AtomicFile {
         if let Some(dir) = target.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| FileError::io(dir, FileAction::Create, &e))?;
         }
+        remove_stale_temporaries(&target);
         let temp = temp_beside(&target);
+        live().push(temp.clone());
         let file = File::options()
             .write(true)
             .create_new(true)
             .open(&temp)
-            .map_err(|e| FileError::io(shown, FileAction::Create, &e))?;
+            .map_err(|e| {
+                forget(&temp);
+                FileError::io(shown, FileAction::Create, &e)
+            })?;
+        // Held until the file is closed: tells other writers this one is not abandoned.
+        let _ = file.try_lock();
         Ok(Self {
             target,
             shown: shown.to_path_buf(),
@@ -231,7 +340,7 @@ impl AtomicFile {
         std::fs::rename(&self.temp, &self.target)
             .map_err(|e| FileError::io(&self.shown, FileAction::Rename, &e))?;
         // Renamed: nothing left for `drop` to remove.
-        self.temp = PathBuf::new();
+        forget(&std::mem::take(&mut self.temp));
         sync_dir(self.target.parent().unwrap_or(Path::new("")));
         Ok(())
     }
@@ -262,6 +371,7 @@ impl Drop for AtomicFile {
         }
         if !self.temp.as_os_str().is_empty() {
             let _ = std::fs::remove_file(&self.temp);
+            forget(&self.temp);
         }
     }
 }
@@ -282,11 +392,59 @@ pub fn write_atomic_with(
     file.commit()
 }
 
-/// Reads a whole file of at most `limit` bytes: a larger one (or an endless device such as
-/// `/dev/zero`) is [`FileError::TooLarge`] after reading at most `limit + 1` bytes.
+/// Opens a file to read, refusing what is not a regular file ([`FileError::NotAFile`]): a
+/// FIFO would block until a writer comes, a device such as `/dev/zero` never ends, a folder
+/// has no bytes. A link is followed.
+pub fn open_regular(path: &Path) -> Result<File, FileError> {
+    let read_err = |e: io::Error| FileError::io(path, FileAction::Read, &e);
+    // Checked before opening: opening a FIFO blocks.
+    let kind = std::fs::metadata(path).map_err(read_err)?.file_type();
+    if !kind.is_file() {
+        return Err(FileError::NotAFile {
+            path: path.to_path_buf(),
+            what: what_is(kind),
+        });
+    }
+    let file = File::open(path).map_err(read_err)?;
+    // And after: the path may have been swapped in between.
+    let kind = file.metadata().map_err(read_err)?.file_type();
+    if !kind.is_file() {
+        return Err(FileError::NotAFile {
+            path: path.to_path_buf(),
+            what: what_is(kind),
+        });
+    }
+    Ok(file)
+}
+
+/// What a file type that is not a regular file is, in words.
+fn what_is(kind: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return "a FIFO";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+        if kind.is_block_device() || kind.is_char_device() {
+            return "a device";
+        }
+    }
+    if kind.is_dir() {
+        "a folder"
+    } else {
+        "not a file"
+    }
+}
+
+/// Reads a whole regular file (see [`open_regular`]) of at most `limit` bytes: a larger one
+/// (or one that grows while it is read) is [`FileError::TooLarge`] after reading at most
+/// `limit + 1` bytes.
 pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FileError> {
     let read_err = |e: io::Error| FileError::io(path, FileAction::Read, &e);
-    let file = File::open(path).map_err(read_err)?;
+    let file = open_regular(path)?;
     let too_large = || FileError::TooLarge {
         path: path.to_path_buf(),
         limit,
@@ -367,6 +525,7 @@ impl SaveTransaction {
         let mut file = AtomicFile::beside(path.clone(), &path)?;
         write(&mut file).map_err(|e| FileError::io(&path, FileAction::Write, &e))?;
         file.finish()?;
+        // Still live (a signal removes it) until the commit renames it.
         let temp = std::mem::take(&mut file.temp);
         self.staged.push(Staged {
             temp: file_name(&temp),
@@ -389,7 +548,9 @@ impl Drop for SaveTransaction {
     fn drop(&mut self) {
         // Not committed: the staged files go, the folder's files stay as they were.
         for s in &self.staged {
-            let _ = std::fs::remove_file(self.dir.join(&s.temp));
+            let temp = self.dir.join(&s.temp);
+            let _ = std::fs::remove_file(&temp);
+            forget(&temp);
         }
     }
 }
@@ -409,6 +570,7 @@ fn finish_journal(dir: &Path, staged: &[Staged]) -> Result<(), FileError> {
             std::fs::rename(&temp, &target)
                 .map_err(|e| FileError::io(&dir.join(&s.name), FileAction::Rename, &e))?;
         }
+        forget(&temp);
     }
     sync_dir(dir);
     let journal = dir.join(JOURNAL_FILE);
@@ -529,6 +691,37 @@ mod tests {
         assert_eq!(leftovers, 0);
     }
 
+    #[cfg(unix)]
+    #[test]
+    fn link_chains_are_followed_to_the_end_and_loops_refused() {
+        use std::os::unix::fs::symlink;
+        let dir = scratch("chain");
+        std::fs::create_dir(dir.join("sub")).unwrap();
+        // out -> sub/hop -> ../final.txt (missing: written there).
+        symlink("sub/hop", dir.join("out")).unwrap();
+        symlink("../final.txt", dir.join("sub/hop")).unwrap();
+        write_atomic(&dir.join("out"), b"one").unwrap();
+        assert_eq!(std::fs::read(dir.join("final.txt")).unwrap(), b"one");
+        write_atomic(&dir.join("out"), b"two").unwrap();
+        assert_eq!(std::fs::read(dir.join("final.txt")).unwrap(), b"two");
+        assert!(
+            std::fs::symlink_metadata(dir.join("sub/hop"))
+                .unwrap()
+                .is_symlink()
+        );
+        assert_eq!(names(&dir), ["final.txt", "out", "sub"]);
+        symlink("b", dir.join("a")).unwrap();
+        symlink("a", dir.join("b")).unwrap();
+        let err = write_atomic(&dir.join("a"), b"x").unwrap_err();
+        assert!(err.to_string().contains("loop of links"), "{err}");
+        assert!(
+            std::fs::symlink_metadata(dir.join("a"))
+                .unwrap()
+                .is_symlink()
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn reads_are_limited_before_memory_is_spent() {
         let dir = scratch("limit");
@@ -542,11 +735,82 @@ mod tests {
                 limit: 999
             })
         );
-        #[cfg(unix)]
-        assert!(matches!(
-            read_limited(Path::new("/dev/zero"), 1 << 20),
-            Err(FileError::TooLarge { limit: 1048576, .. })
-        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_temporary_name_fits_wherever_its_target_name_fits() {
+        let dir = scratch("long");
+        for len in [2, 200, 214, 215, 255] {
+            let name = "n".repeat(len - 2) + "é";
+            assert_eq!(name.len(), len);
+            let path = dir.join(&name);
+            write_atomic(&path, b"bytes").unwrap_or_else(|e| panic!("{len}: {e}"));
+            assert_eq!(std::fs::read(&path).unwrap(), b"bytes");
+            assert!(temp_beside(&path).file_name().unwrap().len() <= NAME_MAX);
+        }
+        // Two long names that share their first 200 bytes get their own temporaries.
+        let (a, b) = ("x".repeat(240) + "a", "x".repeat(240) + "b");
+        assert_ne!(temp_prefix(&dir.join(a)), temp_prefix(&dir.join(b)));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn abandoned_temporaries_are_removed_by_the_next_write_and_live_ones_kept() {
+        let dir = scratch("stale");
+        let path = dir.join("points.txt");
+        // What a `kill -9` leaves: a temporary file no process holds.
+        let mut dead = temp_prefix(&path);
+        dead.push(format!("999999-0{TEMP_SUFFIX}"));
+        std::fs::write(dir.join(&dead), vec![1u8; 4096]).unwrap();
+        // Another target's temporary file stays.
+        let mut other = temp_prefix(&dir.join("other.txt"));
+        other.push(format!("999999-0{TEMP_SUFFIX}"));
+        std::fs::write(dir.join(&other), b"x").unwrap();
+        // A writer still at work on the same target: its file is locked.
+        let mut busy = AtomicFile::create(&path).unwrap();
+        busy.write_all(b"busy").unwrap();
+        write_atomic(&path, b"done").unwrap();
+        let names = names(&dir);
+        assert!(
+            !names.contains(&dead.to_string_lossy().into_owned()),
+            "{names:?}"
+        );
+        assert!(
+            names.contains(&other.to_string_lossy().into_owned()),
+            "{names:?}"
+        );
+        assert_eq!(names.len(), 3, "{names:?}");
+        busy.commit().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"busy");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn readers_refuse_fifos_devices_and_folders() {
+        let dir = scratch("fifo");
+        let fifo = dir.join("pipe");
+        assert!(
+            std::process::Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success()
+        );
+        for (path, what) in [
+            (fifo.as_path(), "a FIFO"),
+            (Path::new("/dev/zero"), "a device"),
+            (dir.as_path(), "a folder"),
+        ] {
+            assert_eq!(
+                read_limited(path, 1 << 20),
+                Err(FileError::NotAFile {
+                    path: path.to_path_buf(),
+                    what
+                })
+            );
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -28,6 +28,50 @@ pub const FIXED_ONE: f64 = 4_294_967_296.0;
 /// a complete set of 4 colours with 2048 points per tile is about 75 MB).
 pub const MAX_FILE_BYTES: u64 = 128 << 20;
 
+/// Most edge colours of a set (`K`).
+const MAX_COLORS: usize = 8;
+
+/// Most tiles of a set (`K^4`).
+const MAX_TILES: usize = MAX_COLORS.pow(4);
+
+/// Most seam polylines a tile file may give a tile (a built tile has four).
+const MAX_SEAMS: usize = 64;
+
+/// Sequences read with a most length, refused as soon as they pass it: a file of nested
+/// empty sequences (`[[],[],...]`, 3 bytes each in the file, 24 in memory) must not
+/// balloon before the set is validated.
+mod bounded {
+    use serde::de::{Deserialize, Deserializer, Error, SeqAccess, Visitor};
+    use std::marker::PhantomData;
+
+    pub fn seq<'de, D: Deserializer<'de>, T: Deserialize<'de>, const MAX: usize>(
+        d: D,
+    ) -> Result<Vec<T>, D::Error> {
+        struct Bounded<T, const MAX: usize>(PhantomData<T>);
+        impl<'de, T: Deserialize<'de>, const MAX: usize> Visitor<'de> for Bounded<T, MAX> {
+            type Value = Vec<T>;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "a sequence of at most {MAX} elements")
+            }
+
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<T>, A::Error> {
+                let mut out = Vec::new();
+                while let Some(item) = seq.next_element()? {
+                    if out.len() == MAX {
+                        return Err(A::Error::custom(format!(
+                            "a sequence of more than {MAX} elements"
+                        )));
+                    }
+                    out.push(item);
+                }
+                Ok(out)
+            }
+        }
+        d.deserialize_seq(Bounded::<T, MAX>(PhantomData))
+    }
+}
+
 /// Closest two points of one tile may be, as a fraction of the spacing of `N` points on a
 /// hexagonal lattice (`rho`): blue-noise tiles reach 0.6 to 0.8, white noise about 0.01.
 /// Closer points are a corrupt or degenerate set (coincident or crowded points).
@@ -49,8 +93,8 @@ pub struct Tile {
     /// The `n^2 N` points of the subdivision in subdivision-rank order, each `cell << 16 |
     /// child point index`. The first `N` entries are this tile's own points, in base order.
     pub subdivision: Vec<u32>,
-    /// Seam polylines of the construction (for pictures), tile coordinates.
-    #[serde(default)]
+    /// Seam polylines of the construction (for pictures), tile coordinates in `[0, 1]`.
+    #[serde(default, deserialize_with = "bounded::seq::<_, _, MAX_SEAMS>")]
     pub seams: Vec<Vec<[f32; 2]>>,
 }
 
@@ -68,10 +112,13 @@ pub struct TileSet {
     /// Seed the set was built from.
     pub seed: u64,
     /// `n`-colour sequence that replaces each horizontal edge colour on subdivision.
+    #[serde(deserialize_with = "bounded::seq::<_, _, MAX_COLORS>")]
     pub horizontal_sequences: Vec<Vec<u8>>,
     /// `n`-colour sequence that replaces each vertical edge colour on subdivision.
+    #[serde(deserialize_with = "bounded::seq::<_, _, MAX_COLORS>")]
     pub vertical_sequences: Vec<Vec<u8>>,
     /// Tiles, indexed by [`EdgeColors::complete_index`].
+    #[serde(deserialize_with = "bounded::seq::<_, _, MAX_TILES>")]
     pub tiles: Vec<Tile>,
 }
 
@@ -330,6 +377,20 @@ impl TileSet {
             .find(|&&c| c as usize >= self.tiles.len())
         {
             return Err(tile_err(t, format!("child {c} does not exist")));
+        }
+        if let Some(p) = tile
+            .seams
+            .iter()
+            .flatten()
+            .find(|p| !p.iter().all(|v| (0.0..=1.0).contains(v)))
+        {
+            return Err(tile_err(
+                t,
+                format!(
+                    "seam point ({}, {}) is outside the tile's [0, 1] square",
+                    p[0], p[1]
+                ),
+            ));
         }
         self.validate_ranking(t, tile)
     }

@@ -785,6 +785,45 @@ fn the_ordered_parallel_query_holds_few_blocks_and_stops_when_asked() {
     assert!(m > 0 && m < n / 100, "{m}");
 }
 
+/// A constant density that counts the bounds asked of it.
+struct CountingBounds(std::sync::atomic::AtomicUsize);
+
+impl rwt_core::density::Density for CountingBounds {
+    fn density(&self, _: DVec2) -> f64 {
+        0.01
+    }
+
+    fn max_over(&self, _: DVec2, _: DVec2) -> f64 {
+        self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        0.01
+    }
+}
+
+#[test]
+fn the_ordered_parallel_query_plans_only_the_blocks_it_works_on() {
+    // 4 000 x 4 000 tiles: 250 000 leaf blocks. Planning them all before writing the first
+    // (as it did) held every block in memory; a consumer that stops after three blocks now
+    // costs a few splits down to the first leaf, not the whole plan.
+    let s = sampler(4);
+    let rect = square(0.0, 4000.0);
+    let density = CountingBounds(Default::default());
+    let mut blocks = 0;
+    s.query_par_ordered(
+        rect,
+        &density,
+        |run| run.len(),
+        |_| {
+            blocks += 1;
+            std::ops::ControlFlow::Break(())
+        },
+        &|_| {},
+    )
+    .unwrap();
+    assert_eq!(blocks, 1);
+    let asked = density.0.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(asked < 5_000, "{asked} bounds asked before the first block");
+}
+
 #[test]
 fn parallel_progress_counts_every_tile_once() {
     use std::sync::Mutex;

@@ -77,7 +77,7 @@ fn blurred_stipples_keep_the_tone_of_photographs() {
     for (name, image) in [("sphere", sphere(256)), ("landscape", landscape(256))] {
         let s = stipple(&image, &set, &StippleSettings::default()).unwrap();
         let rendered = s.render(&s.dots, 2.0).unwrap();
-        let report = s.tone_report(&rendered, 1);
+        let report = s.tone_report(&rendered, 1).unwrap();
         let page = 1.0 - rendered.mean();
         eprintln!(
             "{name}: {} dots, radius {:.3}, mean grey image {:.3} stipple {page:.3}, {report:?}",
@@ -244,7 +244,7 @@ fn stripes(size: usize) -> Grey {
 fn page_and_report(image: &Grey) -> (f64, rwt_core::stipple::ToneReport) {
     let s = stipple(image, &TileSet::embedded(), &StippleSettings::default()).unwrap();
     let rendered = s.render(&s.dots, 2.0).unwrap();
-    (1.0 - rendered.mean(), s.tone_report(&rendered, 1))
+    (1.0 - rendered.mean(), s.tone_report(&rendered, 1).unwrap())
 }
 
 #[test]

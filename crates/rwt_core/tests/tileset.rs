@@ -202,6 +202,30 @@ fn seams_are_no_worse_than_interiors() {
 }
 
 #[test]
+fn seams_and_nested_sequences_are_validated_before_use() {
+    let set = TileSet::embedded();
+    // A seam point at 1e30 (or NaN) made `tileset render` draw a line without end.
+    for bad in [1e30f32, f32::NAN, -0.5] {
+        let mut far = set.clone();
+        far.tiles[2].seams[1][0] = [0.5, bad];
+        let e = TileSet::from_ron_bytes(far.to_ron().as_bytes()).unwrap_err();
+        assert!(e.to_string().contains("tile 2: seam point"), "{bad}: {e}");
+    }
+    // A file of empty sequences (3 bytes in the file, 24 in memory each) is refused at
+    // the ninth, not parsed whole: it took 881 MB for 103 MB.
+    let text = set.to_ron();
+    let empties = "[],".repeat(1_000_000);
+    let at = text.find("horizontal_sequences:[").unwrap() + "horizontal_sequences:[".len();
+    let hostile = format!("{}{empties}{}", &text[..at], &text[at..]);
+    let e = TileSet::from_ron_bytes(hostile.as_bytes()).unwrap_err();
+    assert!(e.to_string().contains("more than 8 elements"), "{e}");
+    let mut seams = set.clone();
+    seams.tiles[0].seams = vec![Vec::new(); 65];
+    let e = TileSet::from_ron_bytes(seams.to_ron().as_bytes()).unwrap_err();
+    assert!(e.to_string().contains("more than 64 elements"), "{e}");
+}
+
+#[test]
 fn loader_reports_what_is_wrong() {
     let set = TileSet::embedded();
     let text = set.to_ron();
@@ -323,7 +347,10 @@ fn tile_set_files_are_read_within_a_size_limit() {
     #[cfg(unix)]
     assert!(matches!(
         TileSet::read_file_with_limit(std::path::Path::new("/dev/zero"), 1 << 20),
-        Err(TileSetError::File(FileError::TooLarge { .. }))
+        Err(TileSetError::File(FileError::NotAFile {
+            what: "a device",
+            ..
+        }))
     ));
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,6 +1,7 @@
 //! `rwt.analyse`: the normalized minimum distance and the averaged power spectrum of a point
 //! set, over the square windows `rwt analyse` uses.
 
+use crate::interrupt::interruptible;
 use glam::DVec2;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
@@ -57,15 +58,17 @@ pub fn analyse<'py>(
         .map(|r| DVec2::new(r[0], r[1]))
         .filter(|p| p.x >= min.x && p.y >= min.y && p.x < max.x && p.y < max.y)
         .collect();
+    if inside.len() < 2 {
+        return Err(PyValueError::new_err(format!(
+            "{} points inside the window: at least 2 are needed",
+            inside.len()
+        )));
+    }
     let grid = WindowGrid::new(min, max, inside.len())
-        .filter(|_| inside.len() >= 2)
-        .ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "{} points inside the window: at least 2 are needed",
-                inside.len()
-            ))
-        })?;
-    let analysis = py.detach(|| WindowAnalysis::of(&grid.split(inside), grid.side, size));
+        .map_err(|e| PyValueError::new_err(format!("window: {e}")))?;
+    let analysis = interruptible(py, move |_| {
+        WindowAnalysis::of(&grid.split(inside), grid.side, size)
+    })?;
     let s = analysis.spectrum;
     let power = Array2::from_shape_vec((s.size, s.size), s.power).expect("size x size");
     Ok((

@@ -28,9 +28,10 @@ pub fn query_error(e: QueryError) -> PyErr {
 /// A refused stipple.
 pub fn stipple_error(e: StippleError) -> PyErr {
     match e {
-        StippleError::TooManyDots { .. } | StippleError::RasterTooLarge { .. } => {
-            BudgetError::new_err(e.to_string())
-        }
+        StippleError::TooManyDots { .. }
+        | StippleError::RasterTooLarge { .. }
+        | StippleError::ImageTooLarge { .. }
+        | StippleError::OutOfMemory { .. } => BudgetError::new_err(e.to_string()),
         StippleError::Query(q) => query_error(q),
         e => PyValueError::new_err(e.to_string()),
     }

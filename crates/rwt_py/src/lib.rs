@@ -4,6 +4,7 @@
 
 mod analyse;
 mod errors;
+mod interrupt;
 mod sample;
 mod stipple;
 mod tiles;
@@ -13,8 +14,17 @@ use pyo3::prelude::*;
 /// `rwt._rwt`: the functions `rwt`'s Python modules call.
 #[pymodule]
 fn _rwt(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // numpy's C API is imported here, with the module, not by the first call that needs it:
+    // a Ctrl-C during that import made the call panic ("Failed to access NumPy array API
+    // capsule") instead of raising KeyboardInterrupt.
+    numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add("BudgetError", m.py().get_type::<errors::BudgetError>())?;
     m.add("DEFAULT_BUDGET", rwt_core::query::DEFAULT_BUDGET)?;
+    m.add("MAX_MAP_PIXELS", sample::MAX_MAP_PIXELS)?;
+    m.add(
+        "DEFAULT_MAX_IMAGE_PIXELS",
+        rwt_core::stipple::DEFAULT_MAX_IMAGE_PIXELS,
+    )?;
     m.add_function(wrap_pyfunction!(sample::query, m)?)?;
     m.add_function(wrap_pyfunction!(stipple::stipple, m)?)?;
     m.add_function(wrap_pyfunction!(analyse::analyse, m)?)?;

@@ -1,6 +1,7 @@
 //! `rwt.sample`'s query: the points of a rectangle for a constant or a density map.
 
 use crate::errors::{image_error, query_error};
+use crate::interrupt::{Cancellable, interruptible};
 use crate::tiles;
 use glam::DVec2;
 use numpy::ndarray::Array2;
@@ -12,6 +13,7 @@ use rwt_core::clumps::{ClumpKernel, ClumpParams, Clumps};
 use rwt_core::density::{Constant, Density, ImageDensity, Placement};
 use rwt_core::query::{DEFAULT_BUDGET, Point, QueryError, Rect, Sampler};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Hash salt of the 64-bit point ids (`PointId::hash`).
 const ID_SALT: u64 = 0x1d5;
@@ -30,6 +32,11 @@ const CHUNKS_PER_AXIS: usize = 8;
 
 /// Longest side of a density map (as of an image density).
 const MAX_MAP_SIDE: usize = 32_768;
+
+/// Most values of a density map: 2^24 (4096 x 4096). A map takes about 20 bytes a value
+/// while its density is made (the float64 array `rwt.sample` passes, its unit values and
+/// the density): 340 MB at the limit. Checked on the array's shape, before it is converted.
+pub const MAX_MAP_PIXELS: usize = 1 << 24;
 
 /// A density as Python passes it: points per unit area, or a map of them (row 0 at the
 /// rectangle's top edge, largest y).
@@ -84,8 +91,8 @@ pub fn query<'py>(
             "the density scale must be non-negative and finite, got {scale}"
         )));
     }
-    let density: Box<dyn Density + Send + Sync> = match density {
-        DensityArg::Constant(c) if c.is_finite() && c >= 0.0 => Box::new(Constant(c * scale)),
+    let density: Arc<dyn Density + Send + Sync> = match density {
+        DensityArg::Constant(c) if c.is_finite() && c >= 0.0 => Arc::new(Constant(c * scale)),
         DensityArg::Constant(c) => {
             return Err(PyValueError::new_err(format!(
                 "density must be a non-negative finite number, got {c}"
@@ -93,16 +100,18 @@ pub fn query<'py>(
         }
         DensityArg::Map(values) => {
             let over = rect_of(extent.unwrap_or(corners(&rect)), "extent")?;
-            Box::new(map_density(&values, over, scale)?)
+            Arc::new(map_density(&values, over, scale)?)
         }
-        DensityArg::Clumps(params) => Box::new(clumps(params, scale)?),
+        DensityArg::Clumps(params) => Arc::new(clumps(params, scale)?),
     };
     let sampler = tiles::sampler(tileset.as_deref(), seed)?
         .with_tile_size(tile_size)
         .with_budget(budget);
-    let points = py
-        .detach(|| collect(&sampler, rect, &*density))
-        .map_err(query_error)?;
+    let inner = density.clone();
+    let points = interruptible(py, move |cancel| {
+        collect(&sampler, rect, &Cancellable { cancel, inner })
+    })?
+    .map_err(query_error)?;
     Ok(arrays(py, &points, &*density, seed))
 }
 
@@ -205,6 +214,11 @@ fn map_density(
     if h == 0 || w == 0 || h > MAX_MAP_SIDE || w > MAX_MAP_SIDE {
         return Err(PyValueError::new_err(format!(
             "density array: shape ({h}, {w}) must be between 1 and {MAX_MAP_SIDE} on each side"
+        )));
+    }
+    if h * w > MAX_MAP_PIXELS {
+        return Err(PyValueError::new_err(format!(
+            "density array: shape ({h}, {w}) has more than {MAX_MAP_PIXELS} values"
         )));
     }
     if let Some(((row, col), v)) = values

@@ -2,6 +2,7 @@
 //! defaults (every setting left as `None` is `StippleSettings::default()`'s).
 
 use crate::errors::stipple_error;
+use crate::interrupt::interruptible;
 use crate::tiles;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
@@ -24,7 +25,7 @@ type Stippled<'py> = (
 #[pyfunction]
 #[pyo3(signature = (image, *, dots = None, radius = None, gamma = None, contrast = None,
     seed = None, scale = None, render = false, max_dots = None, max_raster_pixels = None,
-    tileset = None))]
+    max_image_pixels = None, tileset = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn stipple<'py>(
     py: Python<'py>,
@@ -38,6 +39,7 @@ pub fn stipple<'py>(
     render: bool,
     max_dots: Option<usize>,
     max_raster_pixels: Option<u64>,
+    max_image_pixels: Option<u64>,
     tileset: Option<PathBuf>,
 ) -> PyResult<Stippled<'py>> {
     let dots = match (dots, radius) {
@@ -60,6 +62,7 @@ pub fn stipple<'py>(
         limits: StippleLimits {
             max_dots: max_dots.unwrap_or(d.limits.max_dots),
             max_raster_pixels: max_raster_pixels.unwrap_or(d.limits.max_raster_pixels),
+            max_image_pixels: max_image_pixels.unwrap_or(d.limits.max_image_pixels),
         },
     };
     let view = image.as_array();
@@ -75,19 +78,18 @@ pub fn stipple<'py>(
         Some(path) => Stippler::new(&tiles::load(path)?),
         None => Stippler::new(tiles::embedded()),
     };
-    let (s, ink, tone) = py
-        .detach(|| {
-            let s = stippler.stipple(&grey, &settings)?;
-            if !render {
-                return Ok((s, None, None));
-            }
-            let ink = s.render(&s.dots, settings.scale)?;
-            // The white-noise stipple is seeded as `rwt stipple` seeds it.
-            let report = s.tone_report(&ink, settings.seed);
-            let tone = (report.blue.mean_abs, report.white.mean_abs);
-            Ok((s, Some(ink), Some(tone)))
-        })
-        .map_err(stipple_error)?;
+    let (s, ink, tone) = interruptible(py, move |_| {
+        let s = stippler.stipple(&grey, &settings)?;
+        if !render {
+            return Ok((s, None, None));
+        }
+        let ink = s.render(&s.dots, settings.scale)?;
+        // The white-noise stipple is seeded as `rwt stipple` seeds it.
+        let report = s.tone_report(&ink, settings.seed)?;
+        let tone = (report.blue.mean_abs, report.white.mean_abs);
+        Ok((s, Some(ink), Some(tone)))
+    })?
+    .map_err(stipple_error)?;
     let xy: Vec<f64> = s.dots.iter().flat_map(|d| [d.x, d.y]).collect();
     let xy = Array2::from_shape_vec((s.dots.len(), 2), xy).expect("two coordinates per dot");
     let raster = ink.map(|g| {

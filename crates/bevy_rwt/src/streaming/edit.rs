@@ -59,7 +59,8 @@ fn index_edits(state: &mut LayerState, layer: &ScatterLayer, sampler: &Sampler, 
         // An identity the tiling lacks names no point: it can never apply.
         if let Some(p) = sampler.locate(id) {
             let chunk = ChunkCoord::containing(p, size);
-            by_chunk.entry(chunk).or_default().set(*id, *edit);
+            // A share of a set that took these edits: it takes them too.
+            let _ = by_chunk.entry(chunk).or_default().set(*id, *edit);
         }
     }
     let old = std::mem::take(&mut state.chunk_edits);
@@ -95,12 +96,13 @@ fn apply_edit(
         }
         _ => None,
     };
-    edits.apply(id, message.edit);
+    edits.apply(id, message.edit)?;
     let chunk = ChunkCoord::containing(position, layer.streaming.chunk_size);
+    // A chunk holds a share of the layer's edits: what the layer's set took, it takes.
     message.edit.apply_to(
         Arc::make_mut(state.chunk_edits.entry(chunk).or_default()),
         id,
-    );
+    )?;
     let entity_class =
         class.filter(|c| !matches!(layer.classes[*c as usize].look, ClassLook::Instanced(_)));
     let generator = state.generator(layer);

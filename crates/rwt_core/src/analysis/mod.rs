@@ -11,4 +11,4 @@ mod windows;
 pub use crate::geometry::hex_spacing;
 pub use spectrum::Spectrum;
 pub use statistics::{min_distance, nearest_neighbour_distances, rho};
-pub use windows::{MAX_WINDOW_POINTS, WindowAnalysis, WindowGrid};
+pub use windows::{MAX_WINDOW_POINTS, WindowAnalysis, WindowError, WindowGrid};

@@ -25,23 +25,57 @@ pub struct WindowGrid {
     pub density: f64,
 }
 
+/// Why points cannot be laid in windows.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum WindowError {
+    /// Fewer points than an analysis needs.
+    #[error("{count} points, need at least {needed}")]
+    TooFew {
+        /// Points given.
+        count: usize,
+        /// Points needed.
+        needed: usize,
+    },
+    /// The rectangle has no area, or one whose density or windows `f64` cannot hold (the
+    /// figures would be NaN or infinite).
+    #[error(
+        "points span {width:e} x {height:e}: no area an analysis can measure (every point \
+         on a line or one spot, or spread past what f64 densities hold)"
+    )]
+    Extent {
+        /// Width of the rectangle.
+        width: f64,
+        /// Height of the rectangle.
+        height: f64,
+    },
+}
+
 impl WindowGrid {
-    /// The windows for `count` points over `min..max`; `None` when the rectangle has no area
-    /// or no points.
-    pub fn new(min: DVec2, max: DVec2, count: usize) -> Option<Self> {
+    /// The windows for `count` points over `min..max`: an error when the rectangle has no
+    /// area or no points, or when its density, cell or window side is not a normal number.
+    pub fn new(min: DVec2, max: DVec2, count: usize) -> Result<Self, WindowError> {
+        if count == 0 {
+            return Err(WindowError::TooFew { count, needed: 1 });
+        }
         let extent = max - min;
         let square = extent.min_element();
-        if !(square.is_finite() && square > 0.0) || count == 0 {
-            return None;
-        }
         let per_axis = ((count as f64 / 500.0).sqrt().floor() as usize).clamp(1, 4);
         let cell = square / per_axis as f64;
         let density = count as f64 / (extent.x * extent.y);
-        Some(Self {
+        let side = cell.min((MAX_WINDOW_POINTS / density).sqrt());
+        // A window's coordinates relative to its origin must resolve its points, too.
+        let resolvable = side > 1e-9 * min.abs().max(max.abs()).max_element();
+        if !(square > 0.0 && [cell, density, side].iter().all(|v| v.is_normal()) && resolvable) {
+            return Err(WindowError::Extent {
+                width: extent.x,
+                height: extent.y,
+            });
+        }
+        Ok(Self {
             origin: min,
             per_axis,
             cell,
-            side: cell.min((MAX_WINDOW_POINTS / density).sqrt()),
+            side,
             density,
         })
     }
@@ -135,6 +169,20 @@ mod tests {
         assert_eq!(used, vec![0, 5, 10, 15]);
         assert_eq!(grid.window_of(DVec2::new(-0.1, 1.0)), None);
         assert_eq!(grid.window_of(DVec2::new(10.0, 1.0)), None);
-        assert!(WindowGrid::new(DVec2::ZERO, DVec2::new(0.0, 1.0), 10).is_none());
+        assert!(WindowGrid::new(DVec2::ZERO, DVec2::new(0.0, 1.0), 10).is_err());
+        // Extents whose density or window f64 cannot hold (NaN, inf and -1756 dB before).
+        for (lo, hi) in [
+            (DVec2::ZERO, DVec2::splat(1e-300)),
+            (DVec2::splat(-1e300), DVec2::splat(1e300)),
+            (DVec2::splat(1e15), DVec2::splat(1e15 + 1e-3)),
+        ] {
+            assert!(
+                matches!(
+                    WindowGrid::new(lo, hi, 100),
+                    Err(WindowError::Extent { .. })
+                ),
+                "{lo} {hi}"
+            );
+        }
     }
 }

@@ -64,7 +64,12 @@ fn merge_tile(config: &BuildConfig, t: usize, e: EdgeColors, sources: &[Vec<DVec
         let incoming = tagged(sources, src, Origin::Edge(side));
         let (m, seam) = merge(&pts, &incoming, side, config.edge_band);
         pts = m;
-        seams.push(seam.iter().map(|p| [p.x as f32, p.y as f32]).collect());
+        // Tile coordinates, as a loaded set is checked to have them.
+        seams.push(
+            seam.iter()
+                .map(|p| [p.x.clamp(0.0, 1.0) as f32, p.y.clamp(0.0, 1.0) as f32])
+                .collect(),
+        );
     }
     let mut rng = Rng::new(config.seed, 0x1e_0000 + t as u64);
     let mut keyed: Vec<(u32, u64, SourcedPoint)> = pts

@@ -7,10 +7,21 @@ use std::io::{BufRead, Seek};
 use std::path::Path;
 
 /// Most pixels an image may have to be decoded by [`decode_image`] and [`open_image`]:
-/// 2^26 (8192 x 8192). Checked from the image's header, before its pixels are decoded; a
-/// density of that many pixels takes about 1 GB. Pass a larger limit to
-/// [`decode_image_with_limit`] or [`open_image_with_limit`] to read larger images.
+/// 2^26 (8192 x 8192), and at most 4 bytes a pixel decoded (256 MiB: a 16-bit RGBA image is
+/// admitted to half as many pixels). Checked from the image's header, before its pixels
+/// are decoded. Pass a larger limit to [`decode_image_with_limit`] or
+/// [`open_image_with_limit`] to read larger images.
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
+
+/// Bytes an [`ImageDensity`] takes a pixel: its values (4) and its max and min mipmaps
+/// (2 bytes a texel, a third of the pixels each).
+pub const DENSITY_BYTES_PER_PIXEL: f64 = 4.0 + 4.0 / 3.0;
+
+/// Most memory [`ImageDensity::open`] and [`ImageDensity::from_bytes`] take while making a
+/// density: the decoded image and the density, 448 MiB. An 8192 x 8192 grey PNG (64 MiB
+/// decoded, 341 MiB of density) is admitted, an 8-bit RGBA one up to 6 900 x 6 900 pixels;
+/// measured peaks stay under 500 MB.
+pub const MAX_DENSITY_BYTES: u64 = 448 << 20;
 
 /// A painted density map: one channel of an image, bilinearly interpolated over a world
 /// rectangle, times `scale` (points per unit area at value 1). Zero outside the rectangle.
@@ -27,13 +38,15 @@ pub struct ImageDensity {
     height: usize,
     /// Texels per world unit on each axis.
     texels_per_unit: DVec2,
-    /// The image with one extra column and row repeating the last ones, so that bilinear
-    /// interpolation never needs to clamp its second texel (row stride `width + 1`).
+    /// The image (values in [0, 1]) with one extra column and row repeating the last ones,
+    /// so that bilinear interpolation never needs to clamp its second texel (row stride
+    /// `width + 1`). Level 0 of the mipmaps.
     padded: Vec<f32>,
-    /// Level 0 is the image (values in [0, 1]); level `l` holds 2x2 maxima of level `l - 1`.
-    levels: Vec<(usize, usize, Vec<f32>)>,
-    /// The same with 2x2 minima (level 0 is not repeated: `min_levels[l - 1]` is level `l`).
-    min_levels: Vec<Vec<f32>>,
+    /// Levels 1.. of the max mipmap: `(width, height, texels)`, each the 2x2 maxima of the
+    /// level below, in 1/65535 steps rounded up.
+    levels: Vec<(usize, usize, Vec<u16>)>,
+    /// The same with 2x2 minima rounded down (`min_levels[l - 1]` is level `l`).
+    min_levels: Vec<Vec<u16>>,
 }
 
 /// Why an image density could not be made.
@@ -64,6 +77,26 @@ pub enum ImageDensityError {
     /// The image file could not be read.
     #[error("cannot read image: {0}")]
     Read(String),
+    /// Decoding the image (and making its density) would take more memory than the limit.
+    #[error(
+        "a {width}x{height} {color:?} image would take {:.0} MB decoded{}, over the limit of \
+         {:.0} MB (8-bit grey images are admitted up to 8192x8192 pixels)",
+        *bytes as f64 / 1e6,
+        if *limit == MAX_DENSITY_BYTES { " and as a density" } else { "" },
+        *limit as f64 / 1e6
+    )]
+    TooMuchMemory {
+        /// Width in the header.
+        width: u32,
+        /// Height in the header.
+        height: u32,
+        /// Its pixel format.
+        color: image::ColorType,
+        /// Bytes it would take.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
+    },
 }
 
 /// Decodes image bytes (any format this build of `image` reads) of at most
@@ -98,8 +131,10 @@ pub fn open_image_with_limit(
     max_pixels: u64,
 ) -> Result<image::DynamicImage, ImageDensityError> {
     let reader = || {
-        image::ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
+        let file =
+            crate::files::open_regular(path).map_err(|e| ImageDensityError::Read(e.to_string()))?;
+        image::ImageReader::new(std::io::BufReader::new(file))
+            .with_guessed_format()
             .map_err(|e| ImageDensityError::Read(e.to_string()))
     };
     decode_limited(reader, max_pixels)
@@ -111,19 +146,71 @@ fn decode_limited<R: BufRead + Seek>(
     reader: impl Fn() -> Result<image::ImageReader<R>, ImageDensityError>,
     max_pixels: u64,
 ) -> Result<image::DynamicImage, ImageDensityError> {
-    let decode_err = |e: image::ImageError| ImageDensityError::Decode(e.to_string());
-    let (width, height) = reader()?.into_dimensions().map_err(decode_err)?;
-    if width as u64 * height as u64 > max_pixels {
-        return Err(ImageDensityError::TooManyPixels {
+    decode_admitted(reader, |header| {
+        let Header {
             width,
             height,
-            limit: max_pixels,
-        });
+            color,
+        } = header;
+        let pixels = width as u64 * height as u64;
+        if pixels > max_pixels {
+            return Err(ImageDensityError::TooManyPixels {
+                width,
+                height,
+                limit: max_pixels,
+            });
+        }
+        let decoded = pixels * color.bytes_per_pixel() as u64;
+        let limit = max_pixels.saturating_mul(4);
+        if decoded > limit {
+            return Err(ImageDensityError::TooMuchMemory {
+                width,
+                height,
+                color,
+                bytes: decoded,
+                limit,
+            });
+        }
+        Ok(())
+    })
+}
+
+/// What an image's header says.
+#[derive(Clone, Copy, Debug)]
+struct Header {
+    width: u32,
+    height: u32,
+    color: image::ColorType,
+}
+
+impl Header {
+    /// Bytes of the decoded pixels.
+    fn decoded_bytes(&self) -> u64 {
+        self.width as u64 * self.height as u64 * self.color.bytes_per_pixel() as u64
     }
+}
+
+/// Reads the header through one reader and asks `admit`; decodes through another (within
+/// an allocation limit of what the header announced) when it agrees.
+fn decode_admitted<R: BufRead + Seek>(
+    reader: impl Fn() -> Result<image::ImageReader<R>, ImageDensityError>,
+    admit: impl FnOnce(Header) -> Result<(), ImageDensityError>,
+) -> Result<image::DynamicImage, ImageDensityError> {
+    use image::ImageDecoder;
+    let decode_err = |e: image::ImageError| ImageDensityError::Decode(e.to_string());
+    let decoder = reader()?.into_decoder().map_err(decode_err)?;
+    let (width, height) = decoder.dimensions();
+    let header = Header {
+        width,
+        height,
+        color: decoder.color_type(),
+    };
+    drop(decoder);
+    admit(header)?;
     let mut r = reader()?;
     let mut limits = image::Limits::default();
-    // Room for the largest pixel format (16-bit RGBA) of an image within the limit.
-    limits.max_alloc = Some((width as u64 * height as u64 * 8).max(512 << 20));
+    // The decoded pixels and a decoder's working rows.
+    limits.max_alloc = Some(header.decoded_bytes() + (64 << 20));
     r.limits(limits);
     r.decode().map_err(decode_err)
 }
@@ -149,91 +236,110 @@ impl ImageDensity {
         values: &[f32],
         at: Placement,
     ) -> Result<Self, ImageDensityError> {
-        let Placement {
-            min: origin,
-            size,
-            scale,
-        } = at;
-        if width == 0
-            || height == 0
-            || width > 32_768
-            || height > 32_768
-            || values.len() != (width * height) as usize
-        {
+        if values.len() != width as usize * height as usize {
             return Err(ImageDensityError::Size(width, height));
         }
-        if !(origin.is_finite()
-            && size.is_finite()
-            && size.x > 0.0
-            && size.y > 0.0
-            && scale.is_finite())
-        {
-            return Err(ImageDensityError::Rect);
-        }
-        let clean: Vec<f32> = values
-            .iter()
-            .map(|&v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) })
-            .collect();
-        let (w, h) = (width as usize, height as usize);
-        let padded = padded(&clean, w, h);
-        let (levels, min_levels) = mipmaps(clean, w, h);
-        Ok(Self {
-            origin,
-            size,
-            scale: scale.max(0.0),
-            width: w,
-            height: h,
-            texels_per_unit: DVec2::new(w as f64, h as f64) / size,
-            padded,
-            levels,
-            min_levels,
-        })
+        let w = width as usize;
+        let padded = padded_from_strips(width, height, at, |y0, y1, out| {
+            out.extend_from_slice(&values[y0 as usize * w..y1 as usize * w]);
+        })?;
+        Ok(Self::from_padded(width, height, padded, at))
     }
 
     /// From an image: `channel` 0..=3 of its RGBA form, or its luma times its alpha when
     /// `None` (a transparent pixel has no density, as painters expect). With `invert`, dark
-    /// pixels are dense (for stippling): `(1 - luma)` times alpha.
+    /// pixels are dense (for stippling): `(1 - luma)` times alpha. Converted a strip of rows
+    /// at a time: it takes the image and [`DENSITY_BYTES_PER_PIXEL`].
     pub fn from_image(
         image: &image::DynamicImage,
         channel: Option<usize>,
         invert: bool,
         at: Placement,
     ) -> Result<Self, ImageDensityError> {
-        let (w, h) = (image.width(), image.height());
-        if w == 0 || h == 0 || w > 32_768 || h > 32_768 {
-            return Err(ImageDensityError::Size(w, h));
-        }
-        let tone = |v: f32| if invert { 1.0 - v } else { v };
-        let values: Vec<f32> = match channel {
-            None if image.color().has_alpha() => image
-                .to_luma_alpha32f()
-                .pixels()
-                .map(|p| tone(p.0[0]) * p.0[1])
-                .collect(),
-            None => image
-                .to_luma32f()
-                .into_raw()
-                .into_iter()
-                .map(tone)
-                .collect(),
-            Some(c) => image
-                .to_rgba32f()
-                .pixels()
-                .map(|p| tone(p.0[c.min(3)]))
-                .collect(),
-        };
-        Self::from_values(w, h, &values, at)
+        let padded = padded_from_image(image, channel, invert, at)?;
+        Ok(Self::from_padded(image.width(), image.height(), padded, at))
     }
 
-    /// Decodes image bytes (any format this build of `image` supports, at most
-    /// [`MAX_IMAGE_PIXELS`] pixels) into a density (see [`ImageDensity::from_image`]).
+    /// Decodes image bytes (any format this build of `image` supports) into a density (see
+    /// [`ImageDensity::from_image`]), within [`MAX_DENSITY_BYTES`].
     pub fn from_bytes(
         bytes: &[u8],
         invert: bool,
         at: Placement,
     ) -> Result<Self, ImageDensityError> {
-        let img = decode_image(bytes)?;
-        Self::from_image(&img, None, invert, at)
+        let reader = || {
+            image::ImageReader::new(std::io::Cursor::new(bytes))
+                .with_guessed_format()
+                .map_err(|e| ImageDensityError::Decode(e.to_string()))
+        };
+        Self::decode_within(reader, invert, at)
+    }
+
+    /// Opens an image file (see [`ImageDensity::from_image`]): refused from its header when
+    /// decoding it and making its density would take more than [`MAX_DENSITY_BYTES`]; the
+    /// decoded image is dropped before the mipmaps are made.
+    pub fn open(path: &Path, invert: bool, at: Placement) -> Result<Self, ImageDensityError> {
+        let reader = || {
+            let file = crate::files::open_regular(path)
+                .map_err(|e| ImageDensityError::Read(e.to_string()))?;
+            image::ImageReader::new(std::io::BufReader::new(file))
+                .with_guessed_format()
+                .map_err(|e| ImageDensityError::Read(e.to_string()))
+        };
+        Self::decode_within(reader, invert, at)
+    }
+
+    fn decode_within<R: BufRead + Seek>(
+        reader: impl Fn() -> Result<image::ImageReader<R>, ImageDensityError>,
+        invert: bool,
+        at: Placement,
+    ) -> Result<Self, ImageDensityError> {
+        let image = decode_admitted(reader, |header| {
+            let Header {
+                width,
+                height,
+                color,
+            } = header;
+            if width == 0 || height == 0 || width > 32_768 || height > 32_768 {
+                return Err(ImageDensityError::Size(width, height));
+            }
+            let pixels = width as f64 * height as f64;
+            // The values live with the decoded image, then with the mipmaps.
+            let mipmaps = (DENSITY_BYTES_PER_PIXEL - 4.0) * pixels;
+            let bytes = (4.0 * pixels + mipmaps.max(header.decoded_bytes() as f64)) as u64;
+            if bytes > MAX_DENSITY_BYTES {
+                return Err(ImageDensityError::TooMuchMemory {
+                    width,
+                    height,
+                    color,
+                    bytes,
+                    limit: MAX_DENSITY_BYTES,
+                });
+            }
+            Ok(())
+        })?;
+        let (width, height) = (image.width(), image.height());
+        let padded = padded_from_image(&image, None, invert, at)?;
+        drop(image);
+        Ok(Self::from_padded(width, height, padded, at))
+    }
+
+    /// The density of checked padded values.
+    fn from_padded(width: u32, height: u32, padded: Vec<f32>, at: Placement) -> Self {
+        let (w, h) = (width as usize, height as usize);
+        let (levels, min_levels) = mipmaps(&padded, w, h);
+        let size = at.size;
+        Self {
+            origin: at.min,
+            size,
+            scale: at.scale.max(0.0),
+            width: w,
+            height: h,
+            texels_per_unit: DVec2::new(w as f64, h as f64) / size,
+            padded,
+            levels,
+            min_levels,
+        }
     }
 
     /// Image width and height in pixels.
@@ -275,39 +381,99 @@ impl ImageDensity {
     }
 }
 
-/// The image with one extra column and row repeating the last ones (row stride `w + 1`).
-fn padded(img: &[f32], w: usize, h: usize) -> Vec<f32> {
-    let mut padded = Vec::with_capacity((w + 1) * (h + 1));
-    for y in 0..=h {
-        let row = &img[y.min(h - 1) * w..][..w];
-        padded.extend_from_slice(row);
-        padded.push(row[w - 1]);
+/// Rows converted at a time from an image.
+const STRIP_ROWS: u32 = 64;
+
+/// Checks a size and a placement, then gathers values a strip of rows at a time (`strip`
+/// appends rows `y0..y1`) into the padded image: clamped to `[0, 1]` (NaN is 0), with one
+/// extra column and row repeating the last ones (row stride `w + 1`).
+fn padded_from_strips(
+    width: u32,
+    height: u32,
+    at: Placement,
+    mut strip: impl FnMut(u32, u32, &mut Vec<f32>),
+) -> Result<Vec<f32>, ImageDensityError> {
+    if width == 0 || height == 0 || width > 32_768 || height > 32_768 {
+        return Err(ImageDensityError::Size(width, height));
     }
-    padded
+    let Placement { min, size, scale } = at;
+    if !(min.is_finite() && size.is_finite() && size.x > 0.0 && size.y > 0.0 && scale.is_finite()) {
+        return Err(ImageDensityError::Rect);
+    }
+    let (w, h) = (width as usize, height as usize);
+    let clean = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+    let mut padded = Vec::with_capacity((w + 1) * (h + 1));
+    let mut rows = Vec::with_capacity(w * STRIP_ROWS as usize);
+    for y0 in (0..height).step_by(STRIP_ROWS as usize) {
+        let y1 = (y0 + STRIP_ROWS).min(height);
+        rows.clear();
+        strip(y0, y1, &mut rows);
+        for row in rows.chunks_exact(w) {
+            padded.extend(row.iter().map(|&v| clean(v)));
+            padded.push(clean(row[w - 1]));
+        }
+    }
+    padded.extend_from_within((h - 1) * (w + 1)..h * (w + 1));
+    Ok(padded)
 }
 
-/// Max and min mipmaps of an image down to one texel: `levels[0]` is the image, level `l`
-/// holds the 2x2 maxima of level `l - 1`; `min_levels[l - 1]` the minima of level `l`.
-type Mipmaps = (Vec<(usize, usize, Vec<f32>)>, Vec<Vec<f32>>);
+/// An image's values (see [`ImageDensity::from_image`]), padded.
+fn padded_from_image(
+    image: &image::DynamicImage,
+    channel: Option<usize>,
+    invert: bool,
+    at: Placement,
+) -> Result<Vec<f32>, ImageDensityError> {
+    let (w, h) = (image.width(), image.height());
+    let tone = |v: f32| if invert { 1.0 - v } else { v };
+    padded_from_strips(w, h, at, |y0, y1, out| {
+        let strip = image.crop_imm(0, y0, w, y1 - y0);
+        match channel {
+            None if strip.color().has_alpha() => out.extend(
+                strip
+                    .to_luma_alpha32f()
+                    .pixels()
+                    .map(|p| tone(p.0[0]) * p.0[1]),
+            ),
+            None => out.extend(strip.to_luma32f().into_raw().into_iter().map(tone)),
+            Some(c) => out.extend(strip.to_rgba32f().pixels().map(|p| tone(p.0[c.min(3)]))),
+        }
+    })
+}
 
-fn mipmaps(img: Vec<f32>, w: usize, h: usize) -> Mipmaps {
-    let mut levels = vec![(w, h, img)];
-    let mut min_levels: Vec<Vec<f32>> = Vec::new();
-    while levels.last().is_some_and(|l| l.0 > 1 || l.1 > 1) {
-        let (pw, ph, prev) = levels.last().expect("non-empty");
-        let prev_min = min_levels.last().unwrap_or(prev);
+/// Max and min mipmaps above level 0 (the padded image, row stride `w + 1`) down to one
+/// texel, in 1/65535 steps: maxima rounded up and minima down, so that they stay bounds.
+type Mipmaps = (Vec<(usize, usize, Vec<u16>)>, Vec<Vec<u16>>);
+
+fn mipmaps(padded: &[f32], w: usize, h: usize) -> Mipmaps {
+    let up = |v: f32| (v as f64 * 65535.0).ceil() as u16;
+    let down = |v: f32| (v as f64 * 65535.0).floor() as u16;
+    let mut levels: Vec<(usize, usize, Vec<u16>)> = Vec::new();
+    let mut min_levels: Vec<Vec<u16>> = Vec::new();
+    let (mut pw, mut ph) = (w, h);
+    while pw > 1 || ph > 1 {
         let (nw, nh) = (pw.div_ceil(2), ph.div_ceil(2));
-        let mut next = vec![0.0f32; nw * nh];
-        let mut next_min = vec![1.0f32; nw * nh];
-        for y in 0..*ph {
-            for x in 0..*pw {
+        let mut next = vec![0u16; nw * nh];
+        let mut next_min = vec![u16::MAX; nw * nh];
+        for y in 0..ph {
+            for x in 0..pw {
                 let at = (y / 2) * nw + x / 2;
-                next[at] = next[at].max(prev[y * pw + x]);
-                next_min[at] = next_min[at].min(prev_min[y * pw + x]);
+                let (hi, lo) = match (levels.last(), min_levels.last()) {
+                    (Some((_, _, prev)), Some(prev_min)) => {
+                        (prev[y * pw + x], prev_min[y * pw + x])
+                    }
+                    _ => {
+                        let v = padded[y * (w + 1) + x];
+                        (up(v), down(v))
+                    }
+                };
+                next[at] = next[at].max(hi);
+                next_min[at] = next_min[at].min(lo);
             }
         }
         levels.push((nw, nh, next));
         min_levels.push(next_min);
+        (pw, ph) = (nw, nh);
     }
     (levels, min_levels)
 }
@@ -322,8 +488,14 @@ impl Density for ImageDensity {
         let Some((level, x, y)) = self.texel_range(min, max) else {
             return 0.0;
         };
-        let (lw, _, texels) = &self.levels[level];
-        fold_texels(texels, *lw, x, y, 0.0, f32::max) as f64 * self.scale
+        let most = match level {
+            0 => fold_texels(&self.padded, self.width + 1, x, y, 0.0, f32::max) as f64,
+            l => {
+                let (lw, _, texels) = &self.levels[l - 1];
+                fold_texels(texels, *lw, x, y, 0, u16::max) as f64 / 65535.0
+            }
+        };
+        most * self.scale
     }
 
     fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
@@ -339,32 +511,32 @@ impl Density for ImageDensity {
         let Some((level, x, y)) = self.texel_range(min, max) else {
             return 0.0;
         };
-        let (lw, _, _) = &self.levels[level];
-        let texels = if level == 0 {
-            &self.levels[0].2
-        } else {
-            &self.min_levels[level - 1]
+        let least = match level {
+            0 => fold_texels(&self.padded, self.width + 1, x, y, 1.0, f32::min) as f64,
+            l => {
+                let lw = self.levels[l - 1].0;
+                fold_texels(&self.min_levels[l - 1], lw, x, y, u16::MAX, u16::min) as f64 / 65535.0
+            }
         };
-        let least = fold_texels(texels, *lw, x, y, 1.0, f32::min);
         // Bilinear blending in f32 rounds by a few units in the last place of 1.0 (texels
         // are at most 1), so it can land a hair below its smallest texel.
-        (least as f64 - 1e-6).max(0.0) * self.scale
+        (least - 1e-6).max(0.0) * self.scale
     }
 }
 
-/// Folds the texels `columns x rows` of a `width`-wide level.
-fn fold_texels(
-    texels: &[f32],
-    width: usize,
+/// Folds the texels `columns x rows` of a level of row stride `stride`.
+fn fold_texels<T: Copy>(
+    texels: &[T],
+    stride: usize,
     columns: std::ops::RangeInclusive<usize>,
     rows: std::ops::RangeInclusive<usize>,
-    init: f32,
-    f: fn(f32, f32) -> f32,
-) -> f32 {
+    init: T,
+    f: fn(T, T) -> T,
+) -> T {
     let mut acc = init;
     for y in rows {
         for x in columns.clone() {
-            acc = f(acc, texels[y * width + x]);
+            acc = f(acc, texels[y * stride + x]);
         }
     }
     acc
@@ -394,7 +566,7 @@ impl ImageDensity {
         let y1 = ((b.y + 1.0).ceil() as usize).min(self.height - 1);
         let span = (x1 - x0).max(y1 - y0) + 1;
         let mut level = 0;
-        while level + 1 < self.levels.len() && (span >> (level + 1)) >= 2 {
+        while level < self.levels.len() && (span >> (level + 1)) >= 2 {
             level += 1;
         }
         Some((

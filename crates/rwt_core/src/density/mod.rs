@@ -18,8 +18,8 @@ mod tests;
 
 pub use self::combinators::{DistanceFalloff, Exclude, Mask, Product, Scale, Sum, SumOf};
 pub use self::image::{
-    ImageDensity, ImageDensityError, MAX_IMAGE_PIXELS, Placement, decode_image,
-    decode_image_with_limit, open_image, open_image_with_limit,
+    DENSITY_BYTES_PER_PIXEL, ImageDensity, ImageDensityError, MAX_DENSITY_BYTES, MAX_IMAGE_PIXELS,
+    Placement, decode_image, decode_image_with_limit, open_image, open_image_with_limit,
 };
 pub use self::local::LocalModel;
 pub use self::noise::{NoiseDensity, NoiseParams};

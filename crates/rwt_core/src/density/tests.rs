@@ -258,11 +258,16 @@ fn crc32(bytes: &[u8]) -> u32 {
 /// A PNG's signature, header chunk and an empty data chunk, announcing `width x height` grey pixels: enough for a
 /// reader of headers.
 fn png_header(width: u32, height: u32) -> Vec<u8> {
+    png_header_of(width, height, 8, 0)
+}
+
+/// [`png_header`] of another bit depth and PNG colour type (0 grey, 2 RGB, 6 RGBA).
+fn png_header_of(width: u32, height: u32, depth: u8, colour: u8) -> Vec<u8> {
     let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
     let mut ihdr = b"IHDR".to_vec();
     ihdr.extend(width.to_be_bytes());
     ihdr.extend(height.to_be_bytes());
-    ihdr.extend([8, 0, 0, 0, 0]);
+    ihdr.extend([depth, colour, 0, 0, 0]);
     png.extend(13u32.to_be_bytes());
     png.extend(&ihdr);
     png.extend(crc32(&ihdr).to_be_bytes());
@@ -276,16 +281,7 @@ fn png_header(width: u32, height: u32) -> Vec<u8> {
 #[test]
 fn images_over_the_pixel_limit_are_refused_from_their_header() {
     let huge = png_header(20_000, 20_000);
-    let e = ImageDensity::from_bytes(
-        &huge,
-        false,
-        Placement {
-            min: DVec2::ZERO,
-            size: DVec2::ONE,
-            scale: 1.0,
-        },
-    )
-    .unwrap_err();
+    let e = decode_image(&huge).unwrap_err();
     assert_eq!(
         e,
         ImageDensityError::TooManyPixels {
@@ -295,6 +291,33 @@ fn images_over_the_pixel_limit_are_refused_from_their_header() {
         }
     );
     assert!(e.to_string().contains("decode_image_with_limit"), "{e}");
+    // As a density, what it would take is admitted: the decoded image and the density. A
+    // 65 KB 8192 x 8192 PNG took 1 GB (16-bit RGBA, 1.5 GB) within the pixel limit.
+    let at = Placement {
+        min: DVec2::ZERO,
+        size: DVec2::ONE,
+        scale: 1.0,
+    };
+    for (depth, colour, admitted) in [(8, 0, true), (8, 2, true), (8, 6, false), (16, 6, false)] {
+        let e = ImageDensity::from_bytes(&png_header_of(8192, 8192, depth, colour), false, at)
+            .unwrap_err();
+        match e {
+            ImageDensityError::TooMuchMemory { bytes, limit, .. } => {
+                assert!(
+                    !admitted && bytes > limit && limit == MAX_DENSITY_BYTES,
+                    "{e}"
+                )
+            }
+            // Admitted: decoding is tried, and these headers have no pixels.
+            ImageDensityError::Decode(_) => assert!(admitted, "{depth} {colour}: {e}"),
+            e => panic!("{e:?}"),
+        }
+    }
+    // 16-bit RGBA decodes to 8 bytes a pixel: half the pixel limit.
+    assert!(matches!(
+        decode_image(&png_header_of(8192, 8192, 16, 6)),
+        Err(ImageDensityError::TooMuchMemory { .. })
+    ));
     // Within a raised limit the header passes and decoding is tried (this one has no
     // pixel data, so it fails there).
     assert!(matches!(

@@ -32,8 +32,8 @@ fn sample_edits(points: &[Point]) -> EditSet {
     let mut edits = EditSet::default();
     for (i, p) in points.iter().enumerate() {
         match i % 6 {
-            0 | 2 | 4 => edits.set(p.id, Edit::Remove),
-            3 => edits.set(p.id, Edit::Reclass((i % 300) as u16)),
+            0 | 2 | 4 => edits.set(p.id, Edit::Remove).unwrap(),
+            3 => edits.set(p.id, Edit::Reclass((i % 300) as u16)).unwrap(),
             _ => None,
         };
     }
@@ -60,7 +60,7 @@ fn a_set_round_trips_bit_for_bit() {
         (MAX_LEVEL as u8, -1, 1, 7),
     ] {
         let id = PointId { level, x, y, index };
-        extreme.set(id, Edit::Reclass(u16::MAX));
+        extreme.set(id, Edit::Reclass(u16::MAX)).unwrap();
     }
     let bytes = extreme.to_bytes(&stamp);
     assert_eq!(EditSet::from_bytes(&bytes, &stamp).unwrap(), extreme);
@@ -98,7 +98,7 @@ fn a_file_takes_a_few_bytes_per_edit() {
     let (_, points) = points(12.0, 40.0);
     let mut edits = EditSet::default();
     for p in points.iter().step_by(3) {
-        edits.set(p.id, Edit::Remove);
+        edits.set(p.id, Edit::Remove).unwrap();
     }
     let bytes = edits.to_bytes(&stamp()).len();
     let per_edit = bytes as f64 / edits.len() as f64;
@@ -190,4 +190,52 @@ fn fingerprints_tell_tile_sets_apart() {
     other.tiles[3].points.swap(0, 1);
     assert_ne!(set.fingerprint(), other.fingerprint());
     assert_eq!(set.fingerprint(), set.clone().fingerprint());
+}
+
+#[test]
+fn identities_a_file_cannot_hold_and_too_many_edits_are_refused() {
+    let stamp = EditStamp {
+        seed: 1,
+        tile_set: 2,
+    };
+    // Level 30 was accepted, saved, and the whole file then refused to load.
+    let mut edits = EditSet::default();
+    let deep = PointId {
+        level: MAX_LEVEL as u8 + 1,
+        x: 3,
+        y: -4,
+        index: 5,
+    };
+    assert_eq!(
+        edits.set(deep, Edit::Remove),
+        Err(EditsError::Unstorable {
+            level: MAX_LEVEL as u8 + 1,
+            x: 3,
+            y: -4,
+            index: 5
+        })
+    );
+    assert!(edits.is_empty());
+    // A file within the byte limit declaring 33.5 million edits (2 bytes each: index
+    // steps) took 1.9 GB; its count is refused before any record is decoded.
+    let declared = 33_554_432u64;
+    let mut bytes = EditSet::default().to_bytes(&stamp);
+    bytes.truncate(bytes.len() - 5);
+    let mut count = declared;
+    while count >= 0x80 {
+        bytes.push(count as u8 | 0x80);
+        count >>= 7;
+    }
+    bytes.push(count as u8);
+    bytes.extend_from_slice(&[3 << 1, 0, 0, 0, 0]);
+    bytes.extend(std::iter::repeat_n([0u8, 1], 1000).flatten());
+    let crc = crc32fast::hash(&bytes);
+    bytes.extend_from_slice(&crc.to_le_bytes());
+    assert_eq!(
+        EditSet::from_bytes(&bytes, &stamp),
+        Err(EditsError::TooMany {
+            count: declared,
+            limit: MAX_EDITS
+        })
+    );
 }

@@ -131,15 +131,15 @@ impl Sampler {
             return Ok(0);
         };
         let fork = Fork::new(self, rect, density, progress, &range);
-        let blocks = fork.plan(range, LEAF_BLOCK as usize);
+        // Blocks are planned as they are spawned: a window of `ahead` blocks is in flight.
+        let mut blocks = fork.blocks(range, LEAF_BLOCK as usize);
         let ahead = BLOCKS_AHEAD_PER_THREAD * rayon::current_num_threads().max(1);
         let (sender, receiver) = std::sync::mpsc::channel();
         let stop = AtomicBool::new(false);
         let mut count = 0;
         rayon::in_place_scope_fifo(|scope| {
-            let spawn = |i: usize| {
+            let spawn = |i: usize, block: TileRange| {
                 let (sender, fork, map, stop) = (sender.clone(), &fork, &map, &stop);
-                let block = blocks[i];
                 scope.spawn_fifo(move |_| {
                     let unwinding = SendOnUnwind(&sender, i);
                     let done = (!stop.load(Ordering::Relaxed)).then(|| {
@@ -151,9 +151,14 @@ impl Sampler {
                     std::mem::forget(unwinding);
                 });
             };
-            (0..blocks.len().min(ahead)).for_each(spawn);
+            let mut spawned = 0;
+            for block in blocks.by_ref().take(ahead) {
+                spawn(spawned, block);
+                spawned += 1;
+            }
             let mut waiting = BTreeMap::new();
-            for i in 0..blocks.len() {
+            let mut i = 0;
+            while i < spawned {
                 match next_in_order(&receiver, &mut waiting, i) {
                     Some((n, t)) => {
                         count += n;
@@ -164,8 +169,10 @@ impl Sampler {
                     // A block's task unwound (its density panicked): the scope re-raises it.
                     None => break,
                 }
-                if i + ahead < blocks.len() {
-                    spawn(i + ahead);
+                i += 1;
+                if let Some(block) = blocks.next() {
+                    spawn(spawned, block);
+                    spawned += 1;
                 }
             }
             stop.store(true, Ordering::Relaxed);
@@ -361,47 +368,19 @@ impl<'a, D: Density + Sync + ?Sized> Fork<'a, D> {
     }
 
     /// The blocks of base tiles in `range` that the serial traversal takes whole, in its
-    /// order: its splits, skipping blocks where the density is zero (counted done at once).
+    /// order (see [`Plan`]), all of them.
     fn plan(&self, range: TileRange, strip_rows: usize) -> Vec<TileRange> {
-        let mut blocks = Vec::new();
-        self.plan_into(range, strip_rows, &mut blocks);
-        blocks
+        self.blocks(range, strip_rows).collect()
     }
 
-    fn plan_into(&self, range: TileRange, strip_rows: usize, blocks: &mut Vec<TileRange>) {
-        let TileRange { i0, i1, j0, j1 } = range;
-        if i1 <= i0 || j1 <= j0 {
-            return;
-        }
-        if i1 - i0 <= LEAF_BLOCK && j1 - j0 <= LEAF_BLOCK {
-            // The traversal takes a leaf row by row, so strips of its rows keep its order.
-            for j in (j0..j1).step_by(strip_rows) {
-                let j1 = (j + strip_rows as i64).min(j1);
-                blocks.push(TileRange { j0: j, j1, ..range });
-            }
-            return;
-        }
-        let s = self.sampler.tile_size();
-        let block = Rect::from_ordered(
-            DVec2::new(i0 as f64 * s, j0 as f64 * s),
-            DVec2::new(i1 as f64 * s, j1 as f64 * s),
-        );
-        let Some(block) = block.intersect(&self.rect) else {
-            self.progress.finished(&range);
-            return;
-        };
-        let bound = sanitize(self.density.max_over(block.min(), block.max()));
-        if bound.is_nan() || bound <= 0.0 {
-            self.progress.finished(&range);
-            return;
-        }
-        let (im, jm) = (i0 + (i1 - i0) / 2, j0 + (j1 - j0) / 2);
-        if i1 - i0 >= j1 - j0 {
-            self.plan_into(TileRange { i1: im, ..range }, strip_rows, blocks);
-            self.plan_into(TileRange { i0: im, ..range }, strip_rows, blocks);
-        } else {
-            self.plan_into(TileRange { j1: jm, ..range }, strip_rows, blocks);
-            self.plan_into(TileRange { j0: jm, ..range }, strip_rows, blocks);
+    /// The blocks of base tiles in `range` that the serial traversal takes whole, in its
+    /// order, found as they are asked for.
+    fn blocks(&self, range: TileRange, strip_rows: usize) -> Plan<'_, 'a, D> {
+        Plan {
+            fork: self,
+            stack: vec![range],
+            strips: Vec::new(),
+            strip_rows,
         }
     }
 
@@ -493,5 +472,74 @@ impl<'a, D: Density + Sync + ?Sized> Fork<'a, D> {
             range.j1,
             self.sampler.tile_size(),
         );
+    }
+}
+
+/// The blocks of a [`Fork`]'s range in the serial traversal's order: its splits, skipping
+/// blocks where the density is zero (counted done at once). Lazy, so that memory follows
+/// the blocks being worked on, not the rectangle: a depth-first stack of at most two
+/// ranges per level, and the strips of one leaf.
+struct Plan<'f, 'a, D: ?Sized> {
+    fork: &'f Fork<'a, D>,
+    /// Ranges still to split, the next on top.
+    stack: Vec<TileRange>,
+    /// Strips of the current leaf still to hand out, the next on top.
+    strips: Vec<TileRange>,
+    strip_rows: usize,
+}
+
+impl<D: Density + Sync + ?Sized> Iterator for Plan<'_, '_, D> {
+    type Item = TileRange;
+
+    fn next(&mut self) -> Option<TileRange> {
+        loop {
+            if let Some(strip) = self.strips.pop() {
+                return Some(strip);
+            }
+            let range = self.stack.pop()?;
+            let TileRange { i0, i1, j0, j1 } = range;
+            if i1 <= i0 || j1 <= j0 {
+                continue;
+            }
+            if i1 - i0 <= LEAF_BLOCK && j1 - j0 <= LEAF_BLOCK {
+                // The traversal takes a leaf row by row, so strips of its rows keep its order.
+                let rows = self.strip_rows as i64;
+                let mut j = j0 + (j1 - j0 - 1) / rows * rows;
+                loop {
+                    let top = (j + rows).min(j1);
+                    self.strips.push(TileRange {
+                        j0: j,
+                        j1: top,
+                        ..range
+                    });
+                    if j == j0 {
+                        break;
+                    }
+                    j -= rows;
+                }
+                continue;
+            }
+            let fork = self.fork;
+            let s = fork.sampler.tile_size();
+            let block = Rect::from_ordered(
+                DVec2::new(i0 as f64 * s, j0 as f64 * s),
+                DVec2::new(i1 as f64 * s, j1 as f64 * s),
+            );
+            let bound = block
+                .intersect(&fork.rect)
+                .map(|b| sanitize(fork.density.max_over(b.min(), b.max())));
+            if !bound.is_some_and(|b| b > 0.0) {
+                fork.progress.finished(&range);
+                continue;
+            }
+            let (im, jm) = (i0 + (i1 - i0) / 2, j0 + (j1 - j0) / 2);
+            let (first, second) = if i1 - i0 >= j1 - j0 {
+                (TileRange { i1: im, ..range }, TileRange { i0: im, ..range })
+            } else {
+                (TileRange { j1: jm, ..range }, TileRange { j0: jm, ..range })
+            };
+            self.stack.push(second);
+            self.stack.push(first);
+        }
     }
 }

@@ -11,14 +11,23 @@ pub const DEFAULT_MAX_DOTS: usize = 4_000_000;
 /// bytes a pixel, and the tone report holds about four at a time).
 pub const DEFAULT_MAX_RASTER_PIXELS: u64 = 1 << 26;
 
-/// The most a stipple may produce: dots, and pixels of the rasters it renders. Raise them
-/// for large prints; the errors say which one was reached.
+/// Default [`StippleLimits::max_image_pixels`]: 2^24 pixels (4096 x 4096). A stipple holds
+/// about five image-sized rasters of 4 bytes a pixel and an image density of 5.3: 410 MB
+/// at the limit, measured.
+pub const DEFAULT_MAX_IMAGE_PIXELS: u64 = 1 << 24;
+
+/// The most a stipple may take: dots, pixels of the image it works on, and pixels of the
+/// rasters it renders. Raise them for large prints; the errors say which one was reached.
+/// Whatever they admit is still allocated fallibly: what the system cannot give is
+/// [`StippleError::OutOfMemory`], never an abort.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StippleLimits {
     /// Most dots.
     pub max_dots: usize,
     /// Most pixels of a rendered raster (image pixels times the scale, squared).
     pub max_raster_pixels: u64,
+    /// Most pixels of the image stippled.
+    pub max_image_pixels: u64,
 }
 
 impl Default for StippleLimits {
@@ -26,6 +35,7 @@ impl Default for StippleLimits {
         Self {
             max_dots: DEFAULT_MAX_DOTS,
             max_raster_pixels: DEFAULT_MAX_RASTER_PIXELS,
+            max_image_pixels: DEFAULT_MAX_IMAGE_PIXELS,
         }
     }
 }
@@ -51,6 +61,18 @@ impl StippleLimits {
         Ok((w as usize, h as usize))
     }
 
+    /// Refuses an image of more pixels than the limit.
+    pub fn image(&self, width: usize, height: usize) -> Result<(), StippleError> {
+        if width as u64 * height as u64 > self.max_image_pixels {
+            return Err(StippleError::ImageTooLarge {
+                width,
+                height,
+                limit: self.max_image_pixels,
+            });
+        }
+        Ok(())
+    }
+
     /// Refuses `dots` expected dots over the limit.
     pub fn dots(&self, dots: f64) -> Result<(), StippleError> {
         if dots.is_nan() || dots > self.max_dots as f64 {
@@ -61,4 +83,16 @@ impl StippleLimits {
         }
         Ok(())
     }
+}
+
+/// `n` values of `T` allocated fallibly: [`StippleError::OutOfMemory`] when the system
+/// refuses (a limit raised past what the machine holds), instead of an abort.
+pub(super) fn reserve<T>(n: usize, what: &'static str) -> Result<Vec<T>, StippleError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| StippleError::OutOfMemory {
+            what,
+            bytes: n as f64 * std::mem::size_of::<T>() as f64,
+        })?;
+    Ok(v)
 }

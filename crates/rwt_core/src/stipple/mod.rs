@@ -16,7 +16,7 @@
 //! let values = (0..w * h).map(|i| 1.0 - (i % w) as f32 / (w - 1) as f32).collect();
 //! let image = Grey { width: w, height: h, values };
 //! let s = stipple(&image, &TileSet::embedded(), &StippleSettings::default()).unwrap();
-//! let report = s.tone_report(&s.render(&s.dots, 2.0).unwrap(), 1);
+//! let report = s.tone_report(&s.render(&s.dots, 2.0).unwrap(), 1).unwrap();
 //! assert!(report.blue.mean_abs < report.white.mean_abs);
 //! ```
 
@@ -24,7 +24,9 @@ mod limits;
 mod raster;
 mod tone;
 
-pub use limits::{DEFAULT_MAX_DOTS, DEFAULT_MAX_RASTER_PIXELS, StippleLimits};
+pub use limits::{
+    DEFAULT_MAX_DOTS, DEFAULT_MAX_IMAGE_PIXELS, DEFAULT_MAX_RASTER_PIXELS, StippleLimits,
+};
 pub use raster::Grey;
 pub use tone::{CoverageCurve, Patch, ToneError};
 
@@ -142,6 +144,51 @@ pub enum StippleError {
         /// The limit.
         limit: u64,
     },
+    /// The image has more pixels than [`StippleLimits::max_image_pixels`].
+    #[error(
+        "a {width}x{height} image is over the limit of {limit} pixels to stipple (raise \
+         StippleLimits::max_image_pixels, rwt stipple --max-image-pixels; or scale the image down)"
+    )]
+    ImageTooLarge {
+        /// Image width.
+        width: usize,
+        /// Image height.
+        height: usize,
+        /// The limit.
+        limit: u64,
+    },
+    /// The system refused memory the limits admitted.
+    #[error("out of memory: {what} needs {bytes:.3e} bytes (lower the limits or the request)")]
+    OutOfMemory {
+        /// What was being allocated.
+        what: &'static str,
+        /// Bytes asked for.
+        bytes: f64,
+    },
+    /// Dots too small to draw at the scale asked for: the page would be a grey wash or blank.
+    #[error(
+        "dots of radius {radius:.3e} px are {drawn:.3e} raster pixels across at scale {scale:e}, \
+         under {MIN_DRAWN_DIAMETER} (raise the scale, or ask for fewer dots or a larger radius)"
+    )]
+    DotsTooSmall {
+        /// Dot radius in image pixels.
+        radius: f64,
+        /// Dot diameter in raster pixels.
+        drawn: f64,
+        /// The scale.
+        scale: f64,
+    },
+    /// Dots wider than the image's shorter side: they cannot lay down its tone.
+    #[error(
+        "dots of radius {radius:.3e} px do not fit an image {side} px across (ask for more dots \
+         or a smaller radius)"
+    )]
+    DotsTooLarge {
+        /// Dot radius in image pixels.
+        radius: f64,
+        /// The image's shorter side in pixels.
+        side: usize,
+    },
     /// The image has ink, but no dot fell on it: too few dots for its size.
     #[error("no dot landed (about {expected:.2} expected): ask for more dots or a smaller radius")]
     NoDots {
@@ -174,6 +221,15 @@ const CURVE_SAMPLES: usize = 35;
 const PREFILTER_RADII: f64 = 1.5;
 /// Fewest dots [`DotCount::Auto`] places, so that tiny images still get their tone.
 const MIN_AUTO_DOTS: usize = 64;
+
+/// Smallest dot diameter in raster pixels that is drawn: dots are rasterised with 4 x 4
+/// samples a pixel, and a smaller one may fall between them (a blank page at a tiny scale).
+pub const MIN_DRAWN_DIAMETER: f64 = 0.25;
+
+/// Dot radius, as a fraction of the image's shorter side, that automatic dot counts keep
+/// under; twice it is refused. Dots clipped by the image's border lose ink the coverage
+/// curve does not know of (a black 20000 x 1 image came out mean grey 0.225).
+const MAX_RADIUS_PER_SIDE: f64 = 0.125;
 
 /// A stippled image: dot centres and radius in image pixels (x right, y down).
 #[derive(Clone, Debug)]
@@ -231,9 +287,21 @@ impl Stippler {
         if ink <= 0.0 {
             return Err(StippleError::White);
         }
+        let short = image.width.min(image.height) as f64;
         let wanted = match settings.dots {
-            DotCount::Auto => Some((image.width * image.height).div_ceil(4).max(MIN_AUTO_DOTS)),
-            DotCount::Points(n) => Some(n.max(1)),
+            DotCount::Auto => {
+                // Enough dots that each fits the image's shorter side.
+                let largest = MAX_RADIUS_PER_SIDE * short;
+                let fitting = (ink / (PI * largest * largest)).ceil();
+                settings.limits.dots(fitting)?;
+                Some(
+                    (image.width * image.height)
+                        .div_ceil(4)
+                        .max(MIN_AUTO_DOTS)
+                        .max(fitting as usize),
+                )
+            }
+            DotCount::Points(n) => Some(n),
             DotCount::Radius(_) => None,
         };
         let radius_for = |nominal_ink: f64, n: usize| (nominal_ink / (PI * n as f64)).sqrt();
@@ -257,6 +325,7 @@ impl Stippler {
             radius = radius_for(plan.nominal_ink(), n);
             plan = Plan::new(&self.sampler, settings, &seen, radius)?;
         }
+        settings.fits(radius, image)?;
         plan.place(image, radius, target, settings.limits)
     }
 }
@@ -266,6 +335,26 @@ fn check(image: &Grey, settings: &StippleSettings) -> Result<(), StippleError> {
         return Err(ImageDensityError::Size(image.width as u32, image.height as u32).into());
     }
     settings.admit(image.width, image.height)
+}
+
+impl StippleSettings {
+    /// Whether dots of `radius` can be drawn at the scale and fit in the image.
+    fn fits(&self, radius: f64, image: &Grey) -> Result<(), StippleError> {
+        let drawn = 2.0 * radius * self.scale;
+        if drawn < MIN_DRAWN_DIAMETER {
+            return Err(StippleError::DotsTooSmall {
+                radius,
+                drawn,
+                scale: self.scale,
+            });
+        }
+        let side = image.width.min(image.height);
+        // Automatic counts aim at half of this; calibration moves a radius by a few percent.
+        if radius > 2.0 * MAX_RADIUS_PER_SIDE * side as f64 {
+            return Err(StippleError::DotsTooLarge { radius, side });
+        }
+        Ok(())
+    }
 }
 
 impl StippleSettings {
@@ -280,12 +369,15 @@ impl StippleSettings {
             ("gamma", self.tone.gamma),
             ("contrast", self.tone.contrast),
         ];
-        if let DotCount::Radius(r) = self.dots {
-            numbers.push(("radius", r));
+        match self.dots {
+            DotCount::Radius(r) => numbers.push(("radius", r)),
+            DotCount::Points(n) => numbers.push(("points", n as f64)),
+            DotCount::Auto => {}
         }
         if let Some(&(setting, value)) = numbers.iter().find(|(_, v)| !positive(*v)) {
             return Err(StippleError::Setting { setting, value });
         }
+        self.limits.image(width, height)?;
         self.limits.raster(width, height, self.scale)?;
         match self.dots {
             DotCount::Points(n) => self.limits.dots(n as f64),
@@ -367,7 +459,7 @@ impl Plan {
         let sampler = self
             .sampler
             .with_budget((expected * 4.0).max(work * 1.01).max(10_000.0) as usize);
-        let mut dots = Vec::with_capacity(expected as usize + expected as usize / 8);
+        let mut dots = limits::reserve(expected as usize + expected as usize / 8, "the dots")?;
         sampler.query_with(rect, &density, |p| {
             dots.push(DVec2::new(p.position.x, size.y - p.position.y));
         })?;
@@ -410,15 +502,27 @@ impl Stipple {
         let (w, h) = self
             .limits
             .raster(self.target.width, self.target.height, scale)?;
-        Ok(self.render_at(dots, w, h, scale))
+        self.render_at(dots, w, h, scale)
     }
 
-    fn render_at(&self, dots: &[DVec2], w: usize, h: usize, scale: f64) -> Grey {
-        let mut raster = Grey::filled(w, h, 0.0);
+    fn render_at(
+        &self,
+        dots: &[DVec2],
+        w: usize,
+        h: usize,
+        scale: f64,
+    ) -> Result<Grey, StippleError> {
+        let mut values = limits::reserve(w * h, "the rendered raster")?;
+        values.resize(w * h, 0.0);
+        let mut raster = Grey {
+            width: w,
+            height: h,
+            values,
+        };
         for &d in dots {
             raster.dot(d * scale, self.radius * scale);
         }
-        raster
+        Ok(raster)
     }
 
     /// Mean distance between dots where there is ink: `sqrt(inked area / dots)`, in image
@@ -450,7 +554,7 @@ impl Stipple {
     /// Tone error of this stipple, `rendered` as [`Stipple::render`] draws its dots (at the
     /// scale to compare at), and of a white-noise stipple with the same dots rendered alike;
     /// each blurred by the mean dot spacing against the target blurred the same way.
-    pub fn tone_report(&self, rendered: &Grey, seed: u64) -> ToneReport {
+    pub fn tone_report(&self, rendered: &Grey, seed: u64) -> Result<ToneReport, StippleError> {
         let scale = rendered.width as f64 / self.target.width as f64;
         let sigma = self.mean_spacing() * scale;
         let target = self
@@ -464,12 +568,12 @@ impl Stipple {
                 rendered.width,
                 rendered.height,
                 scale,
-            )
+            )?
             .blurred(sigma);
-        ToneReport {
+        Ok(ToneReport {
             sigma,
             blue,
             white: ToneError::of_blurred(&white, &target),
-        }
+        })
     }
 }

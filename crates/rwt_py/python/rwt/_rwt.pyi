@@ -7,6 +7,8 @@ import numpy as np
 Corners = Tuple[float, float, float, float]
 
 DEFAULT_BUDGET: int
+MAX_MAP_PIXELS: int
+DEFAULT_MAX_IMAGE_PIXELS: int
 
 class BudgetError(ValueError):
     """A request over its point, dot or raster budget, refused before any allocation."""
@@ -34,6 +36,7 @@ def stipple(
     render: bool = False,
     max_dots: Optional[int] = None,
     max_raster_pixels: Optional[int] = None,
+    max_image_pixels: Optional[int] = None,
     tileset: Optional[str] = None,
 ) -> Tuple[np.ndarray, float, Optional[np.ndarray], Optional[Tuple[float, float]]]: ...
 def analyse(

@@ -209,6 +209,10 @@ def _density_array(density: object) -> np.ndarray:
         raise ValueError(f"density array must hold real numbers, got dtype {arr.dtype}")
     if arr.ndim != 2 or arr.size == 0:
         raise ValueError(f"density array must be 2-D and non-empty, got shape {arr.shape}")
+    # Checked on the shape, before a copy: a broadcast view of 20000 x 20000 took 8.9 GB.
+    if arr.size > _rwt.MAX_MAP_PIXELS:
+        raise ValueError(f"density array of shape {arr.shape} has more than "
+                         f"{_rwt.MAX_MAP_PIXELS} values (4096 x 4096): downsample it")
     values = np.ascontiguousarray(arr, dtype=np.float64)
     bad = ~(np.isfinite(values) & (values >= 0))
     if bad.any():

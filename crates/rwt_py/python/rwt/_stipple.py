@@ -45,6 +45,7 @@ def stipple(
     render: bool = False,
     max_dots: Optional[int] = None,
     max_raster_pixels: Optional[int] = None,
+    max_image_pixels: Optional[int] = None,
     tileset: Optional[Union[str, os.PathLike]] = None,
 ) -> Stipple:
     """Stipples a grey image with blue-noise dots whose blurred ink keeps its tone.
@@ -54,8 +55,9 @@ def stipple(
     per four pixels (``dots=`` a count or ``radius=`` a dot radius in pixels instead),
     ``gamma`` and ``contrast`` 1 (darkness ``(contrast * (1 - grey)) ** gamma``), seed 0,
     and dots calibrated for a raster of ``scale`` 2 pixels per image pixel. More dots than
-    ``max_dots`` (4 million) or a raster over ``max_raster_pixels`` (2**26) raise
-    :class:`rwt.BudgetError` before anything is allocated.
+    ``max_dots`` (4 million), a raster over ``max_raster_pixels`` (2**26) or an image of
+    more than ``max_image_pixels`` (2**24) raise :class:`rwt.BudgetError` before anything
+    is allocated. Ctrl-C interrupts a long stipple within a fraction of a second.
 
     >>> import numpy as np, rwt
     >>> ramp = np.tile(np.linspace(1.0, 0.0, 64), (32, 1))  # white to black
@@ -63,10 +65,11 @@ def stipple(
     >>> s.tone_error < s.white_noise_tone_error
     True
     """
-    grey = _grey(image)
     counts = {k: None if v is None else _count(v, k) for k, v in
               (("dots", dots), ("seed", seed), ("max_dots", max_dots),
-               ("max_raster_pixels", max_raster_pixels))}
+               ("max_raster_pixels", max_raster_pixels),
+               ("max_image_pixels", max_image_pixels))}
+    grey = _grey(image, counts["max_image_pixels"])
     reals = {k: None if v is None else _real(v, k) for k, v in
              (("radius", radius), ("gamma", gamma), ("contrast", contrast), ("scale", scale))}
     points, r, raster, tone = _rwt.stipple(
@@ -82,11 +85,16 @@ def _real(v: object, what: str) -> float:
     return float(v)
 
 
-def _grey(image: object) -> np.ndarray:
+def _grey(image: object, max_pixels: Optional[int]) -> np.ndarray:
     arr = np.asarray(image)
     if arr.ndim != 2 or arr.size == 0:
         raise ValueError(f"image must be a non-empty 2-D grey array, got shape {arr.shape} "
                          "(for colour, pass its luma, e.g. rgb @ [0.2126, 0.7152, 0.0722])")
+    # Checked on the shape, before the float32 copy.
+    limit = _rwt.DEFAULT_MAX_IMAGE_PIXELS if max_pixels is None else max_pixels
+    if arr.size > limit:
+        raise _rwt.BudgetError(f"a {arr.shape[1]}x{arr.shape[0]} image is over the limit of "
+                               f"{limit} pixels to stipple (raise max_image_pixels)")
     kind = arr.dtype.kind
     if kind == "b":
         grey = arr.astype(np.float32)
