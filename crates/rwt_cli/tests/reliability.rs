@@ -157,7 +157,7 @@ fn hostile_inputs_are_refused_within_500_mb() {
     // density; an 8192 x 8192 black PNG grew past 5.9 GB in the stipple.
     std::fs::write(dir.join("huge.png"), black_png(20_000, 20_000)).unwrap();
     std::fs::write(dir.join("big.png"), black_png(8192, 8192)).unwrap();
-    std::fs::write(dir.join("black.png"), black_png(4096, 4096)).unwrap();
+    std::fs::write(dir.join("black.png"), black_png(2048, 2048)).unwrap();
     let points = |density: &str, tileset: Option<&str>| {
         let mut a = vec!["points", "--rect", "0", "0", "8", "8", "--density"];
         a.push(density);
@@ -202,12 +202,19 @@ fn hostile_inputs_are_refused_within_500_mb() {
             "--max-raster-pixels",
         ),
         (
-            ["stipple", "black.png", "--out", "x.png"]
-                .map(String::from)
-                .to_vec(),
+            [
+                "stipple",
+                "black.png",
+                "--out",
+                "x.png",
+                "--points",
+                "5000000",
+            ]
+            .map(String::from)
+            .to_vec(),
             "--max-dots",
         ),
-        // Decoded (4096 x 4096 is within the image limit), then refused from its ink.
+        // Decoded (2048 x 2048 is within the image limit), then refused from its ink.
         (
             [
                 "stipple",

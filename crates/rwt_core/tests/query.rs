@@ -824,6 +824,45 @@ fn the_ordered_parallel_query_plans_only_the_blocks_it_works_on() {
     assert!(asked < 5_000, "{asked} bounds asked before the first block");
 }
 
+/// A sparse constant density over unit tiles that logs, in order, whether a plan's bound
+/// (over more than a block of 8 x 8 tiles) or a block's work (anything else) asked of it.
+struct LoggedDensity(std::sync::Mutex<Vec<bool>>);
+
+impl rwt_core::density::Density for LoggedDensity {
+    fn density(&self, _: DVec2) -> f64 {
+        self.0.lock().unwrap().push(false);
+        0.001
+    }
+
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        let planning = (max - min).max_element() > 8.5;
+        self.0.lock().unwrap().push(planning);
+        0.001
+    }
+}
+
+#[test]
+fn the_parallel_query_works_while_it_plans() {
+    // 2 000 x 2 000 tiles: query_par planned all of its million strips, and spawned a task
+    // for each, before working on the first (790 MB for rwt.sample over 3000 x 3000 tiles).
+    let s = sampler(4);
+    let density = LoggedDensity(Default::default());
+    let mut out = Vec::new();
+    s.query_par(square(0.0, 2000.0), &density, &mut out)
+        .unwrap();
+    let log = density.0.into_inner().unwrap();
+    let planned = log.iter().filter(|&&b| b).count();
+    let before_work = log.iter().position(|&b| !b).unwrap();
+    assert!(
+        before_work < planned / 10,
+        "work began after {before_work} of the plan's {planned} steps"
+    );
+    let mut serial = Vec::new();
+    s.query(square(0.0, 2000.0), &rwt_core::Constant(0.001), &mut serial)
+        .unwrap();
+    assert_eq!(out, serial);
+}
+
 #[test]
 fn parallel_progress_counts_every_tile_once() {
     use std::sync::Mutex;

@@ -346,7 +346,7 @@ fn dots_and_rasters_are_admitted_before_they_are_allocated() {
         StippleError::RasterTooLarge {
             width: 640_000.0,
             height: 640_000.0,
-            limit: 1 << 26
+            limit: 1 << 24
         }
     );
     assert!(e.to_string().contains("--max-raster-pixels"), "{e}");

@@ -25,9 +25,9 @@ _INTERRUPTED = textwrap.dedent("""
     started = time.monotonic()
     try:
         if call == "sample":
-            rwt.sample((0, 0, 2000, 2000), 4.0, budget=10**9)
+            rwt.sample((0, 0, 3000, 3000), 0.5, budget=10**9, tile_size=1)
         elif call == "map":
-            rwt.sample((0, 0, 3000, 3000), np.full((64, 64), 3.0), budget=10**9)
+            rwt.sample((0, 0, 3000, 3000), np.full((64, 64), 0.5), budget=10**9, tile_size=1)
         elif call == "stipple":
             rwt.stipple(np.zeros((2048, 2048)), render=True)
         print("finished", time.monotonic() - started)

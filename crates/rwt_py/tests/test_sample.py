@@ -264,12 +264,15 @@ def test_clumps_gather_points_in_patches_as_in_rust():
     assert len(rwt.sample(box, flowers, n=500, seed=11, tile_size=3.0).points) == 500
 
 
-def test_bad_clumps_are_value_errors():
-    box = (0.0, 0.0, 10.0, 10.0)
-    for bad in [
-        rwt.Clumps(clumps=0.01, per_clump=5.0, radius=float("nan")),
-        rwt.Clumps(clumps=-1.0, per_clump=5.0, radius=1.0),
-        rwt.Clumps(clumps=0.01, per_clump=5.0, radius=1.0, kernel="gauss"),
+def test_bad_clumps_are_value_errors_when_made():
+    # They were accepted, and refused only by a later sample.
+    for bad, words in [
+        (dict(clumps=0.01, per_clump=5.0, radius=float("nan")), "radius is nan"),
+        (dict(clumps=-1.0, per_clump=5.0, radius=1.0), "clumps is -1.0"),
+        (dict(clumps=0.01, per_clump=5.0, radius=1.0, kernel="gauss"), "gauss"),
+        (dict(clumps=0.01, per_clump=True, radius=1.0), "per_clump is True"),
+        (dict(clumps=0.01, per_clump=5.0, radius=1.0, seed=-1), "seed"),
+        (dict(clumps=0.01, per_clump=1e9, radius=1e-200), "too dense"),
     ]:
-        with pytest.raises(ValueError):
-            rwt.sample(box, bad)
+        with pytest.raises(ValueError, match=words):
+            rwt.Clumps(**bad)

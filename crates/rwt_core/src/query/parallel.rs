@@ -14,9 +14,9 @@ use crate::density::{Density, sanitize};
 use glam::DVec2;
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
-use std::sync::{Mutex, OnceLock};
 
 impl Sampler {
     /// The points of `rect` for `density`, appended to `out` in the order
@@ -45,9 +45,19 @@ impl Sampler {
             return Ok(0);
         };
         let fork = Fork::new(self, rect, density, &|_| {}, &range);
-        let blocks = fork.plan(range, STRIP_ROWS);
         let before = out.len();
-        fork.build_in_order(&blocks, out);
+        // Each block kept compactly on the pool, built into `out` here in order.
+        let ahead = KEPT_AHEAD_PER_THREAD * rayon::current_num_threads().max(1);
+        fork.in_order(
+            fork.blocks(range, STRIP_ROWS),
+            ahead,
+            |block| fork.kept(block),
+            |kept| {
+                kept.build_into(self, out);
+                kept.give_back();
+                ControlFlow::Continue(())
+            },
+        );
         Ok(out.len() - before)
     }
 
@@ -83,6 +93,10 @@ impl Sampler {
 
 /// Blocks computed ahead of the one [`Sampler::query_par_ordered`] hands over, per pool thread.
 const BLOCKS_AHEAD_PER_THREAD: usize = 4;
+
+/// Blocks kept ahead of the one [`Sampler::query_par`] builds, per pool thread: its blocks
+/// are strips of a few tiles, so more of them keep the pool busy (a few kilobytes each).
+const KEPT_AHEAD_PER_THREAD: usize = 64;
 
 impl Sampler {
     /// The points of [`Sampler::query`], in its order, computed on rayon's pool a block of
@@ -131,52 +145,21 @@ impl Sampler {
             return Ok(0);
         };
         let fork = Fork::new(self, rect, density, progress, &range);
-        // Blocks are planned as they are spawned: a window of `ahead` blocks is in flight.
-        let mut blocks = fork.blocks(range, LEAF_BLOCK as usize);
         let ahead = BLOCKS_AHEAD_PER_THREAD * rayon::current_num_threads().max(1);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        let stop = AtomicBool::new(false);
         let mut count = 0;
-        rayon::in_place_scope_fifo(|scope| {
-            let spawn = |i: usize, block: TileRange| {
-                let (sender, fork, map, stop) = (sender.clone(), &fork, &map, &stop);
-                scope.spawn_fifo(move |_| {
-                    let unwinding = SendOnUnwind(&sender, i);
-                    let done = (!stop.load(Ordering::Relaxed)).then(|| {
-                        let points = fork.points(block);
-                        fork.progress.finished(&block);
-                        (points.len(), map(&points))
-                    });
-                    let _ = sender.send((i, done));
-                    std::mem::forget(unwinding);
-                });
-            };
-            let mut spawned = 0;
-            for block in blocks.by_ref().take(ahead) {
-                spawn(spawned, block);
-                spawned += 1;
-            }
-            let mut waiting = BTreeMap::new();
-            let mut i = 0;
-            while i < spawned {
-                match next_in_order(&receiver, &mut waiting, i) {
-                    Some((n, t)) => {
-                        count += n;
-                        if consume(t).is_break() {
-                            break;
-                        }
-                    }
-                    // A block's task unwound (its density panicked): the scope re-raises it.
-                    None => break,
-                }
-                i += 1;
-                if let Some(block) = blocks.next() {
-                    spawn(spawned, block);
-                    spawned += 1;
-                }
-            }
-            stop.store(true, Ordering::Relaxed);
-        });
+        fork.in_order(
+            fork.blocks(range, LEAF_BLOCK as usize),
+            ahead,
+            |block| {
+                let points = fork.points(block);
+                fork.progress.finished(&block);
+                (points.len(), map(&points))
+            },
+            |(n, t)| {
+                count += n;
+                consume(t)
+            },
+        );
         Ok(count)
     }
 }
@@ -308,18 +291,6 @@ impl Kept {
 /// the output in order never waits long for the next one, or for the last.
 const STRIP_ROWS: usize = 2;
 
-/// Marks a query failed when a block's task unwinds (a density that panicked), so that the
-/// thread building the output stops waiting for that block and the panic goes on up.
-struct FailOnUnwind<'a>(&'a AtomicBool);
-
-impl Drop for FailOnUnwind<'_> {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            self.0.store(true, Ordering::Release);
-        }
-    }
-}
-
 /// Base tiles of a range.
 fn tiles(range: &TileRange) -> u64 {
     ((range.i1 - range.i0).max(0) as u64).saturating_mul((range.j1 - range.j0).max(0) as u64)
@@ -384,47 +355,54 @@ impl<'a, D: Density + Sync + ?Sized> Fork<'a, D> {
         }
     }
 
-    /// The points of `blocks` appended to `out` in order: every block computed on the
-    /// pool (first blocks first) and kept; this thread builds each into `out` as soon as
-    /// it and the blocks before it are done, and computes blocks itself while none is
-    /// ready, so that writing the output overlaps computing it.
-    fn build_in_order(&self, blocks: &[TileRange], out: &mut Vec<Point>) {
-        let kept: Vec<OnceLock<Kept>> = blocks.iter().map(|_| OnceLock::new()).collect();
-        let failed = AtomicBool::new(false);
-        rayon::scope_fifo(|scope| {
-            for (block, slot) in blocks.iter().zip(&kept) {
-                let failed = &failed;
+    /// Runs `work` on the pool for `blocks`, at most `ahead` blocks ahead of the one handed
+    /// to `consume`, which receives the results in the blocks' order on this thread
+    /// (returning `Break` stops it). Blocks are planned as they are spawned, so memory
+    /// follows the window, not the range. A block whose task unwinds (a density that
+    /// panicked) stops the handing over; the scope then re-raises the panic.
+    fn in_order<T: Send>(
+        &self,
+        mut blocks: impl Iterator<Item = TileRange>,
+        ahead: usize,
+        work: impl Fn(TileRange) -> T + Sync,
+        mut consume: impl FnMut(T) -> ControlFlow<()>,
+    ) {
+        let (sender, receiver) = std::sync::mpsc::channel();
+        let stop = AtomicBool::new(false);
+        rayon::in_place_scope_fifo(|scope| {
+            let spawn = |i: usize, block: TileRange| {
+                let (sender, work, stop) = (sender.clone(), &work, &stop);
                 scope.spawn_fifo(move |_| {
-                    let _unwinding = FailOnUnwind(failed);
-                    let _ = slot.set(self.kept(*block));
+                    let unwinding = SendOnUnwind(&sender, i);
+                    let done = (!stop.load(Ordering::Relaxed)).then(|| work(block));
+                    let _ = sender.send((i, done));
+                    std::mem::forget(unwinding);
                 });
+            };
+            let mut spawned = 0;
+            for block in blocks.by_ref().take(ahead.max(1)) {
+                spawn(spawned, block);
+                spawned += 1;
             }
-            for slot in &kept {
-                let Some(block) = self.wait_for(slot, &failed) else {
-                    return;
+            let mut waiting = BTreeMap::new();
+            for i in 0.. {
+                if i == spawned {
+                    break;
+                }
+                // `None`: the block's task unwound, and the scope re-raises it.
+                let Some(t) = next_in_order(&receiver, &mut waiting, i) else {
+                    break;
                 };
-                block.build_into(self.sampler, out);
+                if consume(t).is_break() {
+                    break;
+                }
+                if let Some(block) = blocks.next() {
+                    spawn(spawned, block);
+                    spawned += 1;
+                }
             }
+            stop.store(true, Ordering::Relaxed);
         });
-        kept.into_iter()
-            .filter_map(OnceLock::into_inner)
-            .for_each(Kept::give_back);
-    }
-
-    /// The block kept in `slot`, taking pool work while it is not done yet; `None` once a
-    /// block's task has failed.
-    fn wait_for<'k>(&self, slot: &'k OnceLock<Kept>, failed: &AtomicBool) -> Option<&'k Kept> {
-        loop {
-            if let Some(block) = slot.get() {
-                return Some(block);
-            }
-            if failed.load(Ordering::Acquire) {
-                return None;
-            }
-            if rayon::yield_now() != Some(rayon::Yield::Executed) {
-                std::thread::yield_now();
-            }
-        }
     }
 
     /// The points of `blocks`, a run each: halves of the list forked on the pool.

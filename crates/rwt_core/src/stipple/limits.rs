@@ -7,14 +7,15 @@ use super::StippleError;
 /// image at the default one dot per four pixels).
 pub const DEFAULT_MAX_DOTS: usize = 4_000_000;
 
-/// Default [`StippleLimits::max_raster_pixels`]: 2^26 pixels (8192 x 8192; a raster takes 4
-/// bytes a pixel, and the tone report holds about four at a time).
-pub const DEFAULT_MAX_RASTER_PIXELS: u64 = 1 << 26;
+/// Default [`StippleLimits::max_raster_pixels`]: 2^24 pixels (4096 x 4096; a raster takes 4
+/// bytes a pixel, and rendering with its tone report holds three at a time).
+pub const DEFAULT_MAX_RASTER_PIXELS: u64 = 1 << 24;
 
-/// Default [`StippleLimits::max_image_pixels`]: 2^24 pixels (4096 x 4096). A stipple holds
-/// about five image-sized rasters of 4 bytes a pixel and an image density of 5.3: 410 MB
-/// at the limit, measured.
-pub const DEFAULT_MAX_IMAGE_PIXELS: u64 = 1 << 24;
+/// Default [`StippleLimits::max_image_pixels`]: 2^22 pixels (2048 x 2048). A stipple holds
+/// about five image-sized rasters of 4 bytes a pixel and an image density of 5.3. With the
+/// default raster limit, `rwt stipple` of a black 2048 x 2048 image peaks at 310 MB,
+/// measured.
+pub const DEFAULT_MAX_IMAGE_PIXELS: u64 = 1 << 22;
 
 /// The most a stipple may take: dots, pixels of the image it works on, and pixels of the
 /// rasters it renders. Raise them for large prints; the errors say which one was reached.

@@ -557,19 +557,17 @@ impl Stipple {
     pub fn tone_report(&self, rendered: &Grey, seed: u64) -> Result<ToneReport, StippleError> {
         let scale = rendered.width as f64 / self.target.width as f64;
         let sigma = self.mean_spacing() * scale;
-        let target = self
-            .target
-            .resized(rendered.width, rendered.height)
-            .blurred(sigma);
+        // Blurred in place, one raster-sized buffer at a time beside `rendered`.
+        let mut target = self.target.resized(rendered.width, rendered.height);
+        target.blur(sigma);
         let blue = ToneError::of_blurred(&rendered.blurred(sigma), &target);
-        let white = self
-            .render_at(
-                &self.white_noise(seed),
-                rendered.width,
-                rendered.height,
-                scale,
-            )?
-            .blurred(sigma);
+        let mut white = self.render_at(
+            &self.white_noise(seed),
+            rendered.width,
+            rendered.height,
+            scale,
+        )?;
+        white.blur(sigma);
         Ok(ToneReport {
             sigma,
             blue,

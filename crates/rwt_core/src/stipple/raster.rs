@@ -133,43 +133,48 @@ impl Grey {
     /// This raster blurred by a Gaussian of standard deviation `sigma` pixels; near the
     /// edges the kernel is renormalised over the pixels inside.
     pub fn blurred(&self, sigma: f64) -> Self {
+        let mut out = self.clone();
+        out.blur(sigma);
+        out
+    }
+
+    /// [`Grey::blurred`] in place: it takes one row or column of memory, not a raster.
+    pub fn blur(&mut self, sigma: f64) {
         if sigma.is_nan() || sigma <= 0.0 {
-            return self.clone();
+            return;
         }
         // Beyond the raster's own size a wider kernel reaches no other pixel.
         let reach = ((3.0 * sigma).ceil() as usize).min(self.width.max(self.height));
         let kernel: Vec<f32> = (0..=reach)
             .map(|i| (-0.5 * (i as f64 / sigma).powi(2)).exp() as f32)
             .collect();
-        let rows = blur_pass(&self.values, self.width, self.height, &kernel, true);
-        let values = blur_pass(&rows, self.width, self.height, &kernel, false);
-        Self {
-            width: self.width,
-            height: self.height,
-            values,
-        }
+        blur_pass(&mut self.values, self.width, self.height, &kernel, true);
+        blur_pass(&mut self.values, self.width, self.height, &kernel, false);
     }
 }
 
-/// One separable pass (along rows when `along_x`, else along columns).
-fn blur_pass(v: &[f32], w: usize, h: usize, kernel: &[f32], along_x: bool) -> Vec<f32> {
+/// One separable pass in place (along rows when `along_x`, else along columns), a line at
+/// a time through a copy of it.
+fn blur_pass(v: &mut [f32], w: usize, h: usize, kernel: &[f32], along_x: bool) {
     let (len, lines) = if along_x { (w, h) } else { (h, w) };
     let index = |line: usize, i: usize| if along_x { line * w + i } else { i * w + line };
     let reach = kernel.len() - 1;
-    let mut out = vec![0.0; v.len()];
+    let mut input = vec![0.0f32; len];
     for line in 0..lines {
+        for (i, x) in input.iter_mut().enumerate() {
+            *x = v[index(line, i)];
+        }
         for i in 0..len {
             let (lo, hi) = (i.saturating_sub(reach), (i + reach).min(len - 1));
             let (mut sum, mut weight) = (0.0f32, 0.0f32);
-            for j in lo..=hi {
+            for (j, x) in input.iter().enumerate().take(hi + 1).skip(lo) {
                 let k = kernel[i.abs_diff(j)];
-                sum += k * v[index(line, j)];
+                sum += k * x;
                 weight += k;
             }
-            out[index(line, i)] = sum / weight;
+            v[index(line, i)] = sum / weight;
         }
     }
-    out
 }
 
 #[cfg(test)]

@@ -35,6 +35,20 @@ class Clumps:
     kernel: str = "thomas"
     seed: int = 0
 
+    def __post_init__(self) -> None:
+        # Checked when made, not at the first sample: a bad value names itself here.
+        for field in ("clumps", "per_clump", "radius"):
+            v = getattr(self, field)
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not (0 < float(v) < np.inf):
+                raise ValueError(f"clump parameter {field} is {v!r}, not a finite positive number")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, numbers.Integral) \
+                or not 0 <= self.seed < 2**64:
+            raise ValueError(f"clump seed must be an integer in 0..2**64, got {self.seed!r}")
+        if self.kernel not in ("thomas", "matern"):
+            raise ValueError(f'clump kernel must be "thomas" or "matern", got {self.kernel!r}')
+        # The native checks too (clumps too dense to place), on an empty rectangle.
+        _rwt.query((0.0, 0.0, 0.0, 0.0), self._native())
+
     def _native(self) -> Tuple[int, float, float, float, str]:
         if self.kernel not in ("thomas", "matern"):
             raise ValueError(f'clump kernel must be "thomas" or "matern", got {self.kernel!r}')

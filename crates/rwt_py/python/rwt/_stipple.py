@@ -55,8 +55,8 @@ def stipple(
     per four pixels (``dots=`` a count or ``radius=`` a dot radius in pixels instead),
     ``gamma`` and ``contrast`` 1 (darkness ``(contrast * (1 - grey)) ** gamma``), seed 0,
     and dots calibrated for a raster of ``scale`` 2 pixels per image pixel. More dots than
-    ``max_dots`` (4 million), a raster over ``max_raster_pixels`` (2**26) or an image of
-    more than ``max_image_pixels`` (2**24) raise :class:`rwt.BudgetError` before anything
+    ``max_dots`` (4 million), a raster over ``max_raster_pixels`` (2**24) or an image of
+    more than ``max_image_pixels`` (2**22) raise :class:`rwt.BudgetError` before anything
     is allocated. Ctrl-C interrupts a long stipple within a fraction of a second.
 
     >>> import numpy as np, rwt

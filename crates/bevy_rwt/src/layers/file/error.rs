@@ -91,6 +91,24 @@ pub enum InvalidLayer {
         /// The distance.
         distance: f32,
     },
+    /// A number out of its range.
+    #[error("{field} {} must be {rule}", super::numbers::short(*value))]
+    Number {
+        /// The field, with its class where it has one (`class 1: mesh radius`).
+        field: String,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        rule: String,
+    },
+    /// More classes than a layer may have.
+    #[error("{classes} classes, more than {limit}")]
+    TooManyClasses {
+        /// Classes in the file.
+        classes: usize,
+        /// The limit ([`MAX_CLASSES`](super::MAX_CLASSES)).
+        limit: usize,
+    },
     /// A far material is not `Instanced()` exactly when its class is instanced.
     #[error("class {class}: a far material is Instanced() exactly when the class is instanced")]
     FarMaterial {

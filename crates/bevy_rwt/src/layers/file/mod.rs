@@ -80,6 +80,7 @@ mod describe;
 mod error;
 mod loader;
 mod names;
+mod numbers;
 #[cfg(test)]
 mod tests;
 
@@ -129,6 +130,7 @@ pub enum DensityDescription {
 /// An image over a ground rectangle in a layer file (a [`GroundMap`]), written
 /// `Image(path: "maps/flowers.png", min: (-128.0, -128.0), size: (256.0, 256.0), scale: 2.0)`.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct MapDescription {
     /// Asset path of the image.
     pub path: String,
@@ -164,6 +166,7 @@ impl MapDescription {
 
 /// A mesh in a layer file: an asset path or a primitive.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub enum MeshDescription {
     /// Asset path, e.g. `"models/tree.glb#Mesh0/Primitive0"`.
     Path(String),
@@ -235,6 +238,7 @@ pub enum MaterialDescription {
 /// The shading of an instanced class in a layer file (colours linear RGB); each field
 /// defaults to [`InstancedShading::default`]'s.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct InstancedShadingDescription {
     /// Colour at the root.
@@ -325,6 +329,7 @@ fn variation() -> f32 {
 
 /// A class in a layer file.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct ClassDescription {
     /// Where and how densely the class grows.
     pub density: DensityDescription,
@@ -358,6 +363,7 @@ pub struct ClassDescription {
 /// A promotion in a layer file: its distance, and what promoted instances get by the name
 /// the game registered in [`NamedAssets::insert_inserter`].
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct PromotionDescription {
     /// Ground distance to the nearest viewer within which instances are entities.
     pub distance: f32,
@@ -369,6 +375,7 @@ pub struct PromotionDescription {
 /// class, [`InstancedFar`](crate::look::InstancedFar), whose material is `Instanced()`: the
 /// class's shading applies, and whose crossfade is unused).
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct LodDescription {
     /// The far mesh.
     pub mesh: MeshDescription,
@@ -399,6 +406,7 @@ fn default_tile() -> f64 {
 
 /// A whole layer file.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct LayerDescription {
     /// Classes sharing the layer's point set.
     pub classes: Vec<ClassDescription>,
@@ -458,6 +466,7 @@ pub struct LayerDescription {
 
 /// A keep-out in a layer file: the other layer's entity `Name` and a radius per class.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct KeepOutDescription {
     /// The `Name` of the layer entity whose instances clear this layer.
     pub layer: String,
@@ -485,6 +494,9 @@ impl DensityDescription {
 /// Largest layer file the loader reads (layer files are descriptions of a few kilobytes;
 /// anything larger is refused after reading this many bytes).
 pub const MAX_LAYER_FILE_BYTES: u64 = 1 << 20;
+
+/// Most classes of a layer: a reclass edit names its class with 16 bits.
+pub const MAX_CLASSES: usize = 1 << 16;
 
 impl LayerDescription {
     /// The layer file text: what [`LayerDescription::from_ron`] reads back (optional fields
@@ -515,6 +527,12 @@ impl LayerDescription {
         let d = self;
         if d.classes.is_empty() {
             return Err(InvalidLayer::NoClasses);
+        }
+        if d.classes.len() > MAX_CLASSES {
+            return Err(InvalidLayer::TooManyClasses {
+                classes: d.classes.len(),
+                limit: MAX_CLASSES,
+            });
         }
         for (field, v) in [
             ("tile_size", Some(d.tile_size)),
@@ -572,7 +590,7 @@ impl LayerDescription {
                 return Err(InvalidLayer::FarMaterial { class: i });
             }
         }
-        Ok(())
+        numbers::check(d)
     }
 
     /// The layer, with named assets from `names` and other handles made by the given

@@ -154,6 +154,101 @@ fn rejects_bad_files_with_reasons() {
     assert!(err(&far).contains("more than 256 chunks"), "{}", err(&far));
     let zero = MEADOW.replace("load_distance: 48.0", "load_distance: 0.0");
     assert!(err(&zero).contains("load_distance 0 must be positive"));
+    // Numbers that loaded and then streamed nothing, streamed without end or drew garbage.
+    for (from, to, words) in [
+        (
+            "tile_size: 4.0",
+            "tile_size: 1e300",
+            "tile_size 1e300 must be between 1e-9 and 1e12",
+        ),
+        (
+            "tile_size: 4.0",
+            "tile_size: 1e-300",
+            "tile_size 1e-300 must be between",
+        ),
+        (
+            "chunk_size: 16.0",
+            "chunk_size: 1e300",
+            "chunk_size 1e300 must be between",
+        ),
+        (
+            "(20.0, 60.0)",
+            "(60.0, 20.0)",
+            "falloff end 20 must be finite and at least 60",
+        ),
+        (
+            "(20.0, 60.0)",
+            "(NaN, 60.0)",
+            "falloff start NaN must be finite and at least 0",
+        ),
+        (
+            "Constant(0.4)",
+            "Constant(NaN)",
+            "class 0: density NaN must be finite and at least 0",
+        ),
+        (
+            "Constant(0.4)",
+            "Constant(-1.0)",
+            "class 0: density -1 must be",
+        ),
+        (
+            "Constant(0.4)",
+            "Constant(1e400)",
+            "class 0: density inf must be",
+        ),
+        (
+            "octaves: 3",
+            "octaves: 1000",
+            "class 1: noise octaves 1000 must be between 1 and 16",
+        ),
+        (
+            "frequency: 0.1",
+            "frequency: 0.0",
+            "class 1: noise frequency 0 must be positive",
+        ),
+        (
+            "radius: 0.5",
+            "radius: NaN",
+            "class 0: mesh radius NaN must be positive and at most 1e6",
+        ),
+        (
+            "height: 2.0",
+            "height: 1e30",
+            "class 0: mesh height 1e30 must be",
+        ),
+        (
+            "scale: 1.5",
+            "scale: -1.5",
+            "class 1: scale -1.5 must be positive",
+        ),
+        (
+            "Color(0.1, 0.5, 0.1)",
+            "Color(NaN, 0.5, 0.1)",
+            "class 0: colour NaN must be",
+        ),
+        (
+            "seed: 9,",
+            "seed: 9, wobble: 3,",
+            "Unexpected field named `wobble`",
+        ),
+        (
+            "scale: 1.5)",
+            "scale: 1.5, lod_distence: 3.0)",
+            "Unexpected field named `lod_distence`",
+        ),
+    ] {
+        let bad = MEADOW.replace(from, to);
+        assert_ne!(bad, MEADOW, "{from}");
+        assert!(err(&bad).contains(words), "{to}: {}", err(&bad));
+    }
+    let class =
+        "(density: Constant(0.1), mesh: Sphere(radius: 0.3), material: Color(0.6, 0.2, 0.2)),";
+    let many = MEADOW.replacen(
+        "classes: [",
+        &format!("classes: [{}", class.repeat(1 << 16)),
+        1,
+    );
+    assert!(err(&many).contains("65538 classes, more than 65536"));
 }
 
 /// A handle made in code (no asset path).
