@@ -295,8 +295,7 @@ fn a_thin_black_image_stipples_black_not_grey() {
         .unwrap();
     let o = rwt(&dir, &["stipple", "thin.png", "--out", "out.png"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let out = image::open(dir.join("out.png")).unwrap().to_luma8();
-    let mean = out.pixels().map(|p| p[0] as f64).sum::<f64>() / out.len() as f64 / 255.0;
+    let mean = mean_grey(&dir.join("out.png"));
     // It was 0.225.
     assert!(mean < 0.05, "mean grey {mean}");
     // Dots the image cannot hold are refused, not drawn clipped.
@@ -365,21 +364,7 @@ fn signals_leave_no_temporary_file_and_the_previous_output() {
     child.kill().unwrap();
     child.wait().unwrap();
     assert_eq!(listing(&dir).len(), 2);
-    let o = rwt(
-        &dir,
-        &[
-            "points",
-            "--rect",
-            "0",
-            "0",
-            "2",
-            "2",
-            "--density",
-            "const:3",
-            "--out",
-            "big.txt",
-        ],
-    );
+    let o = small_points(&dir, &["--out", "big.txt"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(listing(&dir), ["big.txt"]);
     std::fs::remove_dir_all(&dir).unwrap();
@@ -455,20 +440,7 @@ fn legal_output_names_and_link_chains_are_written() {
     std::os::unix::fs::symlink("../final.txt", dir.join("sub/hop")).unwrap();
     for name in [long.as_str(), dash, "chain.txt"] {
         let out = format!("--out={name}");
-        let o = rwt(
-            &dir,
-            &[
-                "points",
-                "--rect",
-                "0",
-                "0",
-                "2",
-                "2",
-                "--density",
-                "const:3",
-                &out,
-            ],
-        );
+        let o = small_points(&dir, &[&out]);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
     }
     assert!(

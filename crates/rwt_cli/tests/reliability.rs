@@ -262,8 +262,7 @@ fn stipple_settings_that_aborted_are_typed_errors() {
         .unwrap();
     let o = rwt(&dir, &["stipple", "dot.png", "--out", "dot-out.png"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let out = image::open(dir.join("dot-out.png")).unwrap().to_luma8();
-    let mean = out.pixels().map(|p| p[0] as f64).sum::<f64>() / out.len() as f64 / 255.0;
+    let mean = mean_grey(&dir.join("dot-out.png"));
     assert!(mean < 0.15, "mean grey {mean}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

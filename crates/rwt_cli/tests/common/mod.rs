@@ -157,3 +157,25 @@ pub fn picture(dir: &Path) -> PathBuf {
     img.save(&path).unwrap();
     path
 }
+
+/// The mean grey (0 black .. 1 white) of an image file.
+pub fn mean_grey(path: &Path) -> f64 {
+    let img = image::open(path).unwrap().to_luma8();
+    img.pixels().map(|p| p[0] as f64).sum::<f64>() / img.len() as f64 / 255.0
+}
+
+/// `rwt points` of a 2 x 2 square at 3 points per unit area, with `extra` arguments.
+pub fn small_points(dir: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "points",
+        "--rect",
+        "0",
+        "0",
+        "2",
+        "2",
+        "--density",
+        "const:3",
+    ];
+    args.extend(extra);
+    rwt(dir, &args)
+}
