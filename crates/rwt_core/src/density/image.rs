@@ -18,9 +18,10 @@ pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 pub const DENSITY_BYTES_PER_PIXEL: f64 = 4.0 + 4.0 / 3.0;
 
 /// Most memory [`ImageDensity::open`] and [`ImageDensity::from_bytes`] take while making a
-/// density: the decoded image and the density, 448 MiB. An 8192 x 8192 grey PNG (64 MiB
-/// decoded, 341 MiB of density) is admitted, an 8-bit RGBA one up to 6 900 x 6 900 pixels;
-/// measured peaks stay under 500 MB.
+/// density: its values beside the larger of the decoded image and the mipmaps, 448 MiB. An
+/// 8192 x 8192 8-bit grey or RGB PNG is admitted (`rwt points` peaks at 377 MB on the grey
+/// one, measured), an 8-bit RGBA one up to 7 600 x 7 600 pixels, a 16-bit RGBA one up to
+/// 6 200 x 6 200.
 pub const MAX_DENSITY_BYTES: u64 = 448 << 20;
 
 /// A painted density map: one channel of an image, bilinearly interpolated over a world
