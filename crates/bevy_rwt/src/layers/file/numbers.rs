@@ -128,7 +128,8 @@ pub(super) fn check(d: &LayerDescription) -> Result<(), InvalidLayer> {
         n.add("height_range high", hi, Rule::Between(lo as f64, f64::MAX));
     }
     if let Some(s) = d.max_slope {
-        n.add("max_slope", s, Rule::Between(0.0, 90.0));
+        // Rise over run.
+        n.add("max_slope", s, Rule::NonNegative);
     }
     if let Some(e) = &d.exclusion {
         density(&mut n, "exclusion", e);
