@@ -112,12 +112,7 @@ pub fn decode_image_with_limit(
     bytes: &[u8],
     max_pixels: u64,
 ) -> Result<image::DynamicImage, ImageDensityError> {
-    let reader = || {
-        image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| ImageDensityError::Decode(e.to_string()))
-    };
-    decode_limited(reader, max_pixels)
+    decode_limited(|| bytes_reader(bytes), max_pixels)
 }
 
 /// Opens and decodes an image file of at most [`MAX_IMAGE_PIXELS`] pixels, streaming from
@@ -131,14 +126,28 @@ pub fn open_image_with_limit(
     path: &Path,
     max_pixels: u64,
 ) -> Result<image::DynamicImage, ImageDensityError> {
-    let reader = || {
-        let file =
-            crate::files::open_regular(path).map_err(|e| ImageDensityError::Read(e.to_string()))?;
-        image::ImageReader::new(std::io::BufReader::new(file))
-            .with_guessed_format()
-            .map_err(|e| ImageDensityError::Read(e.to_string()))
-    };
-    decode_limited(reader, max_pixels)
+    decode_limited(|| file_reader(path), max_pixels)
+}
+
+/// A reader of image bytes, its format guessed from them.
+fn bytes_reader(
+    bytes: &[u8],
+) -> Result<image::ImageReader<std::io::Cursor<&[u8]>>, ImageDensityError> {
+    image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| ImageDensityError::Decode(e.to_string()))
+}
+
+/// A reader of an image file (a regular file: see [`crate::files::open_regular`]), its
+/// format guessed from its first bytes.
+fn file_reader(
+    path: &Path,
+) -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>, ImageDensityError> {
+    let file =
+        crate::files::open_regular(path).map_err(|e| ImageDensityError::Read(e.to_string()))?;
+    image::ImageReader::new(std::io::BufReader::new(file))
+        .with_guessed_format()
+        .map_err(|e| ImageDensityError::Read(e.to_string()))
 }
 
 /// Reads the header through one reader, then decodes through another when the size is
@@ -268,26 +277,14 @@ impl ImageDensity {
         invert: bool,
         at: Placement,
     ) -> Result<Self, ImageDensityError> {
-        let reader = || {
-            image::ImageReader::new(std::io::Cursor::new(bytes))
-                .with_guessed_format()
-                .map_err(|e| ImageDensityError::Decode(e.to_string()))
-        };
-        Self::decode_within(reader, invert, at)
+        Self::decode_within(|| bytes_reader(bytes), invert, at)
     }
 
     /// Opens an image file (see [`ImageDensity::from_image`]): refused from its header when
     /// decoding it and making its density would take more than [`MAX_DENSITY_BYTES`]; the
     /// decoded image is dropped before the mipmaps are made.
     pub fn open(path: &Path, invert: bool, at: Placement) -> Result<Self, ImageDensityError> {
-        let reader = || {
-            let file = crate::files::open_regular(path)
-                .map_err(|e| ImageDensityError::Read(e.to_string()))?;
-            image::ImageReader::new(std::io::BufReader::new(file))
-                .with_guessed_format()
-                .map_err(|e| ImageDensityError::Read(e.to_string()))
-        };
-        Self::decode_within(reader, invert, at)
+        Self::decode_within(|| file_reader(path), invert, at)
     }
 
     fn decode_within<R: BufRead + Seek>(

@@ -397,23 +397,18 @@ pub fn write_atomic_with(
 /// has no bytes. A link is followed.
 pub fn open_regular(path: &Path) -> Result<File, FileError> {
     let read_err = |e: io::Error| FileError::io(path, FileAction::Read, &e);
-    // Checked before opening: opening a FIFO blocks.
-    let kind = std::fs::metadata(path).map_err(read_err)?.file_type();
-    if !kind.is_file() {
-        return Err(FileError::NotAFile {
+    let regular = |metadata: std::fs::Metadata| match metadata.file_type() {
+        kind if kind.is_file() => Ok(()),
+        kind => Err(FileError::NotAFile {
             path: path.to_path_buf(),
             what: what_is(kind),
-        });
-    }
+        }),
+    };
+    // Checked before opening (opening a FIFO blocks), and after: the path may have been
+    // swapped in between.
+    regular(std::fs::metadata(path).map_err(read_err)?)?;
     let file = File::open(path).map_err(read_err)?;
-    // And after: the path may have been swapped in between.
-    let kind = file.metadata().map_err(read_err)?.file_type();
-    if !kind.is_file() {
-        return Err(FileError::NotAFile {
-            path: path.to_path_buf(),
-            what: what_is(kind),
-        });
-    }
+    regular(file.metadata().map_err(read_err)?)?;
     Ok(file)
 }
 

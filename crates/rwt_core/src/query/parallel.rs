@@ -1,6 +1,6 @@
 //! Parallel queries (feature `parallel`): the serial traversal's blocks of base tiles,
-//! planned in its order (its splits and its pruning by density bounds), then taken on
-//! rayon's thread pool. [`Sampler::query_par_runs`] returns each block's points as a run;
+//! planned in its order (its splits and its pruning by density bounds) as they are taken
+//! on rayon's thread pool, a window of them in flight. [`Sampler::query_par_runs`] returns each block's points as a run;
 //! [`Sampler::query_par`] keeps each block's points compactly and builds them into the
 //! output in order while later blocks are still being computed; [`Sampler::query_par_ordered`]
 //! hands each block's points, mapped on the pool, to the caller in order with a bounded
@@ -385,10 +385,9 @@ impl<'a, D: Density + Sync + ?Sized> Fork<'a, D> {
                 spawned += 1;
             }
             let mut waiting = BTreeMap::new();
-            for i in 0.. {
-                if i == spawned {
-                    break;
-                }
+            // Block `i` handed over, the next one spawned, until none is in flight.
+            let mut i = 0;
+            while i < spawned {
                 // `None`: the block's task unwound, and the scope re-raises it.
                 let Some(t) = next_in_order(&receiver, &mut waiting, i) else {
                     break;
@@ -396,6 +395,7 @@ impl<'a, D: Density + Sync + ?Sized> Fork<'a, D> {
                 if consume(t).is_break() {
                     break;
                 }
+                i += 1;
                 if let Some(block) = blocks.next() {
                     spawn(spawned, block);
                     spawned += 1;

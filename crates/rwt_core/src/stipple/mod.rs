@@ -355,9 +355,7 @@ impl StippleSettings {
         }
         Ok(())
     }
-}
 
-impl StippleSettings {
     /// The checks that need only the image's size: numbers in range, and the raster and
     /// the dot count (of [`DotCount::Auto`] and [`DotCount::Points`]) within the limits.
     /// [`stipple`] makes them first; a tool makes them from an image file's header, before

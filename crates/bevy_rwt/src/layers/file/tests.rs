@@ -154,6 +154,11 @@ fn rejects_bad_files_with_reasons() {
     assert!(err(&far).contains("more than 256 chunks"), "{}", err(&far));
     let zero = MEADOW.replace("load_distance: 48.0", "load_distance: 0.0");
     assert!(err(&zero).contains("load_distance 0 must be positive"));
+}
+
+#[test]
+fn numbers_out_of_range_and_unknown_fields_are_refused_by_name() {
+    let err = |t: &str| LayerDescription::from_ron(t).unwrap_err().to_string();
     // Numbers that loaded and then streamed nothing, streamed without end or drew garbage.
     for (from, to, words) in [
         (
