@@ -31,6 +31,7 @@ fn main() {
                 .enable::<RwtBrushPlugin>(),
             SmokePlugin,
             HudPlugin,
+            BrushStatusPlugin,
         ))
         .add_systems(Startup, setup)
         .add_systems(
@@ -183,7 +184,7 @@ fn setup(
     *brush = DensityBrush {
         enabled: true,
         targets: (0..CLASSES.len())
-            .map(|i| BrushTarget::new(canvas.layer, i, CLASSES[i].name))
+            .map(|i| NamedMap::new(canvas.layer, i, CLASSES[i].name))
             .collect(),
         radius: 0.06,
         radius_range: (0.005, 0.5),
@@ -244,7 +245,7 @@ fn clear_all(dabs: &mut MessageWriter<PaintDab>) {
 fn paint_script(
     smoke: Res<Smoke>,
     mut step: Local<u8>,
-    brush: Res<DensityBrush>,
+    status: Res<BrushStatus>,
     mut dabs: MessageWriter<PaintDab>,
     mut commands: MessageWriter<BrushCommand>,
     mut exit: MessageWriter<AppExit>,
@@ -281,8 +282,8 @@ fn paint_script(
         return;
     }
     // Save, clear, load: a step a frame, the brush's outcome checked before the next.
-    if *step > 0 && *step < 4 && !matches!(brush.last, Some(Ok(_))) {
-        eprintln!("rwt-smoke: painted maps, step {}: {:?}", *step, brush.last);
+    if *step > 0 && *step < 4 && !matches!(status.last, Some(Ok(_))) {
+        eprintln!("rwt-smoke: painted maps, step {}: {:?}", *step, status.last);
         exit.write(AppExit::error());
         return;
     }
@@ -432,6 +433,7 @@ fn show_maps(
 fn hud(
     canvas: Res<Canvas>,
     brush: Res<DensityBrush>,
+    status: Res<BrushStatus>,
     live: Res<LiveInstances>,
     mut hud: ResMut<Hud>,
 ) {
@@ -444,11 +446,7 @@ fn hud(
             format!("{mark}{} {}", i + 1, t.name)
         })
         .collect();
-    let last = match &brush.last {
-        Some(Ok(done)) => done.clone(),
-        Some(Err(e)) => format!("failed: {e}"),
-        None => String::new(),
-    };
+    let last = status.line();
     hud.lines = vec![
         "rwt paint_density: left paint, right erase, 1-4 class, wheel or [ ] size, Up/Down strength".into(),
         "Z undo, C clear, Space random/blue noise, S save, L load".into(),

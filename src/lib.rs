@@ -1,10 +1,12 @@
 //! What the examples share: the scripted smoke session that lets CI run each example in a
-//! real renderer ([`smoke`]), a fly camera ([`fly_camera`]) and a text HUD ([`hud`]).
+//! real renderer ([`smoke`]), a fly camera ([`fly_camera`]), a text HUD ([`hud`]) and the
+//! brush's last answer for it ([`brush_status`]).
 //!
 //! Run an example as a user would (`cargo run --release --example open_world`), or as CI
 //! does: `RWT_SCREENSHOT=out.png cargo run --example open_world` plays the example's script,
 //! saves a screenshot, prints `rwt-smoke: ... instances N` and exits with status 0.
 
+pub mod brush_status;
 pub mod fly_camera;
 pub mod foliage;
 pub mod hud;
@@ -16,20 +18,24 @@ use bevy::window::{PresentMode, WindowResolution};
 
 /// Everything an example needs from here.
 pub mod prelude {
+    pub use crate::brush_status::{BrushStatus, BrushStatusPlugin};
     pub use crate::fly_camera::{FlyCamera, FlyCameraPlugin};
     pub use crate::hud::{Hud, HudPlugin};
     pub use crate::smoke::{CountedInstance, LiveInstances, Smoke, SmokePlugin, SmokeReport};
     pub use crate::{example_plugins, textons_dir};
 }
 
-/// Bevy's default plugins with a 1280 x 720 window titled `title`; without vsync while a
-/// smoke session runs, so software rendering stays quick.
+/// Bevy's default plugins with a window titled `title`, 1280 x 720 unless
+/// `RWT_WINDOW=WIDTHxHEIGHT` asks for another size (CI's smoke runs render a quarter of the
+/// pixels on the CPU); without vsync while a smoke session runs, so software rendering
+/// stays quick.
 pub fn example_plugins(title: &str) -> impl PluginGroup {
     let smoke = smoke::Smoke::from_env();
-    let (width, height, present_mode) = if smoke.active() {
-        (1280, 720, PresentMode::AutoNoVsync)
+    let (width, height) = window_size_from_env().unwrap_or((1280, 720));
+    let present_mode = if smoke.active() {
+        PresentMode::AutoNoVsync
     } else {
-        (1280, 720, PresentMode::AutoVsync)
+        PresentMode::AutoVsync
     };
     DefaultPlugins.set(WindowPlugin {
         primary_window: Some(Window {
@@ -42,7 +48,20 @@ pub fn example_plugins(title: &str) -> impl PluginGroup {
     })
 }
 
+/// `RWT_WINDOW=WIDTHxHEIGHT`, when set to a size of 64 to 4096 pixels a side.
+fn window_size_from_env() -> Option<(u32, u32)> {
+    let text = std::env::var("RWT_WINDOW").ok()?;
+    let (w, h) = text.trim().split_once('x')?;
+    let size = |v: &str| v.parse::<u32>().ok().filter(|v| (64..=4096).contains(v));
+    Some((size(w)?, size(h)?))
+}
+
 /// Where the texton images live (`assets/textons`, drawn by `scripts/make_textons.py`).
 pub fn textons_dir() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/textons")
 }
+
+/// The README's examples, compiled and run as doctests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

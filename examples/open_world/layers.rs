@@ -1,7 +1,7 @@
 //! The vegetation: every plant and rock is placed by a `bevy_rwt` layer (none by hand).
 
 use bevy::prelude::*;
-use bevy_rwt::brush::{BrushTarget, DensityBrush};
+use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::layers::file::NamedAssets;
 use bevy_rwt::look::blade_mesh;
 use bevy_rwt::prelude::*;
@@ -63,8 +63,8 @@ pub fn setup_layers(
     brush.targets = flower_targets
         .into_iter()
         .enumerate()
-        .map(|(class, name)| BrushTarget::new(flowers, class, name))
-        .chain([BrushTarget::new(bushes, 0, "bushes")])
+        .map(|(class, name)| NamedMap::new(flowers, class, name))
+        .chain([NamedMap::new(bushes, 0, "bushes")])
         .collect();
     brush.save_dir = std::env::var_os("RWT_PAINT_DIR").map_or("painted".into(), Into::into);
 }

@@ -44,6 +44,7 @@ fn main() {
             SmokePlugin,
             HudPlugin,
             FlyCameraPlugin,
+            BrushStatusPlugin,
         ))
         .add_plugins((
             // Five layers stream at once: more generation tasks in flight per layer.
@@ -264,6 +265,7 @@ fn hud(
     time: Res<Time>,
     stats: Res<RwtStats>,
     brush: Res<DensityBrush>,
+    status: Res<BrushStatus>,
     wind: Res<RwtWind>,
     fade: Res<RwtFadeIn>,
     layers: Query<(&Name, &ScatterLayerStatus)>,
@@ -310,7 +312,7 @@ fn hud(
             on(wind.strength > 0.0),
             on(fade.0),
             on(taa),
-            brush_line(&brush)
+            brush_line(&brush, &status)
         ),
     ];
     if brush.enabled {
@@ -319,7 +321,7 @@ fn hud(
     }
 }
 
-fn brush_line(brush: &DensityBrush) -> String {
+fn brush_line(brush: &DensityBrush, status: &BrushStatus) -> String {
     if !brush.enabled {
         return "brush off (B)".into();
     }
@@ -332,11 +334,7 @@ fn brush_line(brush: &DensityBrush) -> String {
             format!("{}{mark}{}", i + 1, t.name)
         })
         .collect();
-    let last = match &brush.last {
-        Some(Ok(s)) => s.clone(),
-        Some(Err(e)) => format!("error: {e}"),
-        None => String::new(),
-    };
+    let last = status.line();
     format!(
         "brush: {} | radius {:.1} m, strength {} {last}",
         names.join(" "),

@@ -299,20 +299,21 @@ fn stroke(
 fn save_painting(
     gameplay: Res<Play>,
     mut script: ResMut<Script>,
-    mut brush: ResMut<DensityBrush>,
+    brush: Res<DensityBrush>,
     mut report: ResMut<SmokeReport>,
     mut commands: MessageWriter<BrushCommand>,
+    mut saved: MessageReader<WorldSaved>,
 ) {
     match script.save {
         Save::NotYet if report.painted.is_some() && gameplay.done() => {
-            brush.last = None;
             commands.write(BrushCommand::Save(brush.save_dir.clone()));
             script.save = Save::Asked;
         }
         Save::Asked => {
-            if let Some(outcome) = &brush.last {
-                match outcome {
-                    Ok(done) => eprintln!("rwt-smoke: brush {done}"),
+            if let Some(answer) = saved.read().last() {
+                let to = answer.dir.display();
+                match &answer.result {
+                    Ok(done) => eprintln!("rwt-smoke: brush {done} to {to}"),
                     Err(e) => eprintln!("rwt-smoke: brush save failed: {e}"),
                 }
                 script.save = Save::Reported;

@@ -11,12 +11,12 @@
 //! Exit status 0 when accepted, 2 when refused (the reason on standard error).
 
 use bevy::prelude::Handle;
-use bevy_rwt::brush::PaintedMaps;
 use bevy_rwt::layers::file::{LayerDescription, MAX_LAYER_FILE_BYTES, NamedAssets};
 use bevy_rwt::rwt_core::density::decode_image;
 use bevy_rwt::rwt_core::edits::{EditSet, EditStamp, MAX_EDITS_FILE_BYTES};
 use bevy_rwt::rwt_core::files::read_limited;
 use bevy_rwt::rwt_core::tileset::TileSet;
+use bevy_rwt::save::PaintedMaps;
 use std::path::Path;
 use std::process::ExitCode;
 

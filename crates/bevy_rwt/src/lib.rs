@@ -154,6 +154,7 @@ pub mod instancing;
 pub mod layers;
 pub mod look;
 pub mod picking;
+pub mod save;
 mod settings;
 pub mod streaming;
 #[cfg(feature = "testing")]
@@ -187,13 +188,14 @@ pub use viewers::{RwtViewer, RwtViewersPlugin, ViewCone};
 pub mod prelude {
     #[cfg(feature = "brush")]
     pub use crate::brush::{
-        BrushCommand, BrushSystems, BrushTarget, DensityBrush, PaintDab, RwtBrushPlugin,
+        BrushCommand, BrushOutcome, BrushSystems, DensityBrush, PaintDab, RwtBrushPlugin,
     };
     pub use crate::edits::{EditInstance, InstanceEdit, ScatterEdits};
     pub use crate::footprints::{Footprint, FootprintShape};
     pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
     pub use crate::layers::file::{NamedAssets, ScatterLayerAsset, ScatterLayerSource};
     pub use crate::picking::{PickFilter, ScatterHit, ScatterPicking};
+    pub use crate::save::{LoadWorld, NamedMap, RwtSavePlugin, SaveWorld, WorldLoaded, WorldSaved};
     pub use crate::{
         AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundMap,
         GroundPlane, HeightSource, InstancedChunk, InstancedShading, InstancedShadows,
@@ -220,6 +222,7 @@ pub mod prelude {
 /// | [`streaming::RwtStreamingPlugin`] | nothing is placed |
 /// | [`diagnostics::RwtDiagnosticsPlugin`] | no [`RwtStats`], no `rwt/` diagnostics |
 /// | [`instancing::RwtInstancingPlugin`] | instanced classes stream and are counted, not drawn |
+/// | [`save::RwtSavePlugin`] | no world saves (the brush adds it back) |
 /// | [`gizmos::RwtGizmosPlugin`] (disabled) | no chunk and tile outlines |
 /// | `brush::RwtBrushPlugin` (disabled; feature `brush`) | no painting |
 ///
@@ -306,6 +309,7 @@ impl PluginGroup for RwtPlugins {
             .add(streaming)
             .add(diagnostics::RwtDiagnosticsPlugin::new(schedule))
             .add(instancing::RwtInstancingPlugin::new(schedule))
+            .add(save::RwtSavePlugin::new(schedule))
             .add(gizmos::RwtGizmosPlugin)
             .disable::<gizmos::RwtGizmosPlugin>();
         #[cfg(feature = "brush")]
@@ -325,3 +329,8 @@ impl Plugin for RwtSettingsPlugin {
         app.insert_resource(self.0.clone());
     }
 }
+
+/// The README's examples, compiled and run as doctests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -3,10 +3,13 @@
 mod common;
 
 use bevy::prelude::*;
-use bevy_rwt::brush::{BrushError, MapAccess, PaintedMaps};
+use bevy_rwt::brush::{BrushError, BrushOutcome};
 use bevy_rwt::edits::{EditInstance, ScatterEdits};
 use bevy_rwt::layers::file::NamedAssets;
 use bevy_rwt::prelude::*;
+use bevy_rwt::save::{
+    LoadSummary, MapError, MapProblem, PaintedMaps, SaveError, SaveSummary, WorldLoaded, WorldSaved,
+};
 use common::*;
 use rwt_core::files::FileError;
 use std::collections::BTreeMap;
@@ -30,9 +33,9 @@ fn painted_app() -> (App, Handle<Image>) {
         .id();
     let mut brush = app.world_mut().resource_mut::<DensityBrush>();
     brush.targets = vec![
-        BrushTarget::new(meadow, 0, "meadow"),
-        BrushTarget::new(constant, 0, "constant"),
-        BrushTarget::new(meadow, 7, "no class"),
+        NamedMap::new(meadow, 0, "meadow"),
+        NamedMap::new(constant, 0, "constant"),
+        NamedMap::new(meadow, 7, "no class"),
     ];
     tick_app(&mut app, 2_000);
     (app, map)
@@ -52,11 +55,40 @@ fn stroke(app: &mut App, target: usize, centre: Vec2, amount: f32, frames: usize
     app.update();
 }
 
-fn command(app: &mut App, command: BrushCommand) -> Result<String, BrushError> {
-    app.world_mut().write_message(command);
+/// The last outcome of a dab or an undo, if any came.
+fn last_outcome(app: &mut App) -> Option<BrushOutcome> {
+    let mut outcomes = app.world_mut().resource_mut::<Messages<BrushOutcome>>();
+    outcomes.drain().last()
+}
+
+/// Undoes the last stroke: how many strokes are left, or why not.
+fn undo(app: &mut App) -> Result<usize, BrushError> {
+    app.world_mut().write_message(BrushCommand::Undo);
     app.update();
-    let last = app.world_mut().resource_mut::<DensityBrush>().last.take();
-    last.expect("the command reports")
+    match last_outcome(app).expect("the undo reports") {
+        BrushOutcome::Undone { strokes_left } => Ok(strokes_left),
+        BrushOutcome::Failed(e) => Err(e),
+    }
+}
+
+/// Saves the brush's maps and the edits to `dir` (the save answers in the same frame).
+fn save(app: &mut App, dir: &Path) -> Result<SaveSummary, SaveError> {
+    app.world_mut()
+        .write_message(BrushCommand::Save(dir.to_path_buf()));
+    app.update();
+    let mut answers = app.world_mut().resource_mut::<Messages<WorldSaved>>();
+    let answer = answers.drain().last().expect("the save answers");
+    assert_eq!(answer.dir, dir);
+    answer.result
+}
+
+/// Loads `dir` into the brush's maps and the named layers.
+fn load(app: &mut App, dir: &Path) -> Result<LoadSummary, SaveError> {
+    app.world_mut()
+        .write_message(BrushCommand::Load(dir.to_path_buf()));
+    app.update();
+    let mut answers = app.world_mut().resource_mut::<Messages<WorldLoaded>>();
+    answers.drain().last().expect("the load answers").result
 }
 
 #[test]
@@ -84,7 +116,7 @@ fn a_stroke_scatters_under_the_brush_only_and_undo_takes_it_back() {
     stroke(&mut app, 0, centre + Vec2::X * 4.0, 0.5, 1);
     tick_app(&mut app, 2_000);
     assert!(instances(&mut app).len() > painted.len());
-    command(&mut app, BrushCommand::Undo).unwrap();
+    undo(&mut app).unwrap();
     tick_app(&mut app, 2_000);
     assert_eq!(
         instances(&mut app)
@@ -92,13 +124,10 @@ fn a_stroke_scatters_under_the_brush_only_and_undo_takes_it_back() {
             .collect::<std::collections::HashSet<_>>(),
         painted.keys().collect()
     );
-    command(&mut app, BrushCommand::Undo).unwrap();
+    undo(&mut app).unwrap();
     tick_app(&mut app, 2_000);
     assert!(instances(&mut app).keys().all(|id| blank.contains_key(id)));
-    assert!(matches!(
-        command(&mut app, BrushCommand::Undo),
-        Err(BrushError::NothingToUndo)
-    ));
+    assert!(matches!(undo(&mut app), Err(BrushError::NothingToUndo)));
 }
 
 #[test]
@@ -133,10 +162,7 @@ fn dabs_that_change_nothing_leave_the_map_and_its_chunks_alone() {
     }
     assert_eq!(instances(&mut app), before);
     // Nothing to undo either.
-    assert!(matches!(
-        command(&mut app, BrushCommand::Undo),
-        Err(BrushError::NothingToUndo)
-    ));
+    assert!(matches!(undo(&mut app), Err(BrushError::NothingToUndo)));
 }
 
 #[test]
@@ -153,11 +179,14 @@ fn maps_save_and_load_into_another_world() {
         .targets
         .truncate(1);
     name_marker_assets(&app);
-    let saved = command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
-    assert!(
-        saved.contains("saved 1 maps, 1 layer files and 0 edits"),
-        "{saved}"
-    );
+    let saved = save(&mut app, &dir).unwrap();
+    let expected = SaveSummary {
+        maps: 1,
+        layer_files: 1,
+        edits: 0,
+    };
+    assert_eq!(saved, expected);
+    assert_eq!(saved.to_string(), "saved 1 maps, 1 layer files and 0 edits");
     let index = PaintedMaps::read(&dir).unwrap();
     assert_eq!(index.maps.len(), 1);
     assert_eq!(
@@ -166,8 +195,8 @@ fn maps_save_and_load_into_another_world() {
     );
 
     let (mut fresh, _) = painted_app();
-    let loaded = command(&mut fresh, BrushCommand::Load(dir.clone())).unwrap();
-    assert!(loaded.contains("loaded 1 maps"), "{loaded}");
+    let loaded = load(&mut fresh, &dir).unwrap();
+    assert_eq!(loaded, LoadSummary { maps: 1, edits: 0 });
     tick_app(&mut fresh, 2_000);
     assert_eq!(instances(&mut fresh), painted);
 
@@ -216,9 +245,9 @@ fn layers_a_file_cannot_name_still_save_their_maps() {
         .resource_mut::<DensityBrush>()
         .targets
         .truncate(1);
-    let err = command(&mut app, BrushCommand::Save(dir.clone())).unwrap_err();
+    let err = save(&mut app, &dir).unwrap_err();
     match &err {
-        BrushError::LayerNotSaved { layers } => {
+        SaveError::LayerNotSaved { layers } => {
             let why = err.to_string();
             assert!(layers.len() == 1 && layers[0].name == "meadow", "{why}");
             assert!(why.contains("meadow: ") && why.contains("mesh"), "{why}")
@@ -235,33 +264,33 @@ fn layers_a_file_cannot_name_still_save_their_maps() {
 fn bad_targets_and_files_are_typed_errors() {
     let (mut app, _) = painted_app();
     let before = instances(&mut app);
+    let map_error = |map: &str, problem| {
+        BrushError::Map(MapError {
+            map: map.into(),
+            problem,
+        })
+    };
     for (target, expected) in [
-        (
-            1,
-            BrushError::NotPaintable {
-                target: "constant".into(),
-            },
-        ),
-        (
-            2,
-            BrushError::NoLayer {
-                target: "no class".into(),
-            },
-        ),
+        (1, map_error("constant", MapProblem::NotAnImage)),
+        (2, map_error("no class", MapProblem::NoLayer)),
         (9, BrushError::NoTarget(9)),
     ] {
-        stroke(&mut app, target, Vec2::ZERO, 1.0, 1);
-        let last = app.world_mut().resource_mut::<DensityBrush>().last.take();
-        // Errors holding I/O and parser errors are not comparable: their debug forms are.
-        assert_eq!(
-            format!("{last:?}"),
-            format!("{:?}", Some(Err::<String, _>(expected)))
-        );
+        app.world_mut().write_message(PaintDab {
+            target,
+            centre: Vec2::ZERO,
+            radius: 8.0,
+            amount: 1.0,
+        });
+        app.update();
+        match last_outcome(&mut app) {
+            Some(BrushOutcome::Failed(e)) => assert_eq!(e, expected),
+            other => panic!("{other:?}"),
+        }
     }
     let missing = std::env::temp_dir().join("rwt-brush-no-such-dir");
     assert!(matches!(
-        command(&mut app, BrushCommand::Load(missing)),
-        Err(BrushError::File(FileError::Io { .. }))
+        load(&mut app, &missing),
+        Err(SaveError::File(FileError::Io { .. }))
     ));
     tick_app(&mut app, 2_000);
     assert_eq!(instances(&mut app), before);
@@ -343,7 +372,7 @@ fn two_map_app(names: [&str; 2], seed: u32) -> App {
             .world_mut()
             .spawn((Name::new(format!("layer {name}")), scatter))
             .id();
-        targets.push(BrushTarget::new(layer, 0, name));
+        targets.push(NamedMap::new(layer, 0, name));
     }
     app.world_mut().resource_mut::<DensityBrush>().targets = targets;
     name_marker_assets(&app);
@@ -385,8 +414,8 @@ fn edits_save_and_load_with_the_maps() {
         chopped.len() + count == unedited.len(),
         "every edit removed one"
     );
-    let saved = command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
-    assert!(saved.contains(&format!("and {count} edits")), "{saved}");
+    let saved = save(&mut app, &dir).unwrap();
+    assert_eq!(saved.edits, count);
     let index = PaintedMaps::read(&dir).unwrap();
     let files: Vec<_> = index.edits.iter().map(|e| e.file.as_str()).collect();
     assert_eq!(files, ["layer_meadow.edits", "layer_noise.edits"]);
@@ -401,8 +430,8 @@ fn edits_save_and_load_with_the_maps() {
 
     // Another world of the same layers gets the chopped world back.
     let mut fresh = two_map_app(["meadow", "noise"], 1);
-    let loaded = command(&mut fresh, BrushCommand::Load(dir.clone())).unwrap();
-    assert!(loaded.contains(&format!("and {count} edits")), "{loaded}");
+    let loaded = load(&mut fresh, &dir).unwrap();
+    assert_eq!(loaded.edits, count);
     tick_app(&mut fresh, 2_000);
     assert_eq!(edits_by_name(&mut fresh), edits);
     assert_eq!(layered(&mut fresh), chopped);
@@ -421,9 +450,9 @@ fn edits_save_and_load_with_the_maps() {
         (b"RWTE".to_vec(), "header only"),
     ] {
         std::fs::write(&file, &bad).unwrap();
-        let err = command(&mut other, BrushCommand::Load(dir.clone())).unwrap_err();
+        let err = load(&mut other, &dir).unwrap_err();
         assert!(
-            matches!(&err, BrushError::Edits { file: f, .. } if f.ends_with("layer_noise.edits")),
+            matches!(&err, SaveError::Edits { file: f, .. } if f.ends_with("layer_noise.edits")),
             "{check}: {err:?}"
         );
         tick_app(&mut other, 2_000);
@@ -448,7 +477,7 @@ fn edits_save_and_load_with_the_maps() {
     other.world_mut().entity_mut(layer).insert(reseeded);
     tick_app(&mut other, 2_000);
     let before = (layered(&mut other), edits_by_name(&mut other));
-    let err = command(&mut other, BrushCommand::Load(dir.clone())).unwrap_err();
+    let err = load(&mut other, &dir).unwrap_err();
     assert!(err.to_string().contains("not seed 555"), "{err}");
     tick_app(&mut other, 2_000);
     assert_eq!((layered(&mut other), edits_by_name(&mut other)), before);
@@ -462,7 +491,7 @@ fn edits_save_and_load_with_the_maps() {
 fn save_on_a_full_disk() {
     let dir = PathBuf::from(std::env::var_os("RWT_FULL_DISK_DIR").expect("the parent's folder"));
     let mut app = two_map_app(["meadow", "noise"], 2);
-    let err = command(&mut app, BrushCommand::Save(dir)).unwrap_err();
+    let err = save(&mut app, &dir).unwrap_err();
     println!("rwt-child: {err}");
 }
 
@@ -474,7 +503,7 @@ fn a_full_disk_during_a_save_keeps_the_previous_save() {
     tick_app(&mut app, 2_000);
     chop_some(&mut app, 40);
     let painted = layered(&mut app);
-    command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
+    save(&mut app, &dir).unwrap();
     let before = folder(&dir);
     assert_eq!(before.len(), 7, "{:?}", before.keys());
     assert!(before["noise.png"].len() > 60_000);
@@ -501,7 +530,7 @@ fn a_full_disk_during_a_save_keeps_the_previous_save() {
     assert_eq!(folder(&dir), before, "the previous save changed");
     // And it still loads: the first world comes back.
     let mut fresh = two_map_app(["meadow", "noise"], 7);
-    command(&mut fresh, BrushCommand::Load(dir.clone())).unwrap();
+    load(&mut fresh, &dir).unwrap();
     tick_app(&mut fresh, 2_000);
     assert_eq!(layered(&mut fresh), painted);
     std::fs::remove_dir_all(&dir).ok();
@@ -511,7 +540,7 @@ fn a_full_disk_during_a_save_keeps_the_previous_save() {
 fn a_save_that_fails_part_way_changes_no_file() {
     let dir = scratch("part-way");
     let mut app = two_map_app(["meadow", "noise"], 1);
-    command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
+    save(&mut app, &dir).unwrap();
     let before = folder(&dir);
     // More paint, and a third target whose map cannot be read on the CPU: its map fails
     // after the other two are staged.
@@ -536,13 +565,13 @@ fn a_save_that_fails_part_way_changes_no_file() {
     app.world_mut()
         .resource_mut::<DensityBrush>()
         .targets
-        .push(BrushTarget::new(odd, 0, "odd"));
-    let err = command(&mut app, BrushCommand::Save(dir.clone())).unwrap_err();
-    let bc1 = MapAccess::NotOnCpu {
+        .push(NamedMap::new(odd, 0, "odd"));
+    let err = save(&mut app, &dir).unwrap_err();
+    let bc1 = MapProblem::NotOnCpu {
         format: bevy::render::render_resource::TextureFormat::Bc1RgbaUnorm,
     };
     assert!(
-        matches!(&err, BrushError::MapUnavailable { target, why } if target == "odd" && *why == bc1),
+        matches!(&err, SaveError::Map(MapError { map, problem }) if map == "odd" && *problem == bc1),
         "{err:?}"
     );
     assert_eq!(folder(&dir), before);
@@ -553,7 +582,7 @@ fn a_save_that_fails_part_way_changes_no_file() {
 fn a_load_with_a_bad_map_changes_nothing_and_keeps_undo() {
     let dir = scratch("bad-map");
     let mut app = two_map_app(["meadow", "noise"], 1);
-    command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
+    save(&mut app, &dir).unwrap();
     let png = std::fs::read(dir.join("noise.png")).unwrap();
     // A stroke after the save: what a failed load must keep, undo included.
     stroke(&mut app, 0, Vec2::new(30.0, -12.0), 0.8, 2);
@@ -572,15 +601,15 @@ fn a_load_with_a_bad_map_changes_nothing_and_keeps_undo() {
     let noise = dir.join("noise.png");
     for (bad, check) in [
         (png[..png.len() / 2].to_vec(), "truncated"),
-        (small, "16x16 map, the target's is 256x256"),
+        (small, "16x16 map, the world's is 256x256"),
         (b"(not an image)".to_vec(), "cannot decode"),
     ] {
         std::fs::write(&noise, &bad).unwrap();
-        let err = command(&mut app, BrushCommand::Load(dir.clone())).unwrap_err();
+        let err = load(&mut app, &dir).unwrap_err();
         let text = err.to_string();
         assert!(text.contains("noise.png"), "{check}: {text}");
         assert!(
-            matches!(err, BrushError::Decode { .. } | BrushError::MapSize { .. }),
+            matches!(err, SaveError::Decode { .. } | SaveError::MapSize { .. }),
             "{check}: {err:?}"
         );
         if check != "truncated" {
@@ -591,21 +620,21 @@ fn a_load_with_a_bad_map_changes_nothing_and_keeps_undo() {
     }
     std::fs::remove_file(&noise).unwrap();
     assert!(matches!(
-        command(&mut app, BrushCommand::Load(dir.clone())),
-        Err(BrushError::File(FileError::Io { .. }))
+        load(&mut app, &dir),
+        Err(SaveError::File(FileError::Io { .. }))
     ));
     // Good maps, but a layer file of the save is broken: nothing is loaded either.
     std::fs::write(&noise, &png).unwrap();
     std::fs::write(dir.join("layer_meadow.layer.ron"), "(classes: [").unwrap();
-    let err = command(&mut app, BrushCommand::Load(dir.clone())).unwrap_err();
+    let err = load(&mut app, &dir).unwrap_err();
     assert!(
-        matches!(&err, BrushError::Parse { file, .. } if file.ends_with("layer_meadow.layer.ron")),
+        matches!(&err, SaveError::Parse { file, .. } if file.ends_with("layer_meadow.layer.ron")),
         "{err:?}"
     );
     tick_app(&mut app, 2_000);
     assert_eq!(layered(&mut app), painted);
     // The stroke can still be undone.
-    command(&mut app, BrushCommand::Undo).unwrap();
+    undo(&mut app).unwrap();
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -617,20 +646,20 @@ fn maps_of_colliding_names_round_trip() {
     stroke(&mut app, 0, Vec2::new(-5.0, 20.0), 0.8, 2);
     tick_app(&mut app, 2_000);
     let painted = layered(&mut app);
-    command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
+    save(&mut app, &dir).unwrap();
     let index = PaintedMaps::read(&dir).unwrap();
     let files: Vec<&str> = index.maps.iter().map(|m| m.map.path.as_str()).collect();
     assert_eq!(files, ["red_flowers.png", "red_flowers-2.png"]);
     let mut fresh = two_map_app(["red flowers", "red_flowers"], 9);
-    command(&mut fresh, BrushCommand::Load(dir.clone())).unwrap();
+    load(&mut fresh, &dir).unwrap();
     tick_app(&mut fresh, 2_000);
     assert_eq!(layered(&mut fresh), painted);
     // Two targets of one name cannot be told apart in a save: refused, nothing written.
     let mut twins = two_map_app(["same", "same"], 3);
     let other = scratch("twins");
     assert!(matches!(
-        command(&mut twins, BrushCommand::Save(other.clone())),
-        Err(BrushError::DuplicateTarget { name }) if name == "same"
+        save(&mut twins, &other),
+        Err(SaveError::DuplicateMap { name }) if name == "same"
     ));
     assert!(!other.exists());
     std::fs::remove_dir_all(&dir).ok();
@@ -649,7 +678,7 @@ fn a_layer_on_the_2d_plane_is_painted_saved_and_loaded() {
         .id();
     {
         let mut brush = app.world_mut().resource_mut::<DensityBrush>();
-        brush.targets = vec![BrushTarget::new(sprites, 0, "sprites")];
+        brush.targets = vec![NamedMap::new(sprites, 0, "sprites")];
         brush.layer_files = false;
     }
     tick_app(&mut app, 2_000);
@@ -671,12 +700,12 @@ fn a_layer_on_the_2d_plane_is_painted_saved_and_loaded() {
     }
     // Saved without layer files (sprites made in code have none), cleared, loaded back.
     let dir = scratch("plane-xy");
-    let saved = command(&mut app, BrushCommand::Save(dir.clone())).unwrap();
-    assert!(saved.starts_with("saved 1 maps, 0 layer files"), "{saved}");
+    let saved = save(&mut app, &dir).unwrap();
+    assert_eq!((saved.maps, saved.layer_files), (1, 0));
     stroke(&mut app, 0, centre, -20.0, 1);
     tick_app(&mut app, 2_000);
     assert!(instances(&mut app).is_empty());
-    command(&mut app, BrushCommand::Load(dir.clone())).unwrap();
+    load(&mut app, &dir).unwrap();
     tick_app(&mut app, 2_000);
     assert_eq!(instances(&mut app), painted);
     std::fs::remove_dir_all(&dir).ok();

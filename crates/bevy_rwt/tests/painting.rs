@@ -194,3 +194,45 @@ fn a_layer_on_the_xy_plane_places_sprites_in_two_dimensions() {
     );
     let _ = viewer;
 }
+
+#[test]
+fn a_map_over_the_pixel_limit_fails_its_layer_with_the_reason() {
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+    use bevy_rwt::AssetProblem;
+    let mut app = create_app();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    // 20000 x 20000 texels declared, none allocated: the size alone is refused.
+    let huge = Image::new_uninit(
+        Extent3d {
+            width: 20_000,
+            height: 20_000,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        TextureFormat::R8Unorm,
+        Default::default(),
+    );
+    let handle = app.world_mut().resource_mut::<Assets<Image>>().add(huge);
+    let density = LayerDensity::Image(GroundMap {
+        image: handle,
+        min: Vec2::splat(-64.0),
+        size: Vec2::splat(128.0),
+        scale: 1.0,
+    });
+    let layer = app.world_mut().spawn(layer(density)).id();
+    for _ in 0..5 {
+        app.update();
+    }
+    let status = app.world().get::<ScatterLayerStatus>(layer).unwrap();
+    let AssetStatus::Failed(why) = &status.assets else {
+        panic!("{:?}", status.assets);
+    };
+    let expected = AssetProblem::TooLarge {
+        width: 20_000,
+        height: 20_000,
+        limit: rwt_core::density::MAX_IMAGE_PIXELS,
+    };
+    assert_eq!(why[0].why, expected);
+    assert!(why[0].to_string().contains("20000x20000"), "{}", why[0]);
+    assert_eq!(app.world().resource::<RwtStats>().live_entities, 0);
+}

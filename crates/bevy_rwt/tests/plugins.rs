@@ -70,7 +70,7 @@ fn every_part_runs_in_the_schedule_it_is_given_the_brush_first() {
     let meadow = app.world_mut().spawn(layer(density)).id();
     app.world_mut().spawn(layer(LayerDensity::Constant(0.2)));
     app.world_mut().resource_mut::<DensityBrush>().targets =
-        vec![BrushTarget::new(meadow, 0, "meadow")];
+        vec![NamedMap::new(meadow, 0, "meadow")];
     // `Update` alone streams nothing, and paints nothing.
     let dab = PaintDab {
         target: 0,

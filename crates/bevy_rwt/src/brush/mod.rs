@@ -14,7 +14,8 @@
 //!
 //! ```no_run
 //! use bevy::prelude::*;
-//! use bevy_rwt::brush::{BrushTarget, DensityBrush, RwtBrushPlugin};
+//! use bevy_rwt::brush::{DensityBrush, RwtBrushPlugin};
+//! use bevy_rwt::save::NamedMap;
 //! use bevy_rwt::prelude::*;
 //!
 //! fn setup(mut commands: Commands, mut images: ResMut<Assets<Image>>, mut brush: ResMut<DensityBrush>) {
@@ -25,7 +26,7 @@
 //!         Name::new("flowers"),
 //!         ScatterLayer::new(vec![ScatterClass::instanced(density, Handle::default(), InstancedShading::default())]),
 //!     )).id();
-//!     brush.targets.push(BrushTarget::new(flowers, 0, "flowers"));
+//!     brush.targets.push(NamedMap::new(flowers, 0, "flowers"));
 //!     brush.enabled = true;
 //! }
 //!
@@ -39,7 +40,8 @@
 //!
 //! ```
 //! use bevy::prelude::*;
-//! use bevy_rwt::brush::{BrushTarget, DensityBrush, RwtBrushPlugin};
+//! use bevy_rwt::brush::{DensityBrush, RwtBrushPlugin};
+//! use bevy_rwt::save::NamedMap;
 //! use bevy_rwt::prelude::*;
 //!
 //! let mut app = App::new();
@@ -54,7 +56,7 @@
 //! let class = ScatterClass::new(density, Handle::default(), Handle::default());
 //! let layer = app.world_mut().spawn(ScatterLayer::new(vec![class])).id();
 //! app.world_mut().spawn((RwtViewer::all_around(), Transform::default(), GlobalTransform::default()));
-//! app.world_mut().resource_mut::<DensityBrush>().targets.push(BrushTarget::new(layer, 0, "meadow"));
+//! app.world_mut().resource_mut::<DensityBrush>().targets.push(NamedMap::new(layer, 0, "meadow"));
 //! // One dab of 5 m at full strength: about 2 instances per square metre within it.
 //! app.world_mut().write_message(PaintDab { target: 0, centre: Vec2::ZERO, radius: 5.0, amount: 1.0 });
 //! assert!(bevy_rwt::testing::settle(&mut app, 10_000));
@@ -63,48 +65,22 @@
 //! ```
 
 mod paint;
-mod persist;
 mod plugin;
 mod ray;
 
 pub use paint::blank_map;
-pub use persist::{PaintedMapEntry, PaintedMaps, SavedEdits};
 pub use plugin::RwtBrushPlugin;
 pub use ray::ground_hit;
 
-use crate::layers::file::LayerFileError;
+use crate::save::{MapError, NamedMap};
 use bevy::prelude::*;
-use bevy::render::render_resource::TextureFormat;
 use std::path::PathBuf;
 
 /// The brush's systems (cursor, input, dabs, commands), in `Update` before
-/// [`crate::RwtSystems::Viewers`]; a script that places the brush itself runs after them.
+/// [`crate::save::SaveSystems`] and [`crate::RwtSystems::Viewers`]; a script that places the
+/// brush itself runs after them.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct BrushSystems;
-
-/// A class whose density map the brush paints: the class `class` of the layer on `layer`,
-/// shown to the player as `name`. Its density must be a [`crate::LayerDensity::Image`].
-#[derive(Clone, Debug, PartialEq, Reflect)]
-#[reflect(Clone, Debug, PartialEq)]
-pub struct BrushTarget {
-    /// The layer entity.
-    pub layer: Entity,
-    /// The class index in the layer.
-    pub class: usize,
-    /// Name shown in HUDs, and the file name of its map when saved.
-    pub name: String,
-}
-
-impl BrushTarget {
-    /// The class `class` of `layer`, called `name`.
-    pub fn new(layer: Entity, class: usize, name: impl Into<String>) -> Self {
-        Self {
-            layer,
-            class,
-            name: name.into(),
-        }
-    }
-}
 
 /// The keys and buttons of the brush (`None` turns one off).
 #[derive(Clone, Debug, Reflect)]
@@ -149,8 +125,8 @@ impl Default for BrushKeys {
 pub struct DensityBrush {
     /// Whether the cursor paints (the mouse is the game's otherwise).
     pub enabled: bool,
-    /// The maps it can paint.
-    pub targets: Vec<BrushTarget>,
+    /// The maps it can paint (each a class whose density is a [`crate::LayerDensity::Image`]).
+    pub targets: Vec<NamedMap>,
     /// Index of the selected target.
     pub selected: usize,
     /// Radius in world units.
@@ -173,10 +149,6 @@ pub struct DensityBrush {
     pub cursor: Option<Vec3>,
     /// Height of the gizmo circle above the ground (above the grass, so that it shows).
     pub circle_lift: f32,
-    /// Outcome of the last command or dab that could fail. Reflection does not see it (the
-    /// errors hold I/O and parser errors, which are not data).
-    #[reflect(ignore)]
-    pub last: Option<Result<String, BrushError>>,
 }
 
 impl DensityBrush {
@@ -184,7 +156,7 @@ impl DensityBrush {
     pub const STRENGTHS: [f32; 4] = [0.25, 0.5, 1.0, 2.0];
 
     /// The selected target.
-    pub fn target(&self) -> Option<&BrushTarget> {
+    pub fn target(&self) -> Option<&NamedMap> {
         self.targets.get(self.selected)
     }
 }
@@ -204,7 +176,6 @@ impl Default for DensityBrush {
             keys: BrushKeys::default(),
             cursor: None,
             circle_lift: 0.8,
-            last: None,
         }
     }
 }
@@ -229,180 +200,46 @@ pub struct PaintDab {
 #[derive(Message, Clone, Debug, PartialEq, Reflect)]
 #[reflect(Clone, Debug, PartialEq)]
 pub enum BrushCommand {
-    /// Restores the maps as they were before the last stroke.
+    /// Restores the maps as they were before the last stroke. Answered by a
+    /// [`BrushOutcome`].
     Undo,
-    /// Writes every target's map as a PNG, a layer file (`*.layer.ron`) per target layer
-    /// that reads the maps from beside it, and an index, [`PaintedMaps`], to the folder. The
-    /// folder is a painted world another game loads: put it in the assets and load the layer
-    /// files (see [`crate::layers::file`]; what they name must be in its
-    /// [`crate::layers::file::NamedAssets`]). All or nothing: every file is staged first
-    /// and renamed into place together, so a failure (a full disk, an unreadable map)
-    /// leaves the previous save complete.
+    /// Saves the world with every target's map ([`crate::save::SaveWorld`], with
+    /// [`DensityBrush::layer_files`]) to the folder: the maps as PNGs, a layer file
+    /// (`*.layer.ron`) per target layer that reads them from beside it, the edits of every
+    /// named layer and an index. The folder is a painted world another game loads: put it
+    /// in the assets and load the layer files (see [`crate::layers::file`]; what they name
+    /// must be in its [`crate::layers::file::NamedAssets`]). Answered by a
+    /// [`crate::save::WorldSaved`].
     Save(PathBuf),
-    /// Reads maps written by `Save` into the targets with the same names. Every file is
-    /// read and checked first: a missing, corrupt or mismatched one is an error naming it,
-    /// and then the maps and the undo history stay as they were.
+    /// Loads a folder written by `Save` ([`crate::save::LoadWorld`], into the targets with
+    /// the same names). Answered by a [`crate::save::WorldLoaded`]; strokes before a load
+    /// that succeeded cannot be undone.
     Load(PathBuf),
 }
 
-/// Why a painted map's texels could not be read or written.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-pub enum MapAccess {
-    /// The image asset is not loaded (or was removed).
-    #[error("not loaded")]
-    NotLoaded,
-    /// Its texels cannot be read or written on the CPU: no CPU copy (the asset kept only on
-    /// the GPU), or a format without per-texel colour access.
-    #[error("not editable on the CPU (format {format:?})")]
-    NotOnCpu {
-        /// The image's format.
-        format: TextureFormat,
+/// What a dab or an undo came to (saves and loads answer with
+/// [`crate::save::WorldSaved`] and [`crate::save::WorldLoaded`]).
+#[derive(Message, Debug)]
+pub enum BrushOutcome {
+    /// A stroke was undone; `strokes_left` more can be.
+    Undone {
+        /// Strokes that can still be undone.
+        strokes_left: usize,
     },
+    /// A dab or an undo failed.
+    Failed(BrushError),
 }
 
-impl MapAccess {
-    /// Why `image`'s texels could not be used: not loaded, or not on the CPU.
-    pub(crate) fn of(image: Option<&Image>) -> Self {
-        image.map_or(Self::NotLoaded, |image| Self::NotOnCpu {
-            format: image.texture_descriptor.format,
-        })
-    }
-
-    /// The brush error for target `target`.
-    pub(crate) fn at(self, target: &str) -> BrushError {
-        BrushError::MapUnavailable {
-            target: target.to_string(),
-            why: self,
-        }
-    }
-}
-
-/// Why the brush could not do something.
-#[derive(Debug, thiserror::Error)]
+/// Why the brush could not paint or undo.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum BrushError {
     /// The target index is not in [`DensityBrush::targets`].
     #[error("no brush target {0}")]
     NoTarget(usize),
-    /// The target's layer entity has no `ScatterLayer`, or no such class.
-    #[error("target {target}: no such layer or class")]
-    NoLayer {
-        /// The target's name.
-        target: String,
-    },
-    /// The target's class density is not a painted map.
-    #[error("target {target}: its density is not an image map")]
-    NotPaintable {
-        /// The target's name.
-        target: String,
-    },
-    /// The target's map cannot be painted, saved or loaded into.
-    #[error("target {target}: map {why}")]
-    MapUnavailable {
-        /// The target's name.
-        target: String,
-        /// Why.
-        why: MapAccess,
-    },
+    /// The target's map cannot be painted.
+    #[error(transparent)]
+    Map(#[from] MapError),
     /// Nothing to undo.
     #[error("nothing to undo")]
     NothingToUndo,
-    /// A file could not be read or written (a save leaves the previous one as it was).
-    #[error(transparent)]
-    File(#[from] rwt_core::files::FileError),
-    /// The index or a layer file of a save is not valid.
-    #[error("{}: {error}", file.display())]
-    Parse {
-        /// The file.
-        file: std::path::PathBuf,
-        /// What is wrong with it (boxed: parser errors are large).
-        error: Box<SaveTextError>,
-    },
-    /// A saved map is not an image of at most the target's size.
-    #[error("{}: {error}", file.display())]
-    Decode {
-        /// The file.
-        file: std::path::PathBuf,
-        /// Why.
-        error: rwt_core::density::ImageDensityError,
-    },
-    /// A saved map's size is not its target's.
-    #[error("{}: {}x{} map, the target's is {}x{}", file.display(), found.0, found.1, expected.0, expected.1)]
-    MapSize {
-        /// The file.
-        file: std::path::PathBuf,
-        /// Its size.
-        found: (u32, u32),
-        /// The target map's size.
-        expected: (u32, u32),
-    },
-    /// A map could not be encoded as PNG.
-    #[error("target {target}: cannot encode its map: {error}")]
-    Encode {
-        /// The target.
-        target: String,
-        /// The encoder's error.
-        error: image::ImageError,
-    },
-    /// A saved edits file is damaged, cut short, or made for another point set.
-    #[error("{}: {error}", file.display())]
-    Edits {
-        /// The file.
-        file: std::path::PathBuf,
-        /// Why.
-        error: rwt_core::edits::EditsError,
-    },
-    /// Two layers have one name: their edits could not be told apart when loaded.
-    #[error("two scatter layers are named {name:?}: names identify edits in a save")]
-    DuplicateLayer {
-        /// The name.
-        name: String,
-    },
-    /// Two targets have one name: their maps could not be told apart when loaded.
-    #[error("two brush targets are named {name:?}: names identify maps in a save")]
-    DuplicateTarget {
-        /// The name.
-        name: String,
-    },
-    /// The index names a file outside its folder.
-    #[error("the index names {file:?}, outside its folder")]
-    OutsideFolder {
-        /// The name.
-        file: String,
-    },
-    /// The maps were saved, but these layers have no layer file: they use something a
-    /// layer file cannot name (see [`crate::layers::file::NamedAssets`]).
-    #[error("maps saved; no layer file for {}", join(layers))]
-    LayerNotSaved {
-        /// The layers, and why each has no file.
-        layers: Vec<UnsavedLayer>,
-    },
-}
-
-/// A layer of a save that has no layer file.
-#[derive(Debug, thiserror::Error)]
-#[error("{name}: {error}")]
-pub struct UnsavedLayer {
-    /// The layer's `Name`.
-    pub name: String,
-    /// Why it cannot be described.
-    pub error: LayerFileError,
-}
-
-fn join(layers: &[UnsavedLayer]) -> String {
-    let each: Vec<String> = layers.iter().map(ToString::to_string).collect();
-    each.join("; ")
-}
-
-/// Why a text file of a save is not what it should be.
-#[derive(Debug, thiserror::Error)]
-pub enum SaveTextError {
-    /// Not UTF-8 text.
-    #[error("not UTF-8 text: {0}")]
-    NotText(#[from] std::str::Utf8Error),
-    /// The index is not valid RON for one (the error says where).
-    #[error("invalid index: {0}")]
-    Index(#[from] ron::error::SpannedError),
-    /// A layer file is not valid.
-    #[error("{0}")]
-    Layer(#[from] LayerFileError),
 }

@@ -1,7 +1,8 @@
 //! Dabs of paint on a map's texels, and what a stroke needs to be undone.
 
-use super::{BrushError, DensityBrush, MapAccess};
-use crate::layers::{GroundMap, LayerDensity, ScatterLayer, texel_luminance};
+use super::{BrushError, DensityBrush};
+use crate::layers::{GroundMap, ScatterLayer, set_texel_luminance, texel_luminance};
+use crate::save::MapProblem;
 use bevy::asset::RenderAssetUsages;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -47,20 +48,7 @@ pub(super) fn target_map(
         .targets
         .get(index)
         .ok_or(BrushError::NoTarget(index))?;
-    let density = layers
-        .get(target.layer)
-        .ok()
-        .and_then(|l| l.classes.get(target.class))
-        .map(|c| &c.density)
-        .ok_or_else(|| BrushError::NoLayer {
-            target: target.name.clone(),
-        })?;
-    match density {
-        LayerDensity::Image(map) => Ok(map.clone()),
-        _ => Err(BrushError::NotPaintable {
-            target: target.name.clone(),
-        }),
-    }
+    Ok(target.ground_map(layers)?)
 }
 
 impl GroundMap {
@@ -88,11 +76,6 @@ impl GroundMap {
         );
         (clamp(x0, w), clamp(x1, w), clamp(y0, h), clamp(y1, h))
     }
-}
-
-/// Writes a grey of value `v` (linear) to a texel.
-pub(super) fn set_texel_luminance(image: &mut Image, x: u32, y: u32, v: f32) -> bool {
-    image.set_color_at(x, y, Color::linear_rgb(v, v, v)).is_ok()
 }
 
 /// A map's texel values before a stroke changed them, and the ground the stroke covered.
@@ -148,7 +131,7 @@ pub(super) fn dab(
     centre: Vec2,
     radius: f32,
     amount: f32,
-) -> Result<Dab, MapAccess> {
+) -> Result<Dab, MapProblem> {
     let (w, h) = (image.width(), image.height());
     let radius = radius.max(1e-3);
     let (x0, x1, y0, y1) = at.texel_span(centre, radius, w, h);
@@ -160,7 +143,7 @@ pub(super) fn dab(
                 continue;
             }
             let weight = (1.0 - d * d).powi(2);
-            let old = texel_luminance(image, x, y).ok_or(MapAccess::of(Some(image)))?;
+            let old = texel_luminance(image, x, y).ok_or(MapProblem::of(Some(image)))?;
             let new = (old + amount * weight).clamp(0.0, 1.0);
             if (new - old).abs() >= 1e-4 {
                 changes.push((y * w + x, old, new));
@@ -186,7 +169,7 @@ impl Dab {
         image: &mut Image,
         id: AssetId<Image>,
         record: &mut StrokeRecord,
-    ) -> Result<Option<Rect>, MapAccess> {
+    ) -> Result<Option<Rect>, MapProblem> {
         if self.is_empty() {
             return Ok(None);
         }
@@ -194,7 +177,7 @@ impl Dab {
         for &(texel, old, new) in &self.changes {
             record.note(id, texel, old);
             if !set_texel_luminance(image, texel % w, texel / w, new) {
-                return Err(MapAccess::of(Some(image)));
+                return Err(MapProblem::of(Some(image)));
             }
         }
         if let Some(r) = self.region {
@@ -239,7 +222,7 @@ mod tests {
         radius: f32,
         amount: f32,
         record: &mut StrokeRecord,
-    ) -> Result<Option<Rect>, MapAccess> {
+    ) -> Result<Option<Rect>, MapProblem> {
         dab(image, at, centre, radius, amount)?.apply(image, id, record)
     }
 

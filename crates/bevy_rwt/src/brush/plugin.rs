@@ -1,18 +1,15 @@
 //! The brush plugin: cursor, input, dabs, strokes and their undo, files, the gizmo circle.
 
 use super::paint::{StrokeRecord, dab, restore, target_map};
-use super::persist::{LayerEdits, SaveSources, load, save};
 use super::{
-    BrushCommand, BrushError, BrushSystems, DensityBrush, MapAccess, PaintDab, ground_hit,
+    BrushCommand, BrushError, BrushOutcome, BrushSystems, DensityBrush, PaintDab, ground_hit,
 };
-use crate::edits::ScatterEdits;
-use crate::layers::file::NamedAssets;
 use crate::layers::{HeightFn, ScatterLayer};
 use crate::look::GroundPlane;
+use crate::save::{LoadWorld, MapProblem, RwtSavePlugin, SaveSystems, SaveWorld, WorldLoaded};
 use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use crate::streaming::DensityMapPainted;
 use crate::streaming::LayerState;
-use crate::streaming::RwtTileSet;
 use crate::viewers::RwtViewer;
 use bevy::ecs::schedule::InternedScheduleLabel;
 use bevy::ecs::system::SystemParam;
@@ -24,9 +21,10 @@ use std::sync::Arc;
 
 /// Paints density maps with the mouse (see [`crate::brush`]). Part of [`crate::RwtPlugins`],
 /// disabled there (enable it, or add it alone with the group's schedule); its systems run in
-/// [`BrushSystems`], before [`RwtSystems::Viewers`](crate::RwtSystems::Viewers) in the same
-/// schedule. Draws its circle when Bevy's gizmos are there, reads the mouse and keyboard
-/// when Bevy's input is.
+/// [`BrushSystems`], before [`SaveSystems`] and
+/// [`RwtSystems::Viewers`](crate::RwtSystems::Viewers) in the same schedule. Saves and loads
+/// through [`RwtSavePlugin`] (added with the same schedule if the app has none). Draws its
+/// circle when Bevy's gizmos are there, reads the mouse and keyboard when Bevy's input is.
 pub struct RwtBrushPlugin {
     schedule: InternedScheduleLabel,
 }
@@ -36,6 +34,9 @@ in_schedule!(RwtBrushPlugin);
 impl Plugin for RwtBrushPlugin {
     fn build(&self, app: &mut App) {
         configure_sets(app, self.schedule);
+        if !app.is_plugin_added::<RwtSavePlugin>() {
+            app.add_plugins(RwtSavePlugin::new(self.schedule));
+        }
         app.register_type::<DensityBrush>()
             .register_type::<PaintDab>()
             .register_type::<BrushCommand>()
@@ -43,11 +44,21 @@ impl Plugin for RwtBrushPlugin {
             .init_resource::<BrushHistory>()
             .add_message::<PaintDab>()
             .add_message::<BrushCommand>()
+            .add_message::<BrushOutcome>()
             .add_message::<DensityMapPainted>()
-            .configure_sets(self.schedule, BrushSystems.before(RwtSystems::Viewers))
+            .configure_sets(
+                self.schedule,
+                BrushSystems.before(SaveSystems).before(RwtSystems::Viewers),
+            )
             .add_systems(
                 self.schedule,
-                (locate_cursor, brush_input, apply_dabs, apply_commands)
+                (
+                    forget_strokes_on_load,
+                    locate_cursor,
+                    brush_input,
+                    apply_dabs,
+                    apply_commands,
+                )
                     .chain()
                     .in_set(BrushSystems),
             );
@@ -229,10 +240,11 @@ fn select_and_size(
 /// Paints this frame's dabs into their maps and tells the plugin what changed; dabs in
 /// consecutive frames make one stroke.
 fn apply_dabs(
-    mut brush: ResMut<DensityBrush>,
+    brush: Res<DensityBrush>,
     mut history: ResMut<BrushHistory>,
     mut dabs: MessageReader<PaintDab>,
     mut painted: MessageWriter<DensityMapPainted>,
+    mut outcomes: MessageWriter<BrushOutcome>,
     mut images: ResMut<Assets<Image>>,
     layers: Query<&ScatterLayer>,
 ) {
@@ -242,7 +254,7 @@ fn apply_dabs(
         let map = match target_map(&brush, d.target, &layers) {
             Ok(map) => map,
             Err(e) => {
-                brush.last = Some(Err(e));
+                outcomes.write(BrushOutcome::Failed(e));
                 continue;
             }
         };
@@ -251,13 +263,13 @@ fn apply_dabs(
         // the dab changes a texel.
         let planned = images
             .get(&map.image)
-            .ok_or(MapAccess::NotLoaded)
+            .ok_or(MapProblem::NotLoaded)
             .and_then(|image| dab(image, &map, d.centre, d.radius, d.amount));
         let written = match planned {
             Ok(planned) if planned.is_empty() => Ok(None),
             Ok(planned) => match images.get_mut(&map.image) {
                 Some(mut image) => planned.apply(&mut image, map.image.id(), record),
-                None => Err(MapAccess::NotLoaded),
+                None => Err(MapProblem::NotLoaded),
             },
             Err(why) => Err(why),
         };
@@ -269,7 +281,10 @@ fn apply_dabs(
                 });
             }
             Ok(None) => {}
-            Err(why) => brush.last = Some(Err(why.at(&brush.targets[d.target].name))),
+            Err(why) => {
+                let error = why.at(&brush.targets[d.target].name).into();
+                outcomes.write(BrushOutcome::Failed(error));
+            }
         }
     }
     if !any {
@@ -278,88 +293,67 @@ fn apply_dabs(
     }
 }
 
-/// What saving and loading layer files and edits use: the names of assets and of layers,
-/// the edits, and commands to put loaded edits in place.
+/// What the brush asks of [`RwtSavePlugin`].
 #[derive(SystemParam)]
-struct LayerFiles<'w, 's> {
-    commands: Commands<'w, 's>,
-    names: Res<'w, NamedAssets>,
-    named: Query<
-        'w,
-        's,
-        (
-            Entity,
-            &'static Name,
-            &'static ScatterLayer,
-            &'static ScatterEdits,
-        ),
-    >,
-    tile_set: Res<'w, RwtTileSet>,
+struct WorldRequests<'w> {
+    saves: MessageWriter<'w, SaveWorld>,
+    loads: MessageWriter<'w, LoadWorld>,
 }
 
-impl LayerFiles<'_, '_> {
-    /// Every named layer's edits.
-    fn edits(&self) -> Vec<LayerEdits<'_>> {
-        self.named
-            .iter()
-            .map(|(entity, name, layer, edits)| LayerEdits {
-                name: name.to_string(),
-                entity,
-                edits: edits.edits(),
-                stamp: self.tile_set.stamp(layer.seed),
-            })
-            .collect()
-    }
-}
-
+/// Undoes strokes, and hands saves and loads to [`RwtSavePlugin`] with the brush's
+/// targets.
 fn apply_commands(
-    mut brush: ResMut<DensityBrush>,
+    brush: Res<DensityBrush>,
     mut history: ResMut<BrushHistory>,
     mut received: MessageReader<BrushCommand>,
     mut painted: MessageWriter<DensityMapPainted>,
+    mut outcomes: MessageWriter<BrushOutcome>,
+    mut requests: WorldRequests,
     mut images: ResMut<Assets<Image>>,
-    layers: Query<&ScatterLayer>,
-    mut files: LayerFiles,
 ) {
     for command in received.read() {
-        let depth = brush.undo_depth;
-        history.close(depth);
-        let outcome = match command {
-            BrushCommand::Undo => undo(&mut history, &mut images, &mut painted),
-            BrushCommand::Save(dir) => {
-                let layer_name = |e: Entity| files.named.get(e).ok().map(|n| n.1.to_string());
-                let edits = files.edits();
-                let from = SaveSources {
-                    layers: &layers,
-                    layer_name: &layer_name,
-                    names: &files.names,
-                    images: &images,
-                    edits: &edits,
+        history.close(brush.undo_depth);
+        match command {
+            BrushCommand::Undo => {
+                let outcome = match undo(&mut history, &mut images, &mut painted) {
+                    Ok(strokes_left) => BrushOutcome::Undone { strokes_left },
+                    Err(e) => BrushOutcome::Failed(e),
                 };
-                save(&brush, &from, dir)
+                outcomes.write(outcome);
+            }
+            BrushCommand::Save(dir) => {
+                requests.saves.write(SaveWorld {
+                    dir: dir.clone(),
+                    maps: brush.targets.clone(),
+                    layer_files: brush.layer_files,
+                });
             }
             BrushCommand::Load(dir) => {
-                let loaded = load(&brush, &layers, &mut images, dir, &files.edits());
-                // Strokes before a load cannot be undone over it; a failed load changed
-                // nothing, so they still can.
-                loaded.map(|loaded| {
-                    history.done.clear();
-                    for (layer, set) in loaded.edits {
-                        files.commands.entity(layer).insert(ScatterEdits::new(set));
-                    }
-                    loaded.message
-                })
+                let maps = brush.targets.iter().cloned();
+                requests.loads.write(LoadWorld::from(dir).with_maps(maps));
             }
-        };
-        brush.last = Some(outcome);
+        }
     }
 }
 
+/// Strokes before a load cannot be undone over it (a failed load changed nothing: they
+/// still can).
+fn forget_strokes_on_load(
+    mut history: ResMut<BrushHistory>,
+    mut loads: MessageReader<WorldLoaded>,
+) {
+    if loads.read().any(|l| l.result.is_ok()) {
+        history.open = None;
+        history.done.clear();
+    }
+}
+
+/// Undoes the last stroke; returns how many can still be undone.
 fn undo(
     history: &mut BrushHistory,
     images: &mut Assets<Image>,
     painted: &mut MessageWriter<DensityMapPainted>,
-) -> Result<String, BrushError> {
+) -> Result<usize, BrushError> {
     let stroke = history.done.pop_back().ok_or(BrushError::NothingToUndo)?;
     for (id, before) in &stroke.before {
         if let Some(mut image) = images.get_mut(*id) {
@@ -372,7 +366,7 @@ fn undo(
             }
         }
     }
-    Ok(format!("undid a stroke ({} left)", history.done.len()))
+    Ok(history.done.len())
 }
 
 /// The brush circle, following the ground.

@@ -82,6 +82,11 @@ pub(crate) fn texel_luminance(image: &Image, x: u32, y: u32) -> Option<f32> {
     Some((0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue) * c.alpha)
 }
 
+/// Writes a grey of value `v` (linear) to a texel.
+pub(crate) fn set_texel_luminance(image: &mut Image, x: u32, y: u32, v: f32) -> bool {
+    image.set_color_at(x, y, Color::linear_rgb(v, v, v)).is_ok()
+}
+
 /// Linear luminance times alpha straight from the bytes of the common 8-bit formats (painted
 /// maps are re-read on every stroke, so this path matters); `None` for other formats.
 fn luminance_fast(image: &Image) -> Option<Vec<f32>> {

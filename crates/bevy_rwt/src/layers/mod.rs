@@ -6,10 +6,9 @@ mod image;
 mod plugin;
 mod status;
 
-#[cfg(feature = "brush")]
-pub(crate) use image::texel_luminance;
 pub(crate) use image::too_large;
 pub use image::{GroundMap, from_bevy_image};
+pub(crate) use image::{set_texel_luminance, texel_luminance};
 pub use plugin::RwtLayersPlugin;
 pub(crate) use plugin::{init_image_assets, merge_missing, missing_asset, report_assets};
 pub use status::{

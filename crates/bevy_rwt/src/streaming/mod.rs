@@ -27,7 +27,6 @@ pub(crate) use generate::{Changes, Generator};
 pub use plugin::RwtStreamingPlugin;
 
 use crate::edits::EditSet;
-#[cfg(feature = "brush")]
 use crate::edits::EditStamp;
 use crate::entities::EntityQueue;
 use crate::instancing::{InstancedClasses, InstancedQueue, PackedClass};
@@ -79,21 +78,18 @@ pub struct DensityMapPainted {
 pub(crate) struct RwtTileSet {
     pub set: Arc<TileSet>,
     /// [`TileSet::fingerprint`], which saved edits name their tile set by.
-    #[cfg(feature = "brush")]
     fingerprint: u64,
 }
 
 impl RwtTileSet {
     pub fn new(set: Arc<TileSet>) -> Self {
         Self {
-            #[cfg(feature = "brush")]
             fingerprint: set.fingerprint(),
             set,
         }
     }
 
-    /// What the point identities of a layer of `seed` refer to (in the brush's saves).
-    #[cfg(feature = "brush")]
+    /// What the point identities of a layer of `seed` refer to (in saves).
     pub fn stamp(&self, seed: u64) -> EditStamp {
         EditStamp {
             seed,
@@ -176,7 +172,6 @@ pub(crate) struct LayerState {
 impl LayerState {
     /// The layer's ground as its chunks are generated on (`None` until resolved, e.g.
     /// while a heightmap loads): where the brush paints.
-    #[cfg(feature = "brush")]
     pub(crate) fn ground(&self) -> Option<&crate::ground::SharedGround> {
         self.sources.ground()
     }

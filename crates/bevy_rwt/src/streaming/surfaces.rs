@@ -125,7 +125,7 @@ pub(super) fn track_surfaces(
         if !matches!(layer.height, HeightSource::Surfaces) {
             continue;
         }
-        let fresh = state.sources.ground().is_none();
+        let fresh = state.ground().is_none();
         if (fresh && registry.building.is_empty()) || !changed.is_empty() {
             let ground = registry.ground_for(entity, layer.plane);
             state.sources.set_surfaces(layer, Arc::new(ground));

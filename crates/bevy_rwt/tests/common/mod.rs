@@ -125,6 +125,7 @@ pub fn instances(app: &mut App) -> HashMap<PointId, Vec3> {
 
 /// The brush's blank 64-texel map over -64..64 (x and z) at up to 1 instance per square
 /// unit, and the layer density reading it.
+#[cfg(feature = "brush")]
 pub fn blank_canvas(app: &mut App) -> (Handle<Image>, LayerDensity) {
     let map = bevy_rwt::brush::blank_map(
         &mut app.world_mut().resource_mut::<Assets<Image>>(),

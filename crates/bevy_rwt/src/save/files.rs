@@ -1,17 +1,13 @@
-//! Painted maps on disk: one 16-bit grey PNG per target, a layer file per target layer that
+//! A save on disk: one 16-bit grey PNG per named map, a layer file per map's layer that
 //! reads them, the per-instance edits of every named layer, and a RON index of where each
-//! lies.
-//!
-//! A save is one transaction ([`rwt_core::files::SaveTransaction`]): every file is staged
-//! and synced, then all are renamed into place, so a full disk, an unreadable map or a crash
-//! leaves the previous save complete. A load reads and checks every file first and changes
-//! the world only when all of it is good.
+//! lies; written as one transaction, read back only when all of it is good.
 
-use super::paint::{set_texel_luminance, target_map};
-use super::{BrushError, BrushTarget, DensityBrush, MapAccess, UnsavedLayer};
+use super::{
+    LoadSummary, LoadWorld, MapProblem, NamedMap, SaveError, SaveSummary, SaveWorld, UnsavedLayer,
+};
 use crate::edits::{EditSet, EditStamp};
 use crate::layers::file::{LayerDescription, MapDescription, NamedAssets};
-use crate::layers::{ScatterLayer, texel_luminance};
+use crate::layers::{ScatterLayer, set_texel_luminance, texel_luminance};
 use bevy::prelude::*;
 use rwt_core::edits::MAX_EDITS_FILE_BYTES;
 use rwt_core::files::{SaveTransaction, is_plain_name, read_limited, recover};
@@ -20,7 +16,7 @@ use std::collections::{HashMap, HashSet};
 use std::io::Write;
 use std::path::Path;
 
-/// The index file [`super::BrushCommand::Save`] writes beside the maps.
+/// The index file a save writes beside its files.
 pub const INDEX_FILE: &str = "painted.ron";
 
 /// Largest index or layer file a load reads.
@@ -29,7 +25,7 @@ const MAX_TEXT_BYTES: u64 = 1 << 20;
 /// One saved map.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct PaintedMapEntry {
-    /// The target's name ([`super::BrushTarget::name`]).
+    /// The map's name ([`NamedMap::name`]).
     pub name: String,
     /// The map as a layer file writes it, its path the PNG file relative to the index.
     pub map: MapDescription,
@@ -42,7 +38,7 @@ pub struct PaintedMapEntry {
 pub struct PaintedMaps {
     /// The maps.
     pub maps: Vec<PaintedMapEntry>,
-    /// The layer files (`*.layer.ron`, relative to the index) of the targets' layers, which
+    /// The layer files (`*.layer.ron`, relative to the index) of the maps' layers, which
     /// read the maps (`./name.png`) and load with a [`crate::layers::file::ScatterLayerSource`].
     #[serde(default)]
     pub layers: Vec<String>,
@@ -63,11 +59,11 @@ pub struct SavedEdits {
 
 impl PaintedMaps {
     /// Reads `dir/painted.ron` (finishing first a save that a crash interrupted there).
-    pub fn read(dir: &Path) -> Result<Self, BrushError> {
+    pub fn read(dir: &Path) -> Result<Self, SaveError> {
         recover(dir)?;
         let path = dir.join(INDEX_FILE);
         let text = read_text(&path)?;
-        let index: Self = ron::from_str(&text).map_err(|e| BrushError::Parse {
+        let index: Self = ron::from_str(&text).map_err(|e| SaveError::Parse {
             file: path.clone(),
             error: Box::new(e.into()),
         })?;
@@ -79,7 +75,7 @@ impl PaintedMaps {
             .chain(&index.layers)
             .chain(edits);
         if let Some(bad) = names.into_iter().find(|f| !is_plain_name(f)) {
-            return Err(BrushError::OutsideFolder { file: bad.clone() });
+            return Err(SaveError::OutsideFolder { file: bad.clone() });
         }
         Ok(index)
     }
@@ -92,9 +88,9 @@ impl PaintedMaps {
 }
 
 /// A text file of at most [`MAX_TEXT_BYTES`].
-fn read_text(path: &Path) -> Result<String, BrushError> {
+fn read_text(path: &Path) -> Result<String, SaveError> {
     let bytes = read_limited(path, MAX_TEXT_BYTES)?;
-    String::from_utf8(bytes).map_err(|e| BrushError::Parse {
+    String::from_utf8(bytes).map_err(|e| SaveError::Parse {
         file: path.to_path_buf(),
         error: Box::new(e.utf8_error().into()),
     })
@@ -129,38 +125,38 @@ impl FileNames {
 }
 
 /// Writes a map's values as a 16-bit grey PNG.
-fn write_map(image: &Image, target: &str, w: &mut dyn Write) -> Result<(), BrushError> {
+fn write_map(image: &Image, map: &str, w: &mut dyn Write) -> Result<(), SaveError> {
     let (width, height) = (image.width(), image.height());
     let mut pixels = Vec::with_capacity((width * height) as usize);
     for y in 0..height {
         for x in 0..width {
-            let v = texel_luminance(image, x, y)
-                .ok_or_else(|| MapAccess::of(Some(image)).at(target))?;
+            let v =
+                texel_luminance(image, x, y).ok_or_else(|| MapProblem::of(Some(image)).at(map))?;
             pixels.push((v.clamp(0.0, 1.0) * 65535.0).round() as u16);
         }
     }
     let png = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(width, height, pixels)
-        .ok_or_else(|| MapAccess::of(Some(image)).at(target))?;
+        .ok_or_else(|| MapProblem::of(Some(image)).at(map))?;
     png.write_with_encoder(image::codecs::png::PngEncoder::new(w))
-        .map_err(|error| BrushError::Encode {
-            target: target.to_string(),
+        .map_err(|error| SaveError::Encode {
+            map: map.to_string(),
             error,
         })
 }
 
 /// Reads a PNG written by [`write_map`] (or any image, as its luminance) of exactly
 /// `width x height` pixels (checked from its header, before decoding).
-fn read_map(path: &Path, width: u32, height: u32) -> Result<Vec<f32>, BrushError> {
+fn read_map(path: &Path, width: u32, height: u32) -> Result<Vec<f32>, SaveError> {
     let pixels = width as u64 * height as u64;
     let bytes = read_limited(path, pixels * 16 + (1 << 20))?;
     let png = rwt_core::density::decode_image_with_limit(&bytes, pixels)
-        .map_err(|error| BrushError::Decode {
+        .map_err(|error| SaveError::Decode {
             file: path.to_path_buf(),
             error,
         })?
         .to_luma16();
     if png.dimensions() != (width, height) {
-        return Err(BrushError::MapSize {
+        return Err(SaveError::MapSize {
             file: path.to_path_buf(),
             found: png.dimensions(),
             expected: (width, height),
@@ -187,38 +183,35 @@ pub(super) struct LayerEdits<'a> {
     pub stamp: EditStamp,
 }
 
-/// Writes every target's map, the layer file of every target's layer (reading the maps
-/// from beside it) and the index to `dir`, all or nothing. A layer that cannot be described
-/// (see [`LayerDescription::describe`]) gets no file; the rest is still saved, and the
-/// error names it.
-pub(super) fn save(
-    brush: &DensityBrush,
-    from: &SaveSources,
-    dir: &Path,
-) -> Result<String, BrushError> {
+/// The first name that two of `names` share.
+fn repeated<'n>(mut names: impl Iterator<Item = &'n String>) -> Option<String> {
     let mut seen = HashSet::new();
-    if let Some(t) = brush.targets.iter().find(|t| !seen.insert(&t.name)) {
-        return Err(BrushError::DuplicateTarget {
-            name: t.name.clone(),
-        });
+    names.find(|n| !seen.insert(*n)).cloned()
+}
+
+/// Writes every named map, the layer file of every map's layer (reading the maps from
+/// beside it), every named layer's edits and the index to the request's folder, all or
+/// nothing. A layer that cannot be described (see [`LayerDescription::describe`]) gets no
+/// file; the rest is still saved, and the error names it.
+pub(super) fn save(request: &SaveWorld, from: &SaveSources) -> Result<SaveSummary, SaveError> {
+    if let Some(name) = repeated(request.maps.iter().map(|m| &m.name)) {
+        return Err(SaveError::DuplicateMap { name });
     }
-    let mut seen = HashSet::new();
-    if let Some(l) = from.edits.iter().find(|l| !seen.insert(&l.name)) {
-        return Err(BrushError::DuplicateLayer {
-            name: l.name.clone(),
-        });
+    if let Some(name) = repeated(from.edits.iter().map(|l| &l.name)) {
+        return Err(SaveError::DuplicateLayer { name });
     }
-    let mut save = SaveTransaction::begin(dir)?;
+    let mut save = SaveTransaction::begin(&request.dir)?;
     let mut names = FileNames::default();
     names.claim("painted", "ron");
     let mut index = PaintedMaps::default();
     let mut saved = HashMap::new();
-    for (i, BrushTarget { name, .. }) in brush.targets.iter().enumerate() {
-        let map = target_map(brush, i, from.layers)?;
+    for named in &request.maps {
+        let map = named.ground_map(from.layers)?;
+        let name = &named.name;
         let image = from
             .images
             .get(&map.image)
-            .ok_or_else(|| MapAccess::NotLoaded.at(name))?;
+            .ok_or_else(|| MapProblem::NotLoaded.at(name))?;
         let file = names.claim(name, "png");
         let mut failed = None;
         save.write_with(&file, |w| {
@@ -234,16 +227,23 @@ pub(super) fn save(
             map: MapDescription::of(&map, file),
         });
     }
-    let unwritten = if brush.layer_files {
-        stage_layer_files(brush, from, &saved, &mut names, &mut save, &mut index)?
+    let unwritten = if request.layer_files {
+        stage_layer_files(
+            &request.maps,
+            from,
+            &saved,
+            &mut names,
+            &mut save,
+            &mut index,
+        )?
     } else {
         Vec::new()
     };
-    let mut edited = 0;
+    let mut edits = 0;
     for layer in from.edits {
         let file = names.claim(&layer.name, "edits");
         save.write(&file, &layer.edits.to_bytes(&layer.stamp))?;
-        edited += layer.edits.len();
+        edits += layer.edits.len();
         index.edits.push(SavedEdits {
             layer: layer.name.clone(),
             file,
@@ -252,37 +252,37 @@ pub(super) fn save(
     save.write(INDEX_FILE, index.to_ron().as_bytes())?;
     save.commit()?;
     if !unwritten.is_empty() {
-        return Err(BrushError::LayerNotSaved { layers: unwritten });
+        return Err(SaveError::LayerNotSaved { layers: unwritten });
     }
-    Ok(format!(
-        "saved {} maps, {} layer files and {edited} edits to {}",
-        index.maps.len(),
-        index.layers.len(),
-        dir.display()
-    ))
+    Ok(SaveSummary {
+        maps: index.maps.len(),
+        layer_files: index.layers.len(),
+        edits,
+    })
 }
 
-/// Stages a layer file per target layer; returns the layers that cannot be described.
+/// Stages a layer file per map's layer; returns the layers that cannot be described.
 fn stage_layer_files(
-    brush: &DensityBrush,
+    maps: &[NamedMap],
     from: &SaveSources,
     saved: &HashMap<AssetId<Image>, String>,
     names: &mut FileNames,
     save: &mut SaveTransaction,
     index: &mut PaintedMaps,
-) -> Result<Vec<UnsavedLayer>, BrushError> {
+) -> Result<Vec<UnsavedLayer>, SaveError> {
     let mut unwritten = Vec::new();
     let mut entities: Vec<Entity> = Vec::new();
-    for t in &brush.targets {
-        if !entities.contains(&t.layer) {
-            entities.push(t.layer);
+    for m in maps {
+        if !entities.contains(&m.layer) {
+            entities.push(m.layer);
         }
     }
     for entity in entities {
         let name = (from.layer_name)(entity).unwrap_or_else(|| format!("layer {entity}"));
-        let layer = from.layers.get(entity).map_err(|_| BrushError::NoLayer {
-            target: name.clone(),
-        })?;
+        let layer = from
+            .layers
+            .get(entity)
+            .map_err(|_| MapProblem::NoLayer.at(&name))?;
         let image_path = |h: &Handle<Image>| saved.get(&h.id()).cloned();
         match LayerDescription::describe(layer, from.names, image_path).and_then(|d| d.to_ron()) {
             Ok(text) => {
@@ -296,40 +296,41 @@ fn stage_layer_files(
     Ok(unwritten)
 }
 
-/// A loaded save: what it says, and the edits each named layer gets.
+/// A loaded save: what it holds, and the edits each named layer gets.
 pub(super) struct Loaded {
-    pub message: String,
+    pub summary: LoadSummary,
     pub edits: Vec<(Entity, EditSet)>,
 }
 
-/// Reads the maps of `dir`'s index into the targets of the same name, once every map, layer
-/// file and edits file of the save has been read and checked; on any error nothing changes.
-/// The edits of the layers named in `named` are returned, for the caller to put in place.
+/// Reads the maps of the folder's index into the request's maps of the same name, once
+/// every map, layer file and edits file of the save has been read and checked; on any error
+/// nothing changes. The edits of the layers named in `named` are returned, for the caller to
+/// put in place.
 pub(super) fn load(
-    brush: &DensityBrush,
+    request: &LoadWorld,
     layers: &Query<&ScatterLayer>,
     images: &mut Assets<Image>,
-    dir: &Path,
     named: &[LayerEdits],
-) -> Result<Loaded, BrushError> {
+) -> Result<Loaded, SaveError> {
+    let dir = &request.dir;
     let index = PaintedMaps::read(dir)?;
     let edits = read_edits(&index, dir, named)?;
     let mut read = Vec::new();
     for entry in &index.maps {
-        let Some(i) = brush.targets.iter().position(|t| t.name == entry.name) else {
+        let Some(named) = request.maps.iter().find(|m| m.name == entry.name) else {
             continue;
         };
-        let map = target_map(brush, i, layers)?;
+        let map = named.ground_map(layers)?;
         let image = images.get(&map.image);
         let image = image
             .filter(|image| texel_luminance(image, 0, 0).is_some())
-            .ok_or_else(|| MapAccess::of(image).at(&entry.name))?;
+            .ok_or_else(|| MapProblem::of(image).at(&entry.name))?;
         let values = read_map(&dir.join(&entry.map.path), image.width(), image.height())?;
         read.push((map.image, entry.name.clone(), values));
     }
     for file in &index.layers {
         let path = dir.join(file);
-        LayerDescription::from_ron(&read_text(&path)?).map_err(|e| BrushError::Parse {
+        LayerDescription::from_ron(&read_text(&path)?).map_err(|e| SaveError::Parse {
             file: path,
             error: Box::new(e.into()),
         })?;
@@ -337,24 +338,20 @@ pub(super) fn load(
     for (handle, name, values) in &read {
         let mut image = images
             .get_mut(handle)
-            .ok_or_else(|| MapAccess::NotLoaded.at(name))?;
+            .ok_or_else(|| MapProblem::NotLoaded.at(name))?;
         let width = image.width();
         for (texel, &v) in values.iter().enumerate() {
             let (x, y) = (texel as u32 % width, texel as u32 / width);
             if !set_texel_luminance(&mut image, x, y, v) {
-                return Err(MapAccess::of(Some(&image)).at(name));
+                return Err(MapProblem::of(Some(&image)).at(name).into());
             }
         }
     }
-    let count: usize = edits.iter().map(|(_, e)| e.len()).sum();
-    Ok(Loaded {
-        message: format!(
-            "loaded {} maps and {count} edits from {}",
-            read.len(),
-            dir.display()
-        ),
-        edits,
-    })
+    let summary = LoadSummary {
+        maps: read.len(),
+        edits: edits.iter().map(|(_, e)| e.len()).sum(),
+    };
+    Ok(Loaded { summary, edits })
 }
 
 /// Reads and checks the edits file of every layer in `named` that the index lists.
@@ -362,7 +359,7 @@ fn read_edits(
     index: &PaintedMaps,
     dir: &Path,
     named: &[LayerEdits],
-) -> Result<Vec<(Entity, EditSet)>, BrushError> {
+) -> Result<Vec<(Entity, EditSet)>, SaveError> {
     let mut out = Vec::new();
     for saved in &index.edits {
         let Some(layer) = named.iter().find(|l| l.name == saved.layer) else {
@@ -371,7 +368,7 @@ fn read_edits(
         let path = dir.join(&saved.file);
         let bytes = read_limited(&path, MAX_EDITS_FILE_BYTES)?;
         let set = EditSet::from_bytes(&bytes, &layer.stamp)
-            .map_err(|error| BrushError::Edits { file: path, error })?;
+            .map_err(|error| SaveError::Edits { file: path, error })?;
         out.push((layer.entity, set));
     }
     Ok(out)
