@@ -755,7 +755,12 @@ def pass_cases(args, work):
     return results
 
 
-def table(results):
+def scrub(text, tmp):
+    """The text without this machine's paths: the run's folder as $TMP, the checkout as `.`."""
+    return text.replace(str(tmp), "$TMP").replace(str(ROOT), ".")
+
+
+def table(results, tmp):
     bad = [r for r in results if any(f.isupper() and not f.startswith("(") for f in r.flags)]
     lines = [
         f"{len(results)} cases, {len(bad)} flagged; peak memory at most "
@@ -765,7 +770,7 @@ def table(results):
         "|---|---|---|---|---|---|---|---|",
     ]
     for k, r in enumerate(results, 1):
-        text = r.first.replace("|", "\\|").replace("`", "'")
+        text = scrub(r.first, tmp).replace("|", "\\|").replace("`", "'")
         if len(text) > 110:
             text = text[:107] + "..."
         name = r.name.replace("|", "\\|").replace("`", "'")
@@ -787,7 +792,7 @@ def main():
                         "read_file", "--bin", "rwt"], cwd=ROOT, check=True)
     with tempfile.TemporaryDirectory(prefix="rwt-hostile-") as tmp:
         results = pass_cases(args, pathlib.Path(tmp))
-    text, bad = table(results)
+    text, bad = table(results, tmp)
     print(text)
     if args.update:
         path = pathlib.Path(args.update)

@@ -106,3 +106,8 @@ pub use density::{
 pub use query::{Point, PointId, QueryError, Rect, Sampler};
 pub use tileset::{TileSet, TileSetError};
 pub use tiling::Tiling;
+
+/// The README's examples, compiled and run as doctests (`cargo test --doc`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -1,6 +1,7 @@
-"""The docstrings' examples run, and the package ships its types."""
+"""The docstrings' and the READMEs' examples run, and the package ships its types."""
 
 import doctest
+import re
 from pathlib import Path
 
 import pytest
@@ -20,3 +21,16 @@ def test_docstring_examples(module):
 def test_typed_package():
     here = Path(rwt.__file__).parent
     assert (here / "py.typed").is_file() and (here / "_rwt.pyi").is_file()
+
+
+HERE = Path(__file__).resolve().parent
+READMES = [HERE.parent / "README.md", HERE.parents[2] / "README.md"]
+
+
+@pytest.mark.parametrize("readme", READMES, ids=["crate", "repository"])
+def test_readme_examples_run(readme, capsys):
+    blocks = re.findall(r"```python\n(.*?)```", readme.read_text(), flags=re.S)
+    assert blocks, f"{readme} has no python example"
+    for block in blocks:
+        exec(compile(block, str(readme), "exec"), {})
+    assert capsys.readouterr().out.strip(), "the examples print their results"
