@@ -58,10 +58,29 @@ const CARD_HEIGHT: f32 = 0.05;
 /// Where the bender stands, and grass far from it.
 const BENDER: Vec3 = Vec3::new(2.0, 0.0, 2.0);
 const FAR_GRASS: Vec3 = Vec3::new(3.5, 0.6, -3.5);
-/// Half-size of each compared region, pixels.
+/// Half-size of each compared region, pixels of a 1280-pixel-wide window.
 const REGION: i32 = 5;
+/// Streaming that covers the scene (everything lies within 20 m of the camera) and no more:
+/// a handful of chunks, so that a replaced layer settles in a few frames.
+const NEAR_SCENE: StreamingConfig = StreamingConfig {
+    chunk_size: 8.0,
+    load_distance: 30.0,
+    unload_distance: 40.0,
+    near_distance: 30.0,
+};
 /// Frames each step waits once streaming has settled (pipelines compile on the CPU).
 const WAIT: u32 = 12;
+/// Frames the first step with TAA waits: its history converges over tens of frames, and the
+/// next step's comparison must see the bender, not the convergence.
+const TAA_WAIT: u32 = 40;
+
+fn frames_to_wait(step: Step) -> u32 {
+    if step == Step::Prepasses {
+        TAA_WAIT
+    } else {
+        WAIT
+    }
+}
 
 fn main() -> AppExit {
     App::new()
@@ -148,7 +167,9 @@ fn setup(
     });
     commands.spawn((
         Name::new("grass"),
-        ScatterLayer::new(vec![grass]).with_seed(7),
+        ScatterLayer::new(vec![grass])
+            .with_seed(7)
+            .with_streaming(NEAR_SCENE),
     ));
     let cards = ScatterClass::instanced(
         LayerDensity::Custom(Arc::new(Rectangle {
@@ -168,7 +189,9 @@ fn setup(
     );
     commands.spawn((
         Name::new("cards"),
-        ScatterLayer::new(vec![cards]).with_seed(2),
+        ScatterLayer::new(vec![cards])
+            .with_seed(2)
+            .with_streaming(NEAR_SCENE),
     ));
 }
 
@@ -211,7 +234,7 @@ fn disc_texture() -> Image {
 }
 
 /// Where the check stands.
-#[derive(Resource, Default)]
+#[derive(Resource)]
 struct Check {
     step: Step,
     /// Frames since the step began.
@@ -225,6 +248,25 @@ struct Check {
     /// Cards seen, and those whose centre showed the texture and corners the ground.
     cards: (usize, usize),
     pending: Option<Arc<std::sync::Mutex<Option<Image>>>>,
+    /// Frames and time since the first (for the log's step lines).
+    frames: u32,
+    started: std::time::Instant,
+}
+
+impl Default for Check {
+    fn default() -> Self {
+        Self {
+            step: Step::default(),
+            waited: 0,
+            shots: Vec::new(),
+            bent: Vec::new(),
+            bent_regions: Vec::new(),
+            cards: (0, 0),
+            pending: None,
+            frames: 0,
+            started: std::time::Instant::now(),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -252,6 +294,7 @@ struct Scene<'w, 's> {
 fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands) {
     let settled = scene.stats.pending_tasks == 0 && scene.stats.queued_spawns == 0;
     check.waited += 1;
+    check.frames += 1;
     if let Some(pending) = check.pending.clone() {
         let Some(image) = pending.lock().unwrap().take() else {
             return;
@@ -278,6 +321,12 @@ fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands)
         }
         save(&image, check.step);
         check.pending = None;
+        eprintln!(
+            "rwt-passes: {:?} taken at frame {}, {:.1} s",
+            check.step,
+            check.frames,
+            check.started.elapsed().as_secs_f32()
+        );
         check.step = next(check.step, &mut scene, &mut commands);
         check.waited = 0;
         if check.step == Step::Done {
@@ -290,7 +339,7 @@ fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands)
         }
         return;
     }
-    if settled && check.waited >= WAIT && check.step != Step::Done {
+    if settled && check.waited >= frames_to_wait(check.step) && check.step != Step::Done {
         let slot = Arc::new(std::sync::Mutex::new(None));
         let target = slot.clone();
         commands.spawn(Screenshot::primary_window()).observe(
@@ -410,6 +459,12 @@ fn set_grass_shadows(scene: &mut Scene, commands: &mut Commands, shadows: Instan
     }
 }
 
+/// Half-size of a compared region in `image`: the same share of the view at any window size
+/// (smoke runs render smaller windows).
+fn region(image: &Image) -> i32 {
+    (REGION * image.width() as i32 / 1280).max(2)
+}
+
 /// Mean luminance (0..255) of the pixels around where `p` is seen.
 fn region_luminance(image: &Image, camera: &Camera, at: &GlobalTransform, p: Vec3) -> f32 {
     let Ok(centre) = camera.world_to_viewport(at, p) else {
@@ -417,10 +472,11 @@ fn region_luminance(image: &Image, camera: &Camera, at: &GlobalTransform, p: Vec
     };
     let (w, h) = (image.width() as i32, image.height() as i32);
     let (cx, cy) = (centre.x as i32, centre.y as i32);
+    let r = region(image);
     let mut sum = 0.0;
     let mut n = 0.0;
-    for y in (cy - REGION).max(0)..(cy + REGION).min(h) {
-        for x in (cx - REGION).max(0)..(cx + REGION).min(w) {
+    for y in (cy - r).max(0)..(cy + r).min(h) {
+        for x in (cx - r).max(0)..(cx + r).min(w) {
             if let Ok(c) = image.get_color_at(x as u32, y as u32) {
                 let c = c.to_srgba();
                 sum += 255.0 * (0.2126 * c.red + 0.7152 * c.green + 0.0722 * c.blue);
@@ -515,7 +571,7 @@ fn not_blank(image: &Image) -> bool {
 /// `b`.
 fn region_change(a: &Image, b: &Image, at: Vec2) -> f32 {
     let (cx, cy) = (at.x as i32, at.y as i32);
-    let r = 3 * REGION;
+    let r = 3 * region(a);
     let mut sum = 0.0;
     let mut n = 0.0;
     for y in (cy - r).max(0)..(cy + r).min(a.height() as i32) {

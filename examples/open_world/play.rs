@@ -21,7 +21,7 @@ use std::collections::{HashMap, HashSet};
 /// How far the script flies away.
 const AWAY: f32 = 3_000.0;
 /// Frames of the return: the end of the session's flight, then its landing.
-const RETURN_FRAMES: u32 = 40;
+const RETURN_FRAMES: u32 = 20;
 /// Radius around the cabin that holds everything its footprint can clear.
 const CABIN_REACH: f32 = 10.0;
 
@@ -34,9 +34,8 @@ pub struct Play {
     cabin: Vec2,
     /// The frame the phase began.
     since: u32,
-    /// The walk into a trunk: the walker, the trunk's axis, the collision distance and the
-    /// closest the walker came.
-    walk: Option<(Entity, Vec2, f32, f32)>,
+    /// The walk into a trunk.
+    walk: Option<Walk>,
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -223,11 +222,25 @@ fn persisted(play: &Play, world: &Stage) -> usize {
     stumps + gone
 }
 
-/// Frames of the walk into a trunk.
+/// Most frames of the walk into a trunk.
 const WALK_FRAMES: u32 = 45;
+/// Frames the walker must stand still at the trunk for the walk to end before
+/// [`WALK_FRAMES`] (a slow renderer's frames each move it the most that one frame may).
+const STILL_FRAMES: u32 = 5;
+
+/// The walk into a trunk: the walker, the trunk's axis, the collision distance, the closest
+/// the walker came, and the frames it has stood still since.
+struct Walk {
+    walker: Entity,
+    axis: Vec2,
+    contact: f32,
+    closest: f32,
+    last: Option<Vec2>,
+    still: u32,
+}
 
 /// A walker 3 m from the nearest tree, heading for its axis.
-fn start_walk(world: &Stage, commands: &mut Commands) -> Option<(Entity, Vec2, f32, f32)> {
+fn start_walk(world: &Stage, commands: &mut Commands) -> Option<Walk> {
     let eye = world.camera.single().ok()?;
     let layer = tree_layer(&world.layers)?;
     let trees = world
@@ -242,26 +255,39 @@ fn start_walk(world: &Stage, commands: &mut Commands) -> Option<(Entity, Vec2, f
         scripted: true,
     });
     let contact = TRUNK_RADIUS * tree.transform.scale.x + WALKER_RADIUS;
-    Some((walker, axis, contact, f32::INFINITY))
+    Some(Walk {
+        walker,
+        axis,
+        contact,
+        closest: f32::INFINITY,
+        last: None,
+        still: 0,
+    })
 }
 
 /// Tracks the closest the walker came to the trunk's axis; returns whether the walk is over.
 fn follow_walk(play: &mut Play, world: &Stage, waited: u32) -> bool {
-    let Some((walker, axis, _, closest)) = play.walk.as_mut() else {
+    let Some(walk) = play.walk.as_mut() else {
         return true;
     };
-    if let Ok(at) = world.walkers.get(*walker) {
-        *closest = closest.min(at.translation.xz().distance(*axis));
+    if let Ok(at) = world.walkers.get(walk.walker) {
+        let here = at.translation.xz();
+        walk.closest = walk.closest.min(here.distance(walk.axis));
+        let moved = walk.last.is_none_or(|last| last.distance(here) > 1e-3);
+        walk.still = if moved { 0 } else { walk.still + 1 };
+        walk.last = Some(here);
     }
-    waited >= WALK_FRAMES
+    let at_trunk = walk.closest < walk.contact + 0.2 && walk.still >= STILL_FRAMES;
+    at_trunk || waited >= WALK_FRAMES
 }
 
 /// Reports the walk and goes back to flying.
 fn finish_walk(play: &Play, commands: &mut Commands) {
-    if let Some((walker, _, contact, closest)) = play.walk {
+    if let Some(walk) = &play.walk {
         eprintln!(
-            "rwt-smoke: walked into a trunk: closest {closest:.2} m from its axis, collision at {contact:.2} m"
+            "rwt-smoke: walked into a trunk: closest {:.2} m from its axis, collision at {:.2} m",
+            walk.closest, walk.contact
         );
-        commands.entity(walker).despawn();
+        commands.entity(walk.walker).despawn();
     }
 }
