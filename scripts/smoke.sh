@@ -36,7 +36,10 @@ if [ $docs = 1 ]; then
     cargo build --release "${build[@]}"
     bin=target/release/examples
 else
-    cargo build "${build[@]}"
+    # The binaries `cargo test --workspace` builds (CI's test stage): one build with the
+    # workspace's features, not a second one with the examples' own (`cargo build
+    # --example` unifies features over fewer packages and rebuilds much of Bevy).
+    cargo test --workspace --no-run
     bin=target/debug/examples
 fi
 out=target/smoke

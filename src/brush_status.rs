@@ -40,37 +40,35 @@ fn shown(dir: &std::path::Path) -> String {
     dir.strip_prefix(&cwd).unwrap_or(dir).display().to_string()
 }
 
+/// What an answer of the world save says, for the HUD.
+fn answered<T: std::fmt::Display, E: std::fmt::Display>(
+    result: &Result<T, E>,
+    place: &str,
+) -> Result<String, String> {
+    match result {
+        Ok(done) => Ok(format!("{done} {place}")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 fn track(
     mut status: ResMut<BrushStatus>,
     mut outcomes: MessageReader<BrushOutcome>,
     mut saved: MessageReader<WorldSaved>,
     mut loaded: MessageReader<WorldLoaded>,
 ) {
-    let text = |e: &dyn std::fmt::Display| e.to_string();
     for outcome in outcomes.read() {
         status.last = Some(match outcome {
             BrushOutcome::Undone { strokes_left } => {
                 Ok(format!("undid a stroke ({strokes_left} left)"))
             }
-            BrushOutcome::Failed(e) => Err(text(e)),
+            BrushOutcome::Failed(e) => Err(e.to_string()),
         });
     }
     for s in saved.read() {
-        let to = shown(&s.dir);
-        status.last = Some(
-            s.result
-                .as_ref()
-                .map(|r| format!("{r} to {to}"))
-                .map_err(|e| text(e)),
-        );
+        status.last = Some(answered(&s.result, &format!("to {}", shown(&s.dir))));
     }
     for l in loaded.read() {
-        let from = shown(&l.dir);
-        status.last = Some(
-            l.result
-                .as_ref()
-                .map(|r| format!("{r} from {from}"))
-                .map_err(|e| text(e)),
-        );
+        status.last = Some(answered(&l.result, &format!("from {}", shown(&l.dir))));
     }
 }

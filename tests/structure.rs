@@ -32,6 +32,10 @@ fn code(text: &str) -> String {
         .join("\n")
 }
 
+/// A use group's braces.
+const OPEN: char = '{';
+const CLOSE: char = '}';
+
 fn ident_at(text: &str) -> &str {
     let text = text.trim_start();
     let end = text
@@ -45,15 +49,15 @@ fn named_modules(code: &str) -> BTreeSet<String> {
     let mut out = BTreeSet::new();
     for (i, _) in code.match_indices("crate::") {
         let after = &code[i + "crate::".len()..];
-        if let Some(group) = after.strip_prefix('{') {
+        if let Some(group) = after.strip_prefix(OPEN) {
             // `crate::{a, b::c, d::{e, f}}`: the names at the group's top level.
             let mut depth = 0;
             let mut start = true;
             for (j, c) in group.char_indices() {
                 match c {
-                    '{' => depth += 1,
-                    '}' if depth == 0 => break,
-                    '}' => depth -= 1,
+                    OPEN => depth += 1,
+                    CLOSE if depth == 0 => break,
+                    CLOSE => depth -= 1,
                     ',' if depth == 0 => start = true,
                     c if start && !c.is_whitespace() => {
                         out.insert(ident_at(&group[j..]).to_string());

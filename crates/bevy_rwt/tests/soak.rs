@@ -3,6 +3,7 @@
 //! entities near the viewer and back included) and every few hundred frames for bounded
 //! entity, task and memory counts; back at the start, the world is as it was.
 
+#[path = "integration/common/mod.rs"]
 mod common;
 
 use bevy::asset::AssetPlugin;

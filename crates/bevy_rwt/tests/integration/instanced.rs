@@ -2,8 +2,7 @@
 //! turns, scales and classes, through level-of-detail changes, painting and a return to the
 //! start; and their chunk entities never leak.
 
-mod common;
-
+use crate::common::*;
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::PrimitiveTopology;
 use bevy::prelude::*;
@@ -11,7 +10,6 @@ use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy_rwt::instancing::InstancedChunk;
 use bevy_rwt::look::InstancedClassError;
 use bevy_rwt::prelude::*;
-use common::*;
 use std::collections::HashSet;
 
 /// A layer with an entity class (sparse) and a second class on a painted map, entity or

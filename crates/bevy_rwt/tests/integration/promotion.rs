@@ -2,14 +2,12 @@
 //! exactly where and as the buffer drew them, and go back beyond the distance; chopping a
 //! promoted tree removes it at once and for good.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::edits::EditInstance;
 use bevy_rwt::instancing::PromotedInstance;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use common::*;
 use std::collections::HashMap;
 
 /// What a promoted tree gets: a collider, in a game.

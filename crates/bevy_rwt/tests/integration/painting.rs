@@ -1,11 +1,9 @@
 //! Painted density and exclusion maps: only what the paint covers changes.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::Rect;
-use common::*;
 use glam::DVec2;
 
 #[test]

@@ -123,6 +123,21 @@ pub fn instances(app: &mut App) -> HashMap<PointId, Vec3> {
     out
 }
 
+/// Every instance by its layer's name and point, with its position (layers of one seed and
+/// tile size share point identities; their names tell them apart).
+pub fn layered(app: &mut App) -> HashMap<(String, PointId), Vec3> {
+    let names: HashMap<Entity, String> = app
+        .world_mut()
+        .query::<(Entity, &Name)>()
+        .iter(app.world())
+        .map(|(e, n)| (e, n.to_string()))
+        .collect();
+    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
+    q.iter(app.world())
+        .map(|(i, t)| ((names[&i.layer].clone(), i.id), t.translation))
+        .collect()
+}
+
 /// The brush's blank 64-texel map over -64..64 (x and z) at up to 1 instance per square
 /// unit, and the layer density reading it.
 #[cfg(feature = "brush")]

@@ -1,7 +1,6 @@
 //! The density brush: dabs re-scatter only what they cover, strokes undo, maps save and load.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushError, BrushOutcome};
 use bevy_rwt::edits::{EditInstance, ScatterEdits};
@@ -10,7 +9,6 @@ use bevy_rwt::prelude::*;
 use bevy_rwt::save::{
     LoadSummary, MapError, MapProblem, PaintedMaps, SaveError, SaveSummary, WorldLoaded, WorldSaved,
 };
-use common::*;
 use rwt_core::files::FileError;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -317,21 +315,6 @@ fn folder(dir: &Path) -> BTreeMap<String, Vec<u8>> {
         .collect()
 }
 
-/// Every instance by its layer's name and point, with its position (the layers of
-/// [`two_map_app`] share point identities).
-fn layered(app: &mut App) -> std::collections::HashMap<(String, rwt_core::PointId), Vec3> {
-    let names: std::collections::HashMap<Entity, String> = app
-        .world_mut()
-        .query::<(Entity, &Name)>()
-        .iter(app.world())
-        .map(|(e, n)| (e, n.to_string()))
-        .collect();
-    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
-    q.iter(app.world())
-        .map(|(i, t)| ((names[&i.layer].clone(), i.id), t.translation))
-        .collect()
-}
-
 /// An app with two painted targets on two layers: `names[0]` on a blank 64 x 64 map and
 /// `names[1]` on a 256 x 256 map of noise (from `seed`), whose PNG is large.
 fn two_map_app(names: [&str; 2], seed: u32) -> App {
@@ -513,7 +496,12 @@ fn a_full_disk_during_a_save_keeps_the_previous_save() {
         .arg("-c")
         .arg("ulimit -f 16; trap '' XFSZ; exec \"$0\" \"$@\"")
         .arg(std::env::current_exe().unwrap())
-        .args(["--exact", "save_on_a_full_disk", "--ignored", "--nocapture"])
+        .args([
+            "--exact",
+            "brush::save_on_a_full_disk",
+            "--ignored",
+            "--nocapture",
+        ])
         .env("RWT_FULL_DISK_DIR", &dir)
         .output()
         .unwrap();

@@ -2,14 +2,12 @@
 //! unloading, level-of-detail changes, repainting and a reloaded layer, and exactly the
 //! edited points differ from the same world without edits.
 
-mod common;
-
+use crate::common::forest::*;
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::edits::{Edit, EditInstance, ScatterEdits};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use common::forest::*;
-use common::*;
 use std::collections::HashMap;
 
 /// The unedited world with `edits` applied.

@@ -1,10 +1,8 @@
 //! Streaming around viewers: loading, unloading, level of detail, filters, determinism.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
-use common::*;
 use std::collections::HashMap;
 
 #[test]

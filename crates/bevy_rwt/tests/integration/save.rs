@@ -1,16 +1,12 @@
 //! World saves without the brush: a game saves what the player chopped and the maps it
 //! changed itself, and loads them into a fresh world.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::edits::EditInstance;
 use bevy_rwt::prelude::*;
-use bevy_rwt::rwt_core::query::PointId;
 use bevy_rwt::save::{LoadSummary, PaintedMaps, SaveError, SaveSummary, WorldLoaded, WorldSaved};
-use common::*;
 use rwt_core::files::FileError;
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// A world of two named layers around the origin: a forest of constant density (its trees
@@ -47,20 +43,6 @@ fn chop(app: &mut App, every: usize) -> usize {
     app.world_mut().write_message_batch(edits);
     tick_app(app, 2_000);
     n
-}
-
-/// Every live instance, by its layer's name and its point.
-fn placed(app: &mut App) -> HashMap<(String, PointId), Vec3> {
-    let names: HashMap<Entity, String> = app
-        .world_mut()
-        .query::<(Entity, &Name)>()
-        .iter(app.world())
-        .map(|(e, n)| (e, n.to_string()))
-        .collect();
-    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
-    q.iter(app.world())
-        .map(|(i, t)| ((names[&i.layer].clone(), i.id), t.translation))
-        .collect()
 }
 
 fn named(app: &mut App, name: &str) -> Entity {
@@ -102,13 +84,13 @@ fn a_world_with_chopped_trees_and_a_changed_map_saves_and_loads_without_the_brus
     let (mut app, meadow, map) = world();
     #[cfg(feature = "brush")]
     assert!(!app.is_plugin_added::<bevy_rwt::brush::RwtBrushPlugin>());
-    let untouched = placed(&mut app);
+    let untouched = layered(&mut app);
     let chopped = chop(&mut app, 5);
     assert!(chopped > 20, "{chopped} trees chopped");
     // The game changes the meadow's map itself: a bright square.
     paint_square(&mut app, &map, 40, 40, Color::WHITE);
     tick_app(&mut app, 2_000);
-    let played = placed(&mut app);
+    let played = layered(&mut app);
     assert_ne!(played, untouched);
 
     let dir = scratch("world");
@@ -126,7 +108,7 @@ fn a_world_with_chopped_trees_and_a_changed_map_saves_and_loads_without_the_brus
 
     // Another session: the same layers, untouched, get the played world back.
     let (mut fresh, meadow, _) = world();
-    assert_eq!(placed(&mut fresh), untouched);
+    assert_eq!(layered(&mut fresh), untouched);
     let loaded = load(&mut fresh, &dir, &[meadow]).unwrap();
     assert_eq!(
         loaded,
@@ -136,14 +118,14 @@ fn a_world_with_chopped_trees_and_a_changed_map_saves_and_loads_without_the_brus
         }
     );
     tick_app(&mut fresh, 2_000);
-    assert_eq!(placed(&mut fresh), played);
+    assert_eq!(layered(&mut fresh), played);
 
     // Loading the edits alone leaves the map as it is: the trees go, the meadow stays grey.
     let (mut edits_only, ..) = world();
     let loaded = load(&mut edits_only, &dir, &[]).unwrap();
     assert_eq!((loaded.maps, loaded.edits), (0, chopped));
     tick_app(&mut edits_only, 2_000);
-    let kept = placed(&mut edits_only);
+    let kept = layered(&mut edits_only);
     assert_eq!(kept.len(), untouched.len() - chopped);
     assert!(kept.iter().all(|(id, p)| untouched.get(id) == Some(p)));
     std::fs::remove_dir_all(&dir).ok();
@@ -153,14 +135,14 @@ fn a_world_with_chopped_trees_and_a_changed_map_saves_and_loads_without_the_brus
 fn failed_saves_and_loads_are_typed_and_change_nothing() {
     let (mut app, meadow, _) = world();
     chop(&mut app, 7);
-    let before = placed(&mut app);
+    let before = layered(&mut app);
     let missing = scratch("missing");
     assert!(matches!(
         load(&mut app, &missing, std::slice::from_ref(&meadow)),
         Err(SaveError::File(FileError::Io { .. }))
     ));
     tick_app(&mut app, 2_000);
-    assert_eq!(placed(&mut app), before);
+    assert_eq!(layered(&mut app), before);
 
     // Two maps of one name could not be told apart: refused, nothing written.
     let twins = scratch("twins");
@@ -182,14 +164,14 @@ fn failed_saves_and_loads_are_typed_and_change_nothing() {
     bytes[middle] ^= 1;
     std::fs::write(&file, bytes).unwrap();
     let (mut other, ..) = world();
-    let fresh = placed(&mut other);
+    let fresh = layered(&mut other);
     let err = load(&mut other, &dir, &[]).unwrap_err();
     assert!(
         matches!(&err, SaveError::Edits { file: f, .. } if *f == file),
         "{err:?}"
     );
     tick_app(&mut other, 2_000);
-    assert_eq!(placed(&mut other), fresh);
+    assert_eq!(layered(&mut other), fresh);
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -1,14 +1,12 @@
 //! Picking agrees with a brute-force test of every live instance (entities and instanced
 //! buffers) for random rays, and with a brute-force search near ground points.
 
-mod common;
-
+use crate::common::forest::*;
+use crate::common::*;
 use bevy::ecs::system::SystemState;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use common::forest::*;
-use common::*;
 
 /// Pick bounds of every class: trunks and crowns of 3 units, tufts of half a unit.
 fn bounds(class: u16) -> (Vec3, Vec3) {

@@ -2,13 +2,11 @@
 //! them, by a containment test of the test's own), and moving or removing one brings back
 //! exactly what it cleared.
 
-mod common;
-
+use crate::common::forest::*;
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use common::forest::*;
-use common::*;
 use std::collections::HashMap;
 
 /// A rectangle of `half` turned by `yaw` about y at `centre`, with `margin`: whether it

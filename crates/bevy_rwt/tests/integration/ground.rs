@@ -1,15 +1,13 @@
 //! Ground: layers on the game's meshes (`ScatterSurface`, `HeightSource::Surfaces`), surface
 //! policies, surface-true density, stances, and re-scattering when a ground mesh moves.
 
-mod common;
-
+use crate::common::*;
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 use bevy_rwt::ground::{ScatterSurface, SurfaceMesh, SurfacePolicy};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use common::*;
 use std::collections::HashMap;
 use std::sync::Arc;
 

@@ -1,12 +1,10 @@
 //! Layers that keep out of each other: grass never grows within a tree's radius, whatever
 //! order chunks finish in, and an edit that removes a tree gives the grass back.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use common::*;
 
 const RADIUS: f32 = 1.5;
 

@@ -2,14 +2,12 @@
 //! settings changed through reflection (as an inspector changes them) take effect: the layer
 //! scatters anew.
 
-mod common;
-
+use crate::common::*;
 use bevy::ecs::reflect::{ReflectComponent, ReflectResource};
 use bevy::prelude::*;
 use bevy::reflect::{GetPath, TypeRegistry};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use common::*;
 use std::any::TypeId;
 use std::collections::BTreeMap;
 

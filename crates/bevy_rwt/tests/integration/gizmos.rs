@@ -1,10 +1,8 @@
 //! Debug outlines of chunks and tiles.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
-use common::*;
 
 #[test]
 fn gizmos_outline_loaded_chunks_and_their_tiles() {

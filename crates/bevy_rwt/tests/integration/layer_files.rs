@@ -1,10 +1,8 @@
 //! Layer files and the assets layers read: loading, hot reloading, failures.
 
-mod common;
-
+use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
-use common::*;
 use std::time::Duration;
 
 #[test]

@@ -1,13 +1,11 @@
 //! The plugin group: every part in the schedule it is given (the brush too, ordered before
 //! the streaming sets), parts disabled, parts used alone.
 
-mod common;
-
+use crate::common::*;
 use bevy::asset::AssetPlugin;
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
-use common::*;
 
 /// A schedule the game runs itself (here: by hand).
 #[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]
