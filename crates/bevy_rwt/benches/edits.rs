@@ -28,6 +28,7 @@ fn main() {
     let set = TileSet::embedded();
     let stamp = EditStamp {
         seed: SEED,
+        lattice: Lattice::Seeded,
         tile_set: set.fingerprint(),
     };
     let corridor = corridor_points(&set);

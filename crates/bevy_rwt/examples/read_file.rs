@@ -12,8 +12,9 @@
 
 use bevy::prelude::Handle;
 use bevy_rwt::layers::file::{LayerDescription, MAX_LAYER_FILE_BYTES, NamedAssets};
+use bevy_rwt::rwt_core::Lattice;
 use bevy_rwt::rwt_core::density::decode_image;
-use bevy_rwt::rwt_core::edits::{EditSet, EditStamp, MAX_EDITS_FILE_BYTES};
+use bevy_rwt::rwt_core::edits::{EditSet, EditStamp, EditsError, MAX_EDITS_FILE_BYTES};
 use bevy_rwt::rwt_core::files::read_limited;
 use bevy_rwt::rwt_core::tileset::TileSet;
 use bevy_rwt::save::PaintedMaps;
@@ -64,15 +65,27 @@ fn layer(path: &Path) -> Result<String, String> {
     Ok(format!("layer: {} classes", layer.classes.len()))
 }
 
-/// An edits file for the shipped tile set and `seed`.
+/// An edits file for the shipped tile set and `seed` (on the seeded lattice, or the
+/// aligned one for a file of format 1).
 fn edits(path: &Path, seed: u64) -> Result<String, String> {
     let stamp = EditStamp {
         seed,
+        lattice: Lattice::Seeded,
         tile_set: TileSet::embedded().fingerprint(),
     };
     let bytes = read_limited(path, MAX_EDITS_FILE_BYTES).map_err(|e| e.to_string())?;
-    let set =
-        EditSet::from_bytes(&bytes, &stamp).map_err(|e| format!("{}: {e}", path.display()))?;
+    let set = EditSet::from_bytes(&bytes, &stamp)
+        .or_else(|e| match e {
+            EditsError::FormatLattice { .. } => EditSet::from_bytes(
+                &bytes,
+                &EditStamp {
+                    lattice: Lattice::Aligned,
+                    ..stamp
+                },
+            ),
+            e => Err(e),
+        })
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(format!("edits: {}", set.len()))
 }
 

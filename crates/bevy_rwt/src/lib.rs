@@ -204,6 +204,7 @@ pub mod prelude {
         RwtViewersPlugin, RwtWind, ScatterClass, ScatterEntity, ScatterLayer, ScatterLayerStatus,
         ViewCone,
     };
+    pub use rwt_core::Lattice;
     pub use rwt_core::streaming::{Falloff, StreamingConfig};
 }
 

@@ -5,7 +5,7 @@ use fast_poisson::Poisson2D;
 use glam::DVec2;
 use rwt_core::density::Placement;
 use rwt_core::density::{Constant, Density, ImageDensity, NoiseDensity, NoiseParams};
-use rwt_core::query::{Point, Rect, Sampler};
+use rwt_core::query::{Lattice, Point, Rect, Sampler};
 use rwt_core::rng::Rng;
 use rwt_core::tileset::TileSet;
 use std::hint::black_box;
@@ -109,6 +109,7 @@ pub fn run(quick: bool) -> Result<(), String> {
     let uniform_time = bench.throughput()?;
     bench.against_bridson(if quick { 50_000.0 } else { 200_000.0 });
     bench.scaling(uniform_time)?;
+    bench.lattice()?;
     bench.parallel();
     Ok(())
 }
@@ -219,6 +220,43 @@ impl Bench {
 
     /// The parallel query against the serial one, on the noise density (where a query's
     /// time goes into evaluating the density rather than writing points).
+    /// What each seed's own lattice costs against the aligned one (the noise density, over
+    /// the whole world and as the 64 chunks of 4 x 4 tiles a streaming world queries): the
+    /// seeded lattice's tiles are turned, so rectangles cut them and bounds cover their
+    /// boxes.
+    fn lattice(&mut self) -> Result<(), String> {
+        let noise = bench_noise(self.d_uniform);
+        let (rect, runs, out) = (self.rect, self.runs, &mut self.out);
+        let chunks: Vec<Rect> = (0..64)
+            .map(|k| {
+                let min = DVec2::new((k % 8) as f64, (k / 8) as f64) * 4.0;
+                Rect::new(min, min + 4.0)
+            })
+            .collect::<Result<_, _>>()
+            .map_err(|e| e.to_string())?;
+        let mut time = |sampler: &Sampler| {
+            let whole = best_time(runs, || {
+                out.clear();
+                black_box(sampler.query(rect, &noise, out).unwrap_or_default());
+            });
+            let chunked = best_time(runs, || {
+                out.clear();
+                for chunk in &chunks {
+                    black_box(sampler.query(*chunk, &noise, out).unwrap_or_default());
+                }
+            });
+            (whole, chunked)
+        };
+        let seeded = time(&self.sampler);
+        let aligned = time(&self.sampler.clone().with_lattice(Lattice::Aligned));
+        say!(
+            "seeded lattice over aligned (noise): whole world {:.2}x, 4x4-tile chunks {:.2}x",
+            seeded.0 / aligned.0,
+            seeded.1 / aligned.1
+        );
+        Ok(())
+    }
+
     fn parallel(&mut self) {
         let noise = bench_noise(self.d_uniform);
         let (sampler, rect, out) = (&self.sampler, self.rect, &mut self.out);

@@ -17,6 +17,7 @@ mod stipple_cmd;
 mod tileset_cmd;
 
 use clap::{Parser, Subcommand};
+use rwt_core::Lattice;
 use rwt_core::construction::BuildConfig;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -50,9 +51,14 @@ enum Command {
         /// `:NUMBER` goes in double quotes: `image:"a:5":500`.
         #[arg(long)]
         density: String,
-        /// Tiling seed.
+        /// Tiling seed: each seed turns and moves the whole tiling, so that two seeds give
+        /// independent point sets.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Lay the tiles of every seed on one grid, unturned (where points were before
+        /// seeds turned the tiling).
+        #[arg(long)]
+        aligned_lattice: bool,
         /// Width of a base tile in world units.
         #[arg(long, default_value_t = 1.0, value_parser = finite)]
         tile_size: f64,
@@ -170,6 +176,7 @@ fn main() -> ExitCode {
             rect,
             density,
             seed,
+            aligned_lattice,
             tile_size,
             budget,
             out,
@@ -178,6 +185,10 @@ fn main() -> ExitCode {
             rect: [rect[0], rect[1], rect[2], rect[3]],
             density: &density,
             seed,
+            lattice: match aligned_lattice {
+                true => Lattice::Aligned,
+                false => Lattice::Seeded,
+            },
             tile_size,
             budget,
             out: out.as_deref(),

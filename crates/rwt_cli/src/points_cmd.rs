@@ -8,7 +8,7 @@ use glam::DVec2;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rwt_core::density::Density;
 use rwt_core::files::AtomicFile;
-use rwt_core::query::{Point, Rect, Sampler};
+use rwt_core::query::{Lattice, Point, Rect, Sampler};
 use rwt_core::tileset::TileSet;
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -24,6 +24,8 @@ pub struct PointsArgs<'a> {
     pub density: &'a str,
     /// Tiling seed.
     pub seed: u64,
+    /// How the seed places the tiling.
+    pub lattice: Lattice,
     /// Base tile size in world units.
     pub tile_size: f64,
     /// Point budget.
@@ -50,6 +52,7 @@ pub fn run(args: PointsArgs) -> Result<(), String> {
         None => TileSet::embedded(),
     };
     let sampler = Sampler::new(&set, args.seed)
+        .with_lattice(args.lattice)
         .with_tile_size(args.tile_size)
         .with_budget(args.budget);
     // Refused queries stop here, before any output exists.

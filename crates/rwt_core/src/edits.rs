@@ -5,7 +5,7 @@
 //! often its region is generated again.
 //!
 //! The file format is small and checked: a header (magic, version, the [`EditStamp`] of the
-//! point set the identities refer to), the edits in identity order, each as the difference
+//! point set the identities refer to: lattice, seed and tile set), the edits in identity order, each as the difference
 //! from the one before (a few bytes), and a CRC-32 of everything before it.
 //!
 //! ```
@@ -31,7 +31,7 @@
 //! assert_eq!(points[0].class, 2);
 //! ```
 
-use crate::query::{MAX_LEVEL, Point, PointId, Sampler};
+use crate::query::{Lattice, MAX_LEVEL, Point, PointId, Sampler};
 use std::collections::BTreeMap;
 use thiserror::Error;
 
@@ -44,12 +44,15 @@ pub enum Edit {
     Reclass(u16),
 }
 
-/// What the identities of an edit set refer to: the tiling seed and the tile set. Edits
-/// read back under another stamp would name other points, so they are refused.
+/// What the identities of an edit set refer to: the tiling seed, how it places the lattice,
+/// and the tile set. Edits read back under another stamp would name other points, or put
+/// them elsewhere, so they are refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct EditStamp {
     /// The tiling seed (a scatter layer's seed).
     pub seed: u64,
+    /// How the seed places the lattice (files of format 1 are [`Lattice::Aligned`]).
+    pub lattice: Lattice,
     /// [`crate::TileSet::fingerprint`] of the tile set.
     pub tile_set: u64,
 }
@@ -59,6 +62,7 @@ impl EditStamp {
     pub fn of(sampler: &Sampler) -> Self {
         Self {
             seed: sampler.seed(),
+            lattice: sampler.lattice(),
             tile_set: sampler.tile_set_fingerprint(),
         }
     }
@@ -75,9 +79,14 @@ pub const MAX_EDITS_FILE_BYTES: u64 = 64 << 20;
 
 /// First bytes of an edits file.
 const MAGIC: &[u8; 4] = b"RWTE";
-/// Version of the format this library writes and reads.
-pub const EDITS_FORMAT: u8 = 1;
-/// Bytes of the header: magic, version, seed, tile set fingerprint.
+/// Version of the format this library writes (it reads this one and
+/// [`EDITS_FORMAT_ALIGNED`]).
+pub const EDITS_FORMAT: u8 = 2;
+/// The format written before seeded lattices: no lattice in the header, its identities
+/// name points of [`Lattice::Aligned`].
+pub const EDITS_FORMAT_ALIGNED: u8 = 1;
+/// Bytes of the header of format 1: magic, version, seed, tile set fingerprint (format 2
+/// has a lattice byte after the version).
 const HEADER_BYTES: usize = 4 + 1 + 8 + 8;
 
 /// Why bytes are not an edits file for the expected point set.
@@ -102,16 +111,31 @@ pub enum EditsError {
         /// Checksum of the bytes before it.
         found: u32,
     },
-    /// The edits refer to another point set (another seed or tile set).
+    /// The edits refer to another point set (another seed, lattice or tile set).
     #[error(
-        "edits were made for seed {} and tile set {:016x}, not seed {} and tile set {:016x}",
-        found.seed, found.tile_set, expected.seed, expected.tile_set
+        "edits were made for seed {} on the {} lattice and tile set {:016x}, not seed {} on the \
+         {} lattice and tile set {:016x}",
+        found.seed, found.lattice, found.tile_set, expected.seed, expected.lattice, expected.tile_set
     )]
     Mismatch {
         /// The stamp in the file.
         found: EditStamp,
         /// The stamp of the point set they were read for.
         expected: EditStamp,
+    },
+    /// A file of format 1 (its points on the aligned lattice) read for a point set on the
+    /// seeded lattice: its points lie elsewhere there, so it is refused rather than
+    /// shifted.
+    #[error(
+        "edits file of format {version} names points of the aligned lattice (written before \
+         seeded lattices), and this point set lies on the {expected} lattice: read it for \
+         `Lattice::Aligned` (a layer file's `lattice: Aligned`) to keep its places"
+    )]
+    FormatLattice {
+        /// The file's format version.
+        version: u8,
+        /// The lattice it was read for.
+        expected: Lattice,
     },
     /// More edits than [`MAX_EDITS`], in a file's count or in a set being edited.
     #[error("{count} edits, over the limit of {limit}")]
@@ -240,9 +264,10 @@ impl EditSet {
 
     /// The set as an edits file for the point set of `stamp`.
     pub fn to_bytes(&self, stamp: &EditStamp) -> Vec<u8> {
-        let mut out = Vec::with_capacity(HEADER_BYTES + 8 + 6 * self.0.len());
+        let mut out = Vec::with_capacity(HEADER_BYTES + 9 + 6 * self.0.len());
         out.extend_from_slice(MAGIC);
         out.push(EDITS_FORMAT);
+        out.push(lattice_byte(stamp.lattice));
         out.extend_from_slice(&stamp.seed.to_le_bytes());
         out.extend_from_slice(&stamp.tile_set.to_le_bytes());
         put_varint(&mut out, self.0.len() as u64);
@@ -277,25 +302,72 @@ impl EditSet {
                 found,
             });
         }
-        if body[4] != EDITS_FORMAT {
-            return Err(EditsError::Version {
-                found: body[4],
-                supported: EDITS_FORMAT,
+        let (stamp, header) = read_stamp(body)?;
+        if stamp.lattice != expected.lattice
+            && body[4] == EDITS_FORMAT_ALIGNED
+            && (stamp.seed, stamp.tile_set) == (expected.seed, expected.tile_set)
+        {
+            return Err(EditsError::FormatLattice {
+                version: body[4],
+                expected: expected.lattice,
             });
         }
-        let word = |at: usize| u64::from_le_bytes(body[at..at + 8].try_into().expect("8 bytes"));
-        let stamp = EditStamp {
-            seed: word(5),
-            tile_set: word(13),
-        };
         if stamp != *expected {
             return Err(EditsError::Mismatch {
                 found: stamp,
                 expected: *expected,
             });
         }
-        decode_records(&body[HEADER_BYTES..])
+        decode_records(&body[header..])
     }
+}
+
+/// A lattice as the header's byte.
+fn lattice_byte(lattice: Lattice) -> u8 {
+    match lattice {
+        Lattice::Seeded => 0,
+        Lattice::Aligned => 1,
+    }
+}
+
+/// The stamp of a checksummed file's `body` (at least [`HEADER_BYTES`] long), and where its
+/// records start.
+fn read_stamp(body: &[u8]) -> Result<(EditStamp, usize), EditsError> {
+    let (lattice, at) = match body[4] {
+        EDITS_FORMAT_ALIGNED => (Lattice::Aligned, 5),
+        EDITS_FORMAT => {
+            let lattice = match body[5] {
+                0 => Lattice::Seeded,
+                1 => Lattice::Aligned,
+                _ => {
+                    return Err(EditsError::Record {
+                        record: 0,
+                        what: "unknown lattice in the header",
+                    });
+                }
+            };
+            (lattice, 6)
+        }
+        found => {
+            return Err(EditsError::Version {
+                found,
+                supported: EDITS_FORMAT,
+            });
+        }
+    };
+    if body.len() < at + 16 {
+        return Err(EditsError::Record {
+            record: 0,
+            what: "header cut short",
+        });
+    }
+    let word = |at: usize| u64::from_le_bytes(body[at..at + 8].try_into().expect("8 bytes"));
+    let stamp = EditStamp {
+        seed: word(at),
+        lattice,
+        tile_set: word(at + 8),
+    };
+    Ok((stamp, at + 16))
 }
 
 /// How a record's identity differs from the one before it (identities are in order, so the

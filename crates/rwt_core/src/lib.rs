@@ -103,7 +103,7 @@ pub use density::{
     Constant, Density, DistanceFalloff, Exclude, FnDensity, ImageDensity, LocalModel, Mask,
     NoiseDensity, NoiseParams, Placement, Product, Scale, Sum, SumOf,
 };
-pub use query::{Point, PointId, QueryError, Rect, Sampler};
+pub use query::{Lattice, Point, PointId, QueryError, Rect, Sampler};
 pub use tileset::{TileSet, TileSetError};
 pub use tiling::Tiling;
 

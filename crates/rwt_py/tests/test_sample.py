@@ -276,3 +276,39 @@ def test_bad_clumps_are_value_errors_when_made():
     ]:
         with pytest.raises(ValueError, match=words):
             rwt.Clumps(**bad)
+
+
+def _strip_counts(points, side, per_unit):
+    strips = int(side * per_unit)
+    cells = np.minimum((points * per_unit).astype(np.int64), strips - 1)
+    return np.concatenate([np.bincount(cells[:, 0], minlength=strips),
+                           np.bincount(cells[:, 1], minlength=strips)]).astype(float)
+
+
+def _coincident(a, b):
+    """The fraction of b's points within a millionth of a tile of one of a's, modulo the tile."""
+    key = lambda p: np.round(np.mod(p, 1.0) * 1e6).astype(np.int64)
+    ka = {tuple(k) for k in key(a)}
+    kb = key(b)
+    near = [any((x + dx, y + dy) in ka for dx in (-1, 0, 1) for dy in (-1, 0, 1)) for x, y in kb]
+    return float(np.mean(near))
+
+
+def test_seeds_are_independent_sets():
+    # Ten pairs of seeds, beside ten pairs of white-noise sets of the same size.
+    side, rect = 32.0, (0.0, 0.0, 32.0, 32.0)
+    sets = [rwt.sample(rect, 64.0, seed=s, tile_size=1.0).points for s in range(1, 21)]
+    rng = np.random.default_rng(7)
+    worst, worst_white, shared, shared_white = 0.0, 0.0, 0.0, 0.0
+    for a, b in zip(sets[0::2], sets[1::2]):
+        c = np.corrcoef(_strip_counts(a, side, 8), _strip_counts(b, side, 8))[0, 1]
+        worst = max(worst, abs(c))
+        shared = max(shared, _coincident(a, b))
+        wa, wb = rng.uniform(0, side, a.shape), rng.uniform(0, side, b.shape)
+        cw = np.corrcoef(_strip_counts(wa, side, 8), _strip_counts(wb, side, 8))[0, 1]
+        worst_white = max(worst_white, abs(cw))
+        shared_white = max(shared_white, _coincident(wa, wb))
+    print(f"strip correlation {worst:.3f} (white {worst_white:.3f}), "
+          f"coincident {shared:.5f} (white {shared_white:.5f})")
+    assert worst <= 0.1
+    assert shared <= 3 * max(shared_white, 1.0 / len(sets[0]))

@@ -27,7 +27,7 @@ use crate::look::{
 use bevy::prelude::*;
 use rwt_core::clumps::Clumps;
 use rwt_core::density::{Constant, Density, NoiseDensity};
-use rwt_core::query::Point;
+use rwt_core::query::{Lattice, Point};
 use rwt_core::streaming::{Falloff, StreamingConfig};
 use std::sync::Arc;
 
@@ -352,6 +352,10 @@ pub struct ScatterLayer {
     pub tile_size: f64,
     /// Tiling seed: different seeds give unrelated layouts.
     pub seed: u64,
+    /// How the seed places the tile lattice: [`Lattice::Seeded`] (the default; layers of
+    /// different seeds share no lattice), or [`Lattice::Aligned`], where worlds saved
+    /// before seeded lattices keep their places (layer files and edits of format 1).
+    pub lattice: Lattice,
     /// Chunk size and load / unload distances.
     pub streaming: StreamingConfig,
     /// Level of detail by density: full density near the viewers, fading to none farther
@@ -431,6 +435,7 @@ impl ScatterLayer {
             classes,
             tile_size: DEFAULT_TILE_SIZE,
             seed: 0,
+            lattice: Lattice::Seeded,
             streaming: StreamingConfig::default(),
             falloff: None,
             plane: GroundPlane::Xz,
@@ -453,6 +458,12 @@ impl ScatterLayer {
     /// Sets the seed.
     pub fn with_seed(mut self, seed: u64) -> Self {
         self.seed = seed;
+        self
+    }
+
+    /// Sets how the seed places the tile lattice.
+    pub fn with_lattice(mut self, lattice: Lattice) -> Self {
+        self.lattice = lattice;
         self
     }
 

@@ -71,6 +71,16 @@ pub enum SaveError {
         /// What is wrong with it (boxed: parser errors are large).
         error: Box<SaveTextError>,
     },
+    /// The save is of a format this library does not read (a newer one).
+    #[error("{}: save format {found} is not supported (this library reads 1 to {supported})", file.display())]
+    Format {
+        /// The index file.
+        file: PathBuf,
+        /// Its format.
+        found: u32,
+        /// The newest format read here.
+        supported: u32,
+    },
     /// A saved map is not an image of at most its map's size.
     #[error("{}: {error}", file.display())]
     Decode {

@@ -19,6 +19,15 @@ use std::path::Path;
 /// The index file a save writes beside its files.
 pub const INDEX_FILE: &str = "painted.ron";
 
+/// The save format this library writes: 2 names each layer's lattice in its layer file and
+/// edits files (format 1, with no `format` in its index, kept every layer on the aligned
+/// lattice; its files say so, and load as such).
+pub const SAVE_FORMAT: u32 = 2;
+
+fn format_1() -> u32 {
+    1
+}
+
 /// Largest index or layer file a load reads.
 const MAX_TEXT_BYTES: u64 = 1 << 20;
 
@@ -34,8 +43,11 @@ pub struct PaintedMapEntry {
 /// The index of a folder of saved maps (`painted.ron`): what a layer file or another game
 /// needs to read them (each PNG is the linear map value as 16-bit grey, row 0 at max z),
 /// and the layer files written beside them.
-#[derive(Serialize, Deserialize, Clone, Debug, Default, PartialEq)]
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct PaintedMaps {
+    /// The save's format ([`SAVE_FORMAT`]; an index without it is of format 1).
+    #[serde(default = "format_1")]
+    pub format: u32,
     /// The maps.
     pub maps: Vec<PaintedMapEntry>,
     /// The layer files (`*.layer.ron`, relative to the index) of the maps' layers, which
@@ -57,8 +69,21 @@ pub struct SavedEdits {
     pub file: String,
 }
 
+impl Default for PaintedMaps {
+    /// An empty index of this library's format.
+    fn default() -> Self {
+        Self {
+            format: SAVE_FORMAT,
+            maps: Vec::new(),
+            layers: Vec::new(),
+            edits: Vec::new(),
+        }
+    }
+}
+
 impl PaintedMaps {
-    /// Reads `dir/painted.ron` (finishing first a save that a crash interrupted there).
+    /// Reads `dir/painted.ron` (finishing first a save that a crash interrupted there); a
+    /// save of a newer format is [`SaveError::Format`].
     pub fn read(dir: &Path) -> Result<Self, SaveError> {
         recover(dir)?;
         let path = dir.join(INDEX_FILE);
@@ -67,6 +92,13 @@ impl PaintedMaps {
             file: path.clone(),
             error: Box::new(e.into()),
         })?;
+        if !(1..=SAVE_FORMAT).contains(&index.format) {
+            return Err(SaveError::Format {
+                file: path,
+                found: index.format,
+                supported: SAVE_FORMAT,
+            });
+        }
         let edits = index.edits.iter().map(|e| &e.file);
         let names = index
             .maps

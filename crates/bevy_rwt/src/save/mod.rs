@@ -55,7 +55,7 @@ mod files;
 mod plugin;
 
 pub use error::{MapError, MapProblem, SaveError, SaveTextError, UnsavedLayer};
-pub use files::{INDEX_FILE, PaintedMapEntry, PaintedMaps, SavedEdits};
+pub use files::{INDEX_FILE, PaintedMapEntry, PaintedMaps, SAVE_FORMAT, SavedEdits};
 pub use plugin::{RwtSavePlugin, SaveSystems};
 
 use crate::layers::{GroundMap, LayerDensity, ScatterLayer};

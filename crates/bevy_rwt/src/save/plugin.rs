@@ -75,7 +75,7 @@ impl WorldParts<'_, '_> {
                 name: name.to_string(),
                 entity,
                 edits: edits.edits(),
-                stamp: tile_set.stamp(layer.seed),
+                stamp: tile_set.stamp(layer),
             })
             .collect())
     }

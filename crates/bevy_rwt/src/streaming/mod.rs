@@ -89,10 +89,11 @@ impl RwtTileSet {
         }
     }
 
-    /// What the point identities of a layer of `seed` refer to (in saves).
-    pub fn stamp(&self, seed: u64) -> EditStamp {
+    /// What the point identities of `layer` refer to (in saves).
+    pub fn stamp(&self, layer: &ScatterLayer) -> EditStamp {
         EditStamp {
-            seed,
+            seed: layer.seed,
+            lattice: layer.lattice,
             tile_set: self.fingerprint,
         }
     }
@@ -200,7 +201,9 @@ impl LayerState {
     fn sampler(&mut self, layer: &ScatterLayer, tile_set: &TileSet, budget: usize) -> Arc<Sampler> {
         self.sampler
             .get_or_insert_with(|| {
-                let sampler = Sampler::new(tile_set, layer.seed).with_budget(budget);
+                let sampler = Sampler::new(tile_set, layer.seed)
+                    .with_lattice(layer.lattice)
+                    .with_budget(budget);
                 Arc::new(sampler.with_tile_size(layer.tile_size))
             })
             .clone()

@@ -5,7 +5,10 @@ use crate::common::*;
 use bevy::prelude::*;
 use bevy_rwt::edits::EditInstance;
 use bevy_rwt::prelude::*;
-use bevy_rwt::save::{LoadSummary, PaintedMaps, SaveError, SaveSummary, WorldLoaded, WorldSaved};
+use bevy_rwt::save::{
+    INDEX_FILE, LoadSummary, PaintedMaps, SaveError, SaveSummary, WorldLoaded, WorldSaved,
+};
+use rwt_core::edits::EditsError;
 use rwt_core::files::FileError;
 use std::path::{Path, PathBuf};
 
@@ -13,16 +16,20 @@ use std::path::{Path, PathBuf};
 /// are what the player chops) and a meadow read from a grey map (what the game repaints).
 /// Returns the app and the meadow's map.
 fn world() -> (App, NamedMap, Handle<Image>) {
+    world_on(Lattice::Seeded)
+}
+
+/// [`world`] with its layers on `lattice`.
+fn world_on(lattice: Lattice) -> (App, NamedMap, Handle<Image>) {
     let mut app = create_app();
     spawn_viewer(&mut app, Vec3::ZERO);
-    app.world_mut().spawn((
-        Name::new("forest"),
-        layer(LayerDensity::Constant(0.3)).with_seed(11),
-    ));
+    let forest = layer(LayerDensity::Constant(0.3)).with_seed(11);
+    app.world_mut()
+        .spawn((Name::new("forest"), forest.with_lattice(lattice)));
     let (map, density) = gray_map(&mut app, 0.5);
     let meadow = app
         .world_mut()
-        .spawn((Name::new("meadow"), layer(density)))
+        .spawn((Name::new("meadow"), layer(density).with_lattice(lattice)))
         .id();
     tick_app(&mut app, 2_000);
     (app, NamedMap::new(meadow, 0, "meadow"), map)
@@ -187,4 +194,75 @@ fn a_world_that_does_not_stream_says_so() {
         Err(SaveError::NotStreaming)
     ));
     assert!(!dir.exists());
+}
+
+/// Rewrites a save as format 1 wrote it: no format in its index, edits files of format 1
+/// (no lattice byte).
+fn as_format_1(dir: &Path) {
+    let index = dir.join(INDEX_FILE);
+    let text = std::fs::read_to_string(&index).unwrap();
+    let lines: Vec<&str> = text.lines().filter(|l| !l.contains("format:")).collect();
+    assert!(lines.len() < text.lines().count(), "{text}");
+    std::fs::write(&index, lines.join("\n")).unwrap();
+    for saved in PaintedMaps::read(dir).unwrap().edits {
+        let file = dir.join(&saved.file);
+        let bytes = std::fs::read(&file).unwrap();
+        let body = &bytes[..bytes.len() - 4];
+        assert_eq!(body[4], rwt_core::edits::EDITS_FORMAT);
+        let mut old = body[..4].to_vec();
+        old.push(1);
+        old.extend_from_slice(&body[6..]);
+        let crc = crc32fast::hash(&old);
+        old.extend_from_slice(&crc.to_le_bytes());
+        std::fs::write(&file, old).unwrap();
+    }
+}
+
+#[test]
+fn a_save_of_format_1_loads_placed_as_before_or_is_refused_by_its_version() {
+    let (mut app, ..) = world_on(Lattice::Aligned);
+    let untouched = layered(&mut app);
+    let chopped = chop(&mut app, 5);
+    let played = layered(&mut app);
+    let dir = scratch("format-1");
+    save(&mut app, &dir, &[]).unwrap();
+    as_format_1(&dir);
+    assert_eq!(PaintedMaps::read(&dir).unwrap().format, 1);
+
+    // Into the world it was made in (its layers on the aligned lattice): the same trees go.
+    let (mut same, ..) = world_on(Lattice::Aligned);
+    assert_eq!(layered(&mut same), untouched);
+    assert_eq!(load(&mut same, &dir, &[]).unwrap().edits, chopped);
+    tick_app(&mut same, 2_000);
+    assert_eq!(layered(&mut same), played);
+
+    // Into layers on their seeded lattices the trees would be others: refused, by version.
+    let (mut seeded, ..) = world();
+    let fresh = layered(&mut seeded);
+    let err = load(&mut seeded, &dir, &[]).unwrap_err();
+    assert!(
+        matches!(
+            &err,
+            SaveError::Edits {
+                error: EditsError::FormatLattice { version: 1, .. },
+                ..
+            }
+        ),
+        "{err:?}"
+    );
+    assert!(err.to_string().contains("format 1"), "{err}");
+    tick_app(&mut seeded, 2_000);
+    assert_eq!(layered(&mut seeded), fresh);
+
+    // A save of a newer format than this library reads: refused.
+    let index = dir.join(INDEX_FILE);
+    let text = std::fs::read_to_string(&index).unwrap();
+    let newer = format!(
+        "(format: 3,{}",
+        text.trim_start().strip_prefix('(').unwrap()
+    );
+    std::fs::write(&index, newer).unwrap();
+    let err = load(&mut seeded, &dir, &[]).unwrap_err();
+    assert!(matches!(err, SaveError::Format { found: 3, .. }), "{err:?}");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -13,6 +13,7 @@ fn embedded() -> &'static TileSet {
 fn stamp() -> EditStamp {
     EditStamp {
         seed: 11,
+        lattice: Lattice::Seeded,
         tile_set: embedded().fingerprint(),
     }
 }
@@ -154,7 +155,8 @@ fn sealed(body: &[u8]) -> Vec<u8> {
 fn malformed_records_under_a_good_checksum_are_refused() {
     let stamp = stamp();
     let empty = EditSet::default().to_bytes(&stamp);
-    let header = &empty[..HEADER_BYTES];
+    // Format 2's header: a lattice byte after the version.
+    let header = &empty[..HEADER_BYTES + 1];
     let cases: [(&[u8], &str); 5] = [
         (
             &[2, 6, 0, 0, 0, 0, 6, 0, 0, 0, 0],
@@ -196,6 +198,7 @@ fn fingerprints_tell_tile_sets_apart() {
 fn identities_a_file_cannot_hold_and_too_many_edits_are_refused() {
     let stamp = EditStamp {
         seed: 1,
+        lattice: Lattice::Seeded,
         tile_set: 2,
     };
     // Level 30 was accepted, saved, and the whole file then refused to load.
@@ -238,4 +241,48 @@ fn identities_a_file_cannot_hold_and_too_many_edits_are_refused() {
             limit: MAX_EDITS
         })
     );
+}
+
+/// `bytes` (of format 2) as format 1 wrote them: no lattice byte.
+fn as_format_1(bytes: &[u8]) -> Vec<u8> {
+    let body = &bytes[..bytes.len() - 4];
+    assert_eq!(body[4], EDITS_FORMAT);
+    let mut old = body[..5].to_vec();
+    old[4] = EDITS_FORMAT_ALIGNED;
+    old.extend_from_slice(&body[6..]);
+    sealed(&old)
+}
+
+#[test]
+fn files_of_format_1_keep_their_aligned_places_or_are_refused() {
+    let aligned = Sampler::new(embedded(), 11)
+        .with_tile_size(4.0)
+        .with_lattice(Lattice::Aligned);
+    let rect = Rect::new(DVec2::splat(-6.0), DVec2::splat(6.0)).unwrap();
+    let mut points = Vec::new();
+    aligned.query(rect, &Constant(30.0), &mut points).unwrap();
+    let edits = sample_edits(&points);
+    let stamp = EditStamp::of(&aligned);
+    assert_eq!(stamp.lattice, Lattice::Aligned);
+    let old = as_format_1(&edits.to_bytes(&stamp));
+    // Read for the aligned lattice: the same edits, naming the same points.
+    assert_eq!(EditSet::from_bytes(&old, &stamp), Ok(edits.clone()));
+    // Read for the seeded lattice: refused, naming the version, never shifted.
+    let seeded = EditStamp {
+        lattice: Lattice::Seeded,
+        ..stamp
+    };
+    let e = EditSet::from_bytes(&old, &seeded).unwrap_err();
+    assert_eq!(
+        e,
+        EditsError::FormatLattice {
+            version: 1,
+            expected: Lattice::Seeded
+        }
+    );
+    assert!(e.to_string().contains("format 1"), "{e}");
+    // A file of format 2 names its lattice: read for another, a mismatch.
+    let e = EditSet::from_bytes(&edits.to_bytes(&stamp), &seeded).unwrap_err();
+    assert!(matches!(e, EditsError::Mismatch { .. }), "{e}");
+    assert!(e.to_string().contains("aligned lattice"), "{e}");
 }

@@ -17,17 +17,19 @@ impl Sampler {
         let tile = &self.tiles[self.tile_at(level, id.x, id.y) as usize];
         let frac = tile.points.get(id.index as usize)?;
         let side = self.side(level);
-        Some(DVec2::new(
+        Some(self.placement.world(DVec2::new(
             (id.x as f64 + frac[0]) * side,
             (id.y as f64 + frac[1]) * side,
-        ))
+        )))
     }
 
-    /// The square of the tile that point `id` belongs to (half-open), whatever its index.
+    /// The world square of the tile that point `id` belongs to, whatever its index: it
+    /// holds the tile's points (on its sides too, where rounding puts one there).
     pub fn tile_rect(&self, id: &PointId) -> Option<Rect> {
         let side = self.side((id.level as u32).min(MAX_LEVEL));
         let min = DVec2::new(id.x as f64, id.y as f64) * side;
-        Rect::new(min, min + DVec2::splat(side)).ok()
+        let max = min + DVec2::splat(side);
+        (min.is_finite() && max.is_finite()).then(|| self.placement.world_rect(min, max))
     }
 
     /// Side of the tiles of `level`, divided down as the traversal divides it.

@@ -18,6 +18,7 @@
 //! its [`Point::threshold`], so raising the density anywhere only adds points, and splitting
 //! a rectangle into pieces (half-open: `[min, max)`) yields exactly the union of the pieces.
 
+mod lattice;
 mod locate;
 #[cfg(feature = "parallel")]
 mod parallel;
@@ -27,11 +28,13 @@ mod rect;
 mod traversal;
 mod work_bound;
 
+pub use lattice::Lattice;
 pub use point::{Point, PointId};
 pub use rect::Rect;
 
 use crate::density::{Density, SumOf, sanitize};
 use crate::tileset::TileSet;
+use lattice::Placement;
 use prepared::PreparedTile;
 use std::sync::Arc;
 use traversal::Visit;
@@ -131,14 +134,18 @@ pub struct Sampler {
     colors: u8,
     seed: u64,
     tile_size: f64,
+    lattice: Lattice,
+    /// Where the seed's lattice lies in the world (from the seed, lattice and tile size).
+    placement: Placement,
     budget: usize,
     /// [`TileSet::fingerprint`] of the set.
     fingerprint: u64,
 }
 
 impl Sampler {
-    /// A sampler over `set`'s tiling for `seed`, with base tiles 1 world unit wide and a
-    /// budget of [`DEFAULT_BUDGET`] points per query.
+    /// A sampler over `set`'s tiling for `seed`, with base tiles 1 world unit wide on the
+    /// seed's own lattice ([`Lattice::Seeded`]) and a budget of [`DEFAULT_BUDGET`] points
+    /// per query.
     pub fn new(set: &TileSet, seed: u64) -> Self {
         let tiles = set
             .tiles
@@ -153,6 +160,8 @@ impl Sampler {
             colors: set.colors,
             seed,
             tile_size: 1.0,
+            lattice: Lattice::Seeded,
+            placement: Placement::new(Lattice::Seeded, seed, 1.0),
             budget: DEFAULT_BUDGET,
             fingerprint: set.fingerprint(),
         }
@@ -162,7 +171,7 @@ impl Sampler {
     /// prepared tiles are shared), unlike [`Sampler::new`].
     pub fn with_seed(mut self, seed: u64) -> Self {
         self.seed = seed;
-        self
+        self.place()
     }
 
     /// Base tiles `size` world units wide (finite, positive).
@@ -170,6 +179,19 @@ impl Sampler {
         if size.is_finite() && size > 0.0 {
             self.tile_size = size;
         }
+        self.place()
+    }
+
+    /// How the seed places the tiling: [`Lattice::Aligned`] keeps the places of point sets
+    /// of format 1 (edits and layer files written before the seeded lattice).
+    pub fn with_lattice(mut self, lattice: Lattice) -> Self {
+        self.lattice = lattice;
+        self.place()
+    }
+
+    /// The placement of the seed, lattice and tile size.
+    fn place(mut self) -> Self {
+        self.placement = Placement::new(self.lattice, self.seed, self.tile_size);
         self
     }
 
@@ -189,6 +211,11 @@ impl Sampler {
         self.seed
     }
 
+    /// How the seed places the tiling.
+    pub fn lattice(&self) -> Lattice {
+        self.lattice
+    }
+
     /// [`TileSet::fingerprint`] of the set the sampler was made from.
     pub fn tile_set_fingerprint(&self) -> u64 {
         self.fingerprint
@@ -197,6 +224,16 @@ impl Sampler {
     /// Points per tile of the underlying set.
     pub fn points_per_tile(&self) -> usize {
         self.points_per_tile
+    }
+
+    /// The world rectangle of base tiles `range`.
+    fn block_rect(&self, range: TileRange) -> Rect {
+        let s = self.tile_size;
+        let TileRange { i0, i1, j0, j1 } = range;
+        self.placement.world_rect(
+            glam::DVec2::new(i0 as f64 * s, j0 as f64 * s),
+            glam::DVec2::new(i1 as f64 * s, j1 as f64 * s),
+        )
     }
 
     fn check(&self, rect: &Rect) -> Result<(), QueryError> {
@@ -263,13 +300,8 @@ impl Sampler {
         if rect.is_empty() {
             return Ok(None);
         }
-        let s = self.tile_size;
-        Ok(Some(TileRange {
-            i0: (rect.min().x / s).floor() as i64,
-            i1: (rect.max().x / s).ceil() as i64,
-            j0: (rect.min().y / s).floor() as i64,
-            j1: (rect.max().y / s).ceil() as i64,
-        }))
+        let [i0, i1, j0, j1] = self.placement.tile_range(rect, self.tile_size);
+        Ok(Some(TileRange { i0, i1, j0, j1 }))
     }
 
     /// All points of `rect` for `density`, appended to `out`; returns how many.

@@ -281,7 +281,7 @@ impl Kept {
             let list = sampler.cell_list(frame.list);
             out.extend(self.slots[start..end].iter().map(|&slot| {
                 let cp = &list[slot as usize];
-                frame.point(cp, frame.position(cp))
+                frame.point(cp, frame.position(cp, &sampler.placement))
             }));
         }
     }
@@ -498,12 +498,9 @@ impl<D: Density + Sync + ?Sized> Iterator for Plan<'_, '_, D> {
                 continue;
             }
             let fork = self.fork;
-            let s = fork.sampler.tile_size();
-            let block = Rect::from_ordered(
-                DVec2::new(i0 as f64 * s, j0 as f64 * s),
-                DVec2::new(i1 as f64 * s, j1 as f64 * s),
-            );
-            let bound = block
+            let bound = fork
+                .sampler
+                .block_rect(range)
                 .intersect(&fork.rect)
                 .map(|b| sanitize(fork.density.max_over(b.min(), b.max())));
             if !bound.is_some_and(|b| b > 0.0) {

@@ -1,9 +1,10 @@
 //! The traversal of a query: base tiles in blocks, then each tile's cells, its subdivision
 //! ranking and its children, where the density's bounds ask for them.
 
+use super::lattice::Placement;
 use super::point::{Point, PointId};
 use super::prepared::CellPoint;
-use super::{MAX_LEVEL, OFFSET_STREAM, Rect, Sampler};
+use super::{MAX_LEVEL, OFFSET_STREAM, Rect, Sampler, TileRange};
 use crate::density::{Density, LocalModel, sanitize};
 use crate::rng::{hash_words, unit_f64};
 use crate::tiling::base_tile;
@@ -83,14 +84,14 @@ pub(super) struct Frame {
 }
 
 impl Frame {
-    /// The world position of `cp`.
+    /// The world position of `cp`, on the sampler's `placement`.
     #[inline(always)]
-    pub fn position(&self, cp: &CellPoint) -> DVec2 {
+    pub fn position(&self, cp: &CellPoint, placement: &Placement) -> DVec2 {
         let o = &self.owner;
-        DVec2::new(
+        placement.world(DVec2::new(
             (o.ix as f64 + cp.frac[0]) * o.side,
             (o.iy as f64 + cp.frac[1]) * o.side,
-        )
+        ))
     }
 
     /// The rank of `cp` in its tile's ranking.
@@ -128,11 +129,23 @@ struct TileAt {
 }
 
 impl TileAt {
-    fn rect(&self) -> Rect {
+    /// The tile's world square on `placement` (closed: it holds its points).
+    fn rect(&self, placement: &Placement) -> Rect {
         let s = self.side;
-        Rect::from_ordered(
+        placement.world_rect(
             DVec2::new(self.ix as f64 * s, self.iy as f64 * s),
             DVec2::new((self.ix + 1) as f64 * s, (self.iy + 1) as f64 * s),
+        )
+    }
+
+    /// The world square of the tile's cell `(a, b)` of `n x n` on `placement`.
+    fn cell_rect(&self, (a, b): (i64, i64), n: i64, placement: &Placement) -> Rect {
+        let child_s = self.side / n as f64;
+        let origin = DVec2::new(self.ix as f64 * self.side, self.iy as f64 * self.side);
+        let cell = DVec2::new(a as f64, b as f64);
+        placement.world_rect(
+            origin + cell * child_s,
+            origin + (cell + DVec2::ONE) * child_s,
         )
     }
 }
@@ -186,10 +199,7 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
         }
         // Sides compared separately: their product can overflow for huge rectangles.
         if i1 - i0 > LEAF_BLOCK || j1 - j0 > LEAF_BLOCK {
-            let block = Rect::from_ordered(
-                DVec2::new(i0 as f64 * s, j0 as f64 * s),
-                DVec2::new(i1 as f64 * s, j1 as f64 * s),
-            );
+            let block = self.sampler.block_rect(TileRange { i0, i1, j0, j1 });
             let Some(block) = block.intersect(&self.rect) else {
                 return;
             };
@@ -231,7 +241,7 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
     /// lower bound are taken without evaluating the density (the bound guarantees the
     /// evaluation would take them).
     fn tile(&mut self, t: u16, at: TileAt, known: Option<Known>) {
-        let tile_rect = at.rect();
+        let tile_rect = at.rect(&self.sampler.placement);
         let Some(clip) = tile_rect.intersect(&self.rect) else {
             return;
         };
@@ -264,7 +274,7 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
     /// parent's model) serve all cells. A cell's own local model, where the density has one,
     /// gives both its bounds and its points' decisions.
     fn cell_bounds(&self, at: TileAt, known: Known, clipped: bool) -> CellBounds {
-        let n = self.sampler.n;
+        let (n, placement) = (self.sampler.n, self.sampler.placement);
         let cells = (n * n) as usize;
         let Known { limit, low, model } = known;
         let mut bounds = CellBounds {
@@ -276,14 +286,8 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
             return bounds;
         }
         let area = at.side * at.side;
-        let child_s = at.side / n as f64;
-        let origin = at.rect().min();
         for cell in 0..cells {
-            let (a, b) = ((cell as i64 % n) as f64, (cell as i64 / n) as f64);
-            let cell_rect = Rect::from_ordered(
-                origin + DVec2::new(a, b) * child_s,
-                origin + DVec2::new(a + 1.0, b + 1.0) * child_s,
-            );
+            let cell_rect = at.cell_rect((cell as i64 % n, cell as i64 / n), n, &placement);
             let Some(r) = cell_rect.intersect(&self.rect) else {
                 (bounds.limit[cell], bounds.low[cell]) = (0.0, 0.0);
                 continue;
@@ -410,7 +414,7 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
             .take_while(|cp| (cp.rank as f64) < run.limit)
             .enumerate()
         {
-            let p = frame.position(cp);
+            let p = frame.position(cp, &self.sampler.placement);
             let rank = frame.rank(cp);
             if self.rect.contains(p) && (rank < run.sure || self.decide(&run, p, rank)) {
                 self.emit.accept(frame, slot, cp, p);

@@ -2,7 +2,7 @@
 
 use super::{
     ClassDescription, DensityDescription, HeightDescription, InstancedShadingDescription,
-    KeepOutDescription, LayerDescription, LayerFileError, LayerPart, LodDescription,
+    KeepOutDescription, LAYER_FORMAT, LayerDescription, LayerFileError, LayerPart, LodDescription,
     MapDescription, MaterialDescription, MeshDescription, NamedAssets, PromotionDescription,
     Undescribable,
 };
@@ -34,6 +34,7 @@ impl LayerDescription {
             classes,
             tile_size,
             seed,
+            lattice,
             streaming,
             falloff,
             plane,
@@ -72,9 +73,11 @@ impl LayerDescription {
             None => None,
         };
         Ok(Self {
+            format: LAYER_FORMAT,
             classes,
             tile_size: *tile_size,
             seed: *seed,
+            lattice: Some(*lattice),
             chunk_size: Some(streaming.chunk_size),
             load_distance: Some(streaming.load_distance),
             unload_distance: Some(streaming.unload_distance),

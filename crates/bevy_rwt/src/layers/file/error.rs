@@ -50,6 +50,14 @@ pub enum LayerFileError {
 /// A layer file's values out of range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum InvalidLayer {
+    /// A format this library does not read (a newer one).
+    #[error("layer file format {found} is not supported (this library reads 1 to {supported})")]
+    Format {
+        /// The file's format.
+        found: u32,
+        /// The newest format read here.
+        supported: u32,
+    },
     /// No class.
     #[error("a layer needs at least one class")]
     NoClasses,

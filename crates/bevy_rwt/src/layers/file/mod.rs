@@ -4,6 +4,7 @@
 //!
 //! ```ron
 //! (
+//!     format: 2,
 //!     tile_size: 8.0,
 //!     seed: 7,
 //!     chunk_size: 32.0,
@@ -29,6 +30,7 @@
 //!
 //! ```ron
 //! (
+//!     format: 2,
 //!     ground: Surfaces,
 //!     surfaces: Every,
 //!     max_slope: 0.7,
@@ -40,6 +42,10 @@
 //!     ],
 //! )
 //! ```
+//!
+//! `format: 2` is this library's format: a file without it is of format 1, written before
+//! seeds turned the tiling, and its layer keeps its places on [`Lattice::Aligned`]
+//! (`lattice: Aligned` does the same in format 2).
 //!
 //! In code, a file is parsed and checked by [`LayerDescription::from_ron`], becomes a
 //! layer with [`LayerDescription::to_layer`], and a layer becomes a file again with
@@ -76,6 +82,7 @@
 //! Named("terrain")`) through [`NamedAssets`], and [`LayerDescription::describe`] turns a
 //! layer built in code back into a file.
 
+mod check;
 mod describe;
 mod error;
 mod loader;
@@ -95,6 +102,7 @@ use super::{
 use crate::ground::SurfacePolicy;
 use crate::look::{GroundPlane, InstancedShading, InstancedShadows, MeshLod, Stance, blade_mesh};
 use bevy::prelude::*;
+use rwt_core::Lattice;
 use rwt_core::clumps::{ClumpParams, Clumps};
 use rwt_core::density::{NoiseDensity, NoiseParams};
 use rwt_core::streaming::Falloff;
@@ -404,10 +412,22 @@ fn default_tile() -> f64 {
     DEFAULT_TILE_SIZE
 }
 
+/// The layer file format this library writes. It reads this one and format 1, the files
+/// written before seeded lattices (no `format` field), whose layers keep their places on
+/// [`Lattice::Aligned`].
+pub const LAYER_FORMAT: u32 = 2;
+
+fn format_1() -> u32 {
+    1
+}
+
 /// A whole layer file.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct LayerDescription {
+    /// The file's format ([`LAYER_FORMAT`]; a file without it is of format 1).
+    #[serde(default = "format_1")]
+    pub format: u32,
     /// Classes sharing the layer's point set.
     pub classes: Vec<ClassDescription>,
     /// Base tile width in world units.
@@ -416,6 +436,10 @@ pub struct LayerDescription {
     /// Tiling seed.
     #[serde(default)]
     pub seed: u64,
+    /// How the seed places the tile lattice (see [`Lattice`]); unless set, the format's:
+    /// `Seeded` from format 2 on, `Aligned` in format 1.
+    #[serde(default)]
+    pub lattice: Option<Lattice>,
     /// Chunk side.
     #[serde(default)]
     pub chunk_size: Option<f64>,
@@ -522,75 +546,13 @@ impl LayerDescription {
         Ok(d)
     }
 
-    /// Whether the values are in range.
-    fn check(&self) -> Result<(), InvalidLayer> {
-        let d = self;
-        if d.classes.is_empty() {
-            return Err(InvalidLayer::NoClasses);
-        }
-        if d.classes.len() > MAX_CLASSES {
-            return Err(InvalidLayer::TooManyClasses {
-                classes: d.classes.len(),
-                limit: MAX_CLASSES,
-            });
-        }
-        for (field, v) in [
-            ("tile_size", Some(d.tile_size)),
-            ("chunk_size", d.chunk_size),
-            ("load_distance", d.load_distance),
-            ("unload_distance", d.unload_distance),
-        ] {
-            if let Some(value) = v
-                && !(value.is_finite() && value > 0.0)
-            {
-                return Err(InvalidLayer::NotPositive { field, value });
-            }
-        }
-        let chunk = d
-            .chunk_size
-            .unwrap_or(StreamingConfig::default().chunk_size);
-        let load = d
-            .load_distance
-            .unwrap_or(StreamingConfig::default().load_distance);
-        if load / chunk > rwt_core::streaming::MAX_REACH_CHUNKS {
-            return Err(InvalidLayer::TooFar {
-                load_distance: load,
-                chunk_size: chunk,
-                limit: rwt_core::streaming::MAX_REACH_CHUNKS,
-            });
-        }
-        if let (Some(load_distance), Some(unload_distance)) = (d.load_distance, d.unload_distance)
-            && unload_distance < load_distance
-        {
-            return Err(InvalidLayer::UnloadBelowLoad {
-                load_distance,
-                unload_distance,
-            });
-        }
-        let densities = d.classes.iter().map(|c| &c.density).chain(&d.exclusion);
-        for density in densities {
-            if let DensityDescription::Clumps(params) = density {
-                Clumps::new(*params).map_err(InvalidLayer::Clumps)?;
-            }
-        }
-        for (i, c, lod) in d
-            .classes
-            .iter()
-            .enumerate()
-            .filter_map(|(i, c)| Some((i, c, c.lod.as_ref()?)))
-        {
-            if !(lod.distance.is_finite() && lod.distance > 0.0) {
-                return Err(InvalidLayer::LodDistance {
-                    class: i,
-                    distance: lod.distance,
-                });
-            }
-            let instanced = matches!(c.material, MaterialDescription::Instanced(_));
-            if instanced != matches!(lod.material, MaterialDescription::Instanced(_)) {
-                return Err(InvalidLayer::FarMaterial { class: i });
-            }
-        }
-        numbers::check(d)
+    /// How the layer's seed places the tile lattice: as the file says, or as its format
+    /// placed it.
+    pub fn lattice(&self) -> Lattice {
+        self.lattice.unwrap_or(match self.format {
+            1 => Lattice::Aligned,
+            _ => Lattice::Seeded,
+        })
     }
 
     /// The layer, with named assets from `names` and other handles made by the given
@@ -619,6 +581,7 @@ impl LayerDescription {
         let mut layer = ScatterLayer::new(classes)
             .with_tile_size(self.tile_size)
             .with_seed(self.seed)
+            .with_lattice(self.lattice())
             .with_streaming(StreamingConfig {
                 chunk_size: self.chunk_size.unwrap_or(defaults.chunk_size),
                 load_distance: self.load_distance.unwrap_or(defaults.load_distance),

@@ -530,3 +530,43 @@ fn keep_outs_by_entity_custom_grounds_and_unnamed_inserters_are_reported() {
         );
     }
 }
+
+#[test]
+fn formats_place_the_lattice_and_unknown_ones_are_refused() {
+    // A file without `format` was written before seeded lattices: its layer keeps its
+    // places on the aligned lattice.
+    let old = LayerDescription::from_ron(MEADOW).unwrap();
+    assert_eq!((old.format, old.lattice()), (1, Lattice::Aligned));
+    assert_eq!(plain(&old).lattice, Lattice::Aligned);
+    // Format 2 lays the seed's own lattice unless the file says otherwise.
+    let new = MEADOW.replacen('(', "(format: 2,", 1);
+    let new = LayerDescription::from_ron(&new).unwrap();
+    assert_eq!(plain(&new).lattice, Lattice::Seeded);
+    let kept = MEADOW.replacen('(', "(format: 2, lattice: Aligned,", 1);
+    let kept = LayerDescription::from_ron(&kept).unwrap();
+    assert_eq!(plain(&kept).lattice, Lattice::Aligned);
+    // Described layers are written in this format, with their lattice, and read back so.
+    let names = NamedAssets::default();
+    let map = uuid::<Image>(9);
+    let saved = |_: &Handle<Image>| Some("./flowers.png".to_string());
+    for lattice in [Lattice::Aligned, Lattice::Seeded] {
+        let layer = code_layer(&names, &map).with_lattice(lattice);
+        let described = LayerDescription::describe(&layer, &names, saved);
+        let text = described.unwrap().to_ron().unwrap();
+        let back = LayerDescription::from_ron(&text).unwrap();
+        assert_eq!(
+            (back.format, back.lattice()),
+            (LAYER_FORMAT, lattice),
+            "{text}"
+        );
+    }
+    for format in [0, LAYER_FORMAT + 1] {
+        let text = MEADOW.replacen('(', &format!("(format: {format},"), 1);
+        let e = LayerDescription::from_ron(&text).unwrap_err();
+        assert!(
+            matches!(e, LayerFileError::Invalid(InvalidLayer::Format { found, .. }) if found == format),
+            "{e}"
+        );
+        assert!(e.to_string().contains(&format!("format {format}")), "{e}");
+    }
+}
