@@ -12,11 +12,20 @@ if [ "${RWT_PY_KEEP:-0}" != 1 ] || [ ! -x "$venv/bin/python" ]; then
     rm -rf "$venv"
     python3 -m venv "$venv"
     "$venv/bin/pip" install --quiet --upgrade pip
-    "$venv/bin/pip" install --quiet "maturin>=1.7,<2" numpy pytest scipy "dask[array]" matplotlib
+    "$venv/bin/pip" install --quiet "maturin>=1.7,<2" numpy pytest scipy "dask[array]" matplotlib mypy
 fi
-# The one install a user makes (`pip install crates/rwt_py`); the environment already has
-# maturin, so pip builds without fetching it again.
-"$venv/bin/pip" install --quiet --no-build-isolation --force-reinstall --no-deps crates/rwt_py
+# The wheel a user installs: one abi3 wheel for every CPython from 3.9 on, with the license
+# texts; the tests run on the package installed from it.
+rm -rf target/wheels
+"$venv/bin/maturin" build --quiet --release --manifest-path crates/rwt_py/Cargo.toml --out target/wheels
+wheel=$(ls target/wheels/rwt_noise-*-cp39-abi3-*.whl)
+"$venv/bin/python" - "$wheel" <<'PY'
+import sys, zipfile
+names = zipfile.ZipFile(sys.argv[1]).namelist()
+for wanted in ("LICENSE-MIT", "LICENSE-APACHE"):
+    assert any(n.endswith(wanted) for n in names), f"{wanted} is not in {sys.argv[1]}"
+PY
+"$venv/bin/pip" install --quiet --force-reinstall --no-deps "$wheel"
 # The CLI comparison runs `rwt points`: the debug build `cargo test` made, or one made now.
 [ -x target/debug/rwt ] || cargo build --quiet -p rwt_cli
 export RWT_CLI=$PWD/target/debug/rwt

@@ -15,6 +15,7 @@ mod points_cmd;
 mod spec;
 mod stipple_cmd;
 mod tileset_cmd;
+mod zoneplate_cmd;
 
 use clap::{Parser, Subcommand};
 use rwt_core::Lattice;
@@ -115,6 +116,21 @@ enum Command {
         /// Refuse images of more pixels than this.
         #[arg(long, default_value_t = rwt_core::stipple::DEFAULT_MAX_IMAGE_PIXELS)]
         max_image_pixels: u64,
+    },
+    /// The paper's anti-aliasing test: the zone plate sin(x^2 + y^2) at one sample per pixel
+    /// with a Gaussian reconstruction, for rwt, a regular grid, jittering, white noise, dart
+    /// throwing and Owen-scrambled Sobol, against a supersampled reference: PSNR, and the
+    /// error's low band (aliasing) and high band (noise).
+    Zoneplate {
+        /// Pixels on a side.
+        #[arg(long, default_value_t = 512)]
+        size: usize,
+        /// Seed of every pattern.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Write the reference and each pattern's image side by side to this PNG.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Throughput and scaling of queries, as ratios measured in one run.
     Bench {
@@ -224,6 +240,9 @@ fn main() -> ExitCode {
         })
         .map(|()| true),
         Command::Bench { quick } => bench_cmd::run(quick).map(|()| true),
+        Command::Zoneplate { size, seed, out } => {
+            zoneplate_cmd::run(size, seed, out.as_deref()).map(|()| true)
+        }
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -15,7 +15,7 @@ from __future__ import annotations
 import dask
 import numpy as np
 
-import rwt
+import rwt_noise as rwt
 
 
 def chunk_edges(lo: float, hi: float, count: int) -> np.ndarray:

@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-import rwt  # noqa: E402
+import rwt_noise as rwt  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[3]
 

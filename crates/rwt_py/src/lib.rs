@@ -1,5 +1,5 @@
-//! The native half of the Python package `rwt`: rwt_core's queries, stippling and analysis
-//! over numpy arrays. The Python half (`python/rwt`) checks arguments, turns callables into
+//! The native half of the Python package `rwt_noise`: rwt_core's queries, stippling and analysis
+//! over numpy arrays. The Python half (`python/rwt_noise`) checks arguments, turns callables into
 //! densities and shapes the results; everything here runs with the GIL released.
 
 mod analyse;
@@ -8,10 +8,11 @@ mod interrupt;
 mod sample;
 mod stipple;
 mod tiles;
+mod zoneplate;
 
 use pyo3::prelude::*;
 
-/// `rwt._rwt`: the functions `rwt`'s Python modules call.
+/// `rwt_noise._rwt`: the functions `rwt_noise`'s Python modules call.
 #[pymodule]
 fn _rwt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // numpy's C API is imported here, with the module, not by the first call that needs it:
@@ -28,5 +29,6 @@ fn _rwt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sample::query, m)?)?;
     m.add_function(wrap_pyfunction!(stipple::stipple, m)?)?;
     m.add_function(wrap_pyfunction!(analyse::analyse, m)?)?;
+    m.add_function(wrap_pyfunction!(zoneplate::zoneplate, m)?)?;
     Ok(())
 }

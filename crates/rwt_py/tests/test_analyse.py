@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-import rwt
+import rwt_noise as rwt
 
 
 def test_blue_noise_against_white_noise():

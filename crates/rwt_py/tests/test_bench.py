@@ -1,8 +1,8 @@
-"""`python -m rwt.bench` runs and prints its table and ratio line (small sizes)."""
+"""`python -m rwt_noise.bench` runs and prints its table and ratio line (small sizes)."""
 
 import re
 
-from rwt import bench
+from rwt_noise import bench
 
 
 def test_bench_prints_its_figures(capsys):

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import rwt
+import rwt_noise as rwt
 from conftest import write_grey_png
 
 ROOT = Path(__file__).resolve().parents[3]

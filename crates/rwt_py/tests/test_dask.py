@@ -7,7 +7,7 @@ import dask
 import numpy as np
 import pytest
 
-import rwt
+import rwt_noise as rwt
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 from dask_chunks import sample_chunked  # noqa: E402

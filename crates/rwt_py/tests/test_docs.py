@@ -6,13 +6,14 @@ from pathlib import Path
 
 import pytest
 
-import rwt
-import rwt._analyse
-import rwt._sample
-import rwt._stipple
+import rwt_noise as rwt
+import rwt_noise._analyse
+import rwt_noise._sample
+import rwt_noise._stipple
+import rwt_noise._zoneplate
 
 
-@pytest.mark.parametrize("module", [rwt._sample, rwt._stipple, rwt._analyse])
+@pytest.mark.parametrize("module", [rwt._sample, rwt._stipple, rwt._analyse, rwt._zoneplate])
 def test_docstring_examples(module):
     result = doctest.testmod(module)
     assert result.attempted > 0 and result.failed == 0

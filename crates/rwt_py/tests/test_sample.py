@@ -7,7 +7,7 @@ import time
 import numpy as np
 import pytest
 
-import rwt
+import rwt_noise as rwt
 
 RECT = (-3.0, 2.0, 17.0, 14.5)
 
@@ -137,7 +137,6 @@ def test_bad_densities_are_value_errors(density):
 
 
 @pytest.mark.parametrize("f", [
-    lambda x, y: 1.0,
     lambda x, y: np.ones((len(x), 2)),
     lambda x, y: np.ones(len(x) + 1),
     lambda x, y: np.full(len(x), np.nan),
@@ -312,3 +311,84 @@ def test_seeds_are_independent_sets():
           f"coincident {shared:.5f} (white {shared_white:.5f})")
     assert worst <= 0.1
     assert shared <= 3 * max(shared_white, 1.0 / len(sets[0]))
+
+
+def test_radius_keeps_every_pair_apart():
+    from scipy.spatial import cKDTree
+
+    # From a handful of points to 100 000, several seeds each: the closest pair is r apart.
+    for rect, radius, seeds in (((0, 0, 100, 60), 20.0, 20), ((0, 0, 100, 60), 6.0, 10),
+                                ((0, 0, 1, 1), 0.01, 5), ((-5, 3, 5, 4), 0.002, 3)):
+        for seed in range(seeds):
+            s = rwt.sample(rect, radius=radius, seed=seed)
+            assert len(s) >= 2
+            gap = cKDTree(s.points).query(s.points, k=2)[0][:, 1].min()
+            assert gap >= radius, (rect, radius, seed, gap)
+    # About 0.44 / r^2 points per unit area: what 0.62 of the hexagonal spacing gives.
+    assert abs(len(rwt.sample((0, 0, 1, 1), radius=0.01)) / 4438 - 1) < 0.03
+    with pytest.raises(ValueError, match="radius"):
+        rwt.sample((0, 0, 10, 10), radius=2.0, tile_size=1.0)
+    with pytest.raises(ValueError, match="density or radius"):
+        rwt.sample((0, 0, 1, 1), 5.0, radius=0.1)
+    with pytest.raises(ValueError, match="n= and radius="):
+        rwt.sample((0, 0, 1, 1), radius=0.1, n=5)
+    with pytest.raises(ValueError, match="radius must be"):
+        rwt.sample((0, 0, 1, 1), radius=-1)
+
+
+def test_rng_follows_numpys_convention():
+    rect = (0, 0, 20, 20)
+    same_points(rwt.sample(rect, 2.0, rng=9), rwt.sample(rect, 2.0, seed=9))
+    same_points(rwt.sample(rect, 2.0, rng=np.uint8(9)), rwt.sample(rect, 2.0, seed=9))
+    # A generator draws the seed: the same generator state, the same points; and it moves on.
+    a, b = np.random.default_rng(4), np.random.default_rng(4)
+    first = rwt.sample(rect, 2.0, rng=a)
+    same_points(first, rwt.sample(rect, 2.0, rng=b))
+    assert not np.array_equal(rwt.sample(rect, 2.0, rng=a).points, first.points)
+    # The default stays reproducible: seed 0.
+    same_points(rwt.sample(rect, 2.0), rwt.sample(rect, 2.0, seed=0))
+    with pytest.raises(ValueError, match="seed= or rng="):
+        rwt.sample(rect, 2.0, seed=1, rng=2)
+    with pytest.raises(ValueError, match="rng must be"):
+        rwt.sample(rect, 2.0, rng=np.random.RandomState(1))
+
+
+def test_bounds_as_scipy_names_them():
+    same_points(rwt.sample(l_bounds=(1, 2), u_bounds=np.array([7.0, 9.0]), density=3.0),
+                rwt.sample((1, 2, 7, 9), 3.0))
+    for kwargs, what in (({"l_bounds": (0, 0)}, "u_bounds"), ({}, "rect"),
+                         ({"rect": (0, 0, 1, 1), "l_bounds": (0, 0), "u_bounds": (1, 1)}, "not both"),
+                         ({"l_bounds": (0, 0, 1), "u_bounds": (1, 1)}, "l_bounds")):
+        with pytest.raises(ValueError, match=what):
+            rwt.sample(density=1.0, **kwargs)
+
+
+def test_a_callable_may_return_one_number():
+    rect = (0, 0, 12, 8)
+    same_points(rwt.sample(rect, lambda x, y: 3.0, max_density=3.0), rwt.sample(rect, 3.0))
+    same_points(rwt.sample(rect, lambda x, y: np.float32(3.0)), rwt.sample(rect, 3.0))
+
+
+def test_a_sample_behaves_like_its_points():
+    s = rwt.sample((0, 0, 10, 10), 3.0, seed=2)
+    assert np.asarray(s) is s.points and np.asarray(s, dtype=np.float32).dtype == np.float32
+    assert s.shape == s.points.shape == (len(s), 2)
+    rows = list(s)
+    assert len(rows) == len(s) and np.array_equal(rows[3], s.points[3])
+    assert np.array_equal(s[:5], s.points[:5])
+    assert (s == s.points).all() and not (s != s).any()
+    np.testing.assert_allclose(np.mean(s, axis=0), s.points.mean(axis=0))
+
+
+def test_errors_name_their_argument():
+    rect = (0, 0, 1, 1)
+    for kwargs, what in (({"density": "5"}, "density must be a number.*string"),
+                         ({"density": 1.0, "seed": 2**64}, "seed must be"),
+                         ({"density": 1.0, "rng": 2**64}, "rng must be"),
+                         ({"density": 1.0, "budget": 2**64}, "budget must be"),
+                         ({"density": 1.0, "n": -1}, "n must be"),
+                         ({"density": 1.0, "tile_size": "1"}, "tile_size must be")):
+        with pytest.raises(ValueError, match=what):
+            rwt.sample(rect, **kwargs)
+    with pytest.raises(ValueError, match="seed must be"):
+        rwt.stipple(np.full((8, 8), 0.5), seed=2**64)

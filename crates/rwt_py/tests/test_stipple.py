@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-import rwt
+import rwt_noise as rwt
 
 
 def test_tone_error_within_the_rust_bound(sphere):

@@ -7,6 +7,7 @@ pub mod reference;
 mod spectrum;
 mod statistics;
 mod windows;
+pub mod zoneplate;
 
 pub use crate::geometry::hex_spacing;
 pub use spectrum::Spectrum;

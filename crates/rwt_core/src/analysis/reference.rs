@@ -40,13 +40,12 @@ pub fn jittered_grid(origin: DVec2, side: f64, count: usize, seed: u64) -> Vec<D
 pub fn dart_throwing(origin: DVec2, side: f64, count: usize, seed: u64) -> Vec<DVec2> {
     let total = 4 * count.max(1);
     let mut rng = Rng::new(seed, 0xda27);
-    let pool: Vec<DVec2> = (0..total * 30)
-        .map(|_| DVec2::new(rng.next_f64(), rng.next_f64()))
-        .collect();
+    // Darts drawn as they are thrown: 30 per kept point would be 480 bytes each held.
+    let pool = (0..total * 30).map(|_| DVec2::new(rng.next_f64(), rng.next_f64()));
     let r = 0.75 * crate::geometry::hex_spacing(total as f64);
     let mut grid = crate::geometry::BucketGrid::new(DVec2::ZERO, DVec2::ONE, r);
     let mut kept: Vec<DVec2> = Vec::with_capacity(total + total / 8);
-    for &p in &pool {
+    for p in pool {
         let mut free = true;
         for shift in crate::geometry::torus_shifts(p, r) {
             grid.for_each_near(p + shift, r, |i| {

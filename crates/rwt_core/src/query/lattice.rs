@@ -120,7 +120,10 @@ impl Placement {
         for c in &corners[1..] {
             (lo, hi) = (lo.min(*c), hi.max(*c));
         }
-        let e = self.margin * (lo.abs().max(hi.abs()).max_element() + self.offset.max_element());
+        // The map's rounding follows the frame's coordinates and the offset (its two terms
+        // may cancel to a world coordinate far smaller than either).
+        let scale = min.abs().max(max.abs()).max_element() + self.offset.max_element();
+        let e = self.margin * scale;
         Rect::from_ordered(lo - e, hi + e)
     }
 
@@ -204,6 +207,26 @@ mod tests {
                         })
                     });
                     assert!(inside, "seed {seed}: {w} outside {i0}..{i1} x {j0}..{j1}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn far_tiles_hold_their_points_where_the_map_cancels() {
+        // Tiles a billion tiles out whose world x is near 0: the two terms of x cancel.
+        for seed in 0..32 {
+            let p = Placement::new(Lattice::Seeded, seed, 0.75);
+            for far in [3e8, -7e8, 1e9] {
+                let d = DVec2::new(1e-3, far) - p.offset;
+                let q = DVec2::new(p.x_axis.dot(d), p.y_axis.dot(d));
+                let min = (q / 0.75).floor() * 0.75;
+                let square = p.world_rect(min, min + 0.75);
+                for k in 0..64 {
+                    let f = DVec2::new((k % 8) as f64, (k / 8) as f64) / 7.0;
+                    let w = p.world(min + f * 0.75);
+                    let inside = w.cmpge(square.min()).all() && w.cmple(square.max()).all();
+                    assert!(inside, "seed {seed}: {w} outside {square:?}");
                 }
             }
         }

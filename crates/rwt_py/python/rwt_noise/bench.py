@@ -1,6 +1,6 @@
 """Benchmark: rwt against ``scipy.stats.qmc.PoissonDisk`` at an equal point count.
 
-    python -m rwt.bench [--points 100000] [--repeat 5]
+    python -m rwt_noise.bench [--points 100000] [--repeat 5]
 
 Prints, from one run, points per second and rho (normalized minimum distance) of both on
 the unit square, scipy's radius set so that it fills the square with the same number of
@@ -15,7 +15,7 @@ from typing import Callable, List, Tuple
 
 import numpy as np
 
-import rwt
+import rwt_noise as rwt
 
 UNIT = (0.0, 0.0, 1.0, 1.0)
 
@@ -33,17 +33,17 @@ def best_time(run: Callable[[], np.ndarray], repeat: int) -> Tuple[float, np.nda
 
 def rho(points: np.ndarray) -> float:
     """The normalized minimum distance of points on the unit square."""
-    return rwt.analyse(points, UNIT).rho
+    return float(rwt.analyse(points, UNIT).rho)
 
 
 def scipy_radius(count: int) -> float:
     """The radius at which scipy's PoissonDisk fills the unit square with about ``count``
     points: its count scales as ``1 / radius**2``, measured at a small size."""
-    from scipy.stats import qmc
+    from scipy.stats import qmc  # type: ignore[import-untyped]  # scipy ships no stubs
 
     probe = 0.02
     filled = len(qmc.PoissonDisk(d=2, radius=probe, seed=0).fill_space())
-    return probe * np.sqrt(filled / count)
+    return float(probe * np.sqrt(filled / count))
 
 
 def variable_density(count: int) -> np.ndarray:
@@ -51,11 +51,11 @@ def variable_density(count: int) -> np.ndarray:
     points on the unit square."""
     y, x = np.mgrid[0:256, 0:256] / 255.0
     shape = 0.05 + x + 3.0 * np.exp(-((x - 0.6) ** 2 + (y - 0.4) ** 2) / 0.02)
-    return shape * (count / shape.mean())
+    return np.asarray(shape * (count / shape.mean()))
 
 
 def main(argv: List[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(prog="python -m rwt.bench", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python -m rwt_noise.bench", description=__doc__)
     parser.add_argument("--points", type=int, default=100_000)
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args(argv)

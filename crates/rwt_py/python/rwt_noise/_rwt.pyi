@@ -1,6 +1,6 @@
 """Type stubs of the native module (called through `rwt`'s Python functions)."""
 
-from typing import Optional, Tuple, Union
+from typing import List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -42,3 +42,6 @@ def stipple(
 def analyse(
     points: np.ndarray, window: Corners, *, size: int = 128
 ) -> Tuple[float, float, int, float, np.ndarray, np.ndarray, np.ndarray]: ...
+def zoneplate(
+    *, size: int = 512, seed: int = 0
+) -> Tuple[List[str], np.ndarray, np.ndarray]: ...

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
-
 import numpy as np
+import numpy.typing as npt
 
 from . import _rwt
-from ._sample import _count, _rect
+from ._sample import Count, _count, _rect
 
 
 @dataclass(frozen=True)
@@ -36,11 +35,11 @@ class Analysis:
     power: np.ndarray
 
 
-def analyse(points: np.ndarray, window: Sequence[float], *, size: int = 128) -> Analysis:
+def analyse(points: npt.ArrayLike, window: npt.ArrayLike, *, size: Count = 128) -> Analysis:
     """Normalized minimum distance, radial power spectrum and anisotropy of ``points``
     (shape ``(N, 2)``) inside ``window`` ``(x0, y0, x1, y1)``; points outside are ignored.
 
-    >>> import rwt
+    >>> import rwt_noise as rwt
     >>> s = rwt.sample((0, 0, 40, 40), 4.0)
     >>> a = rwt.analyse(s.points, (0, 0, 40, 40))
     >>> a.rho > 0.6, a.radial_power.shape == a.frequencies.shape

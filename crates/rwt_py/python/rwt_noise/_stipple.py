@@ -8,9 +8,10 @@ from dataclasses import dataclass
 from typing import Optional, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _rwt
-from ._sample import _count
+from ._sample import MAX_SEED, Count, Number, _count
 
 
 @dataclass(frozen=True)
@@ -34,19 +35,19 @@ class Stipple:
 
 
 def stipple(
-    image: np.ndarray,
+    image: npt.ArrayLike,
     *,
-    dots: Optional[int] = None,
-    radius: Optional[float] = None,
-    gamma: Optional[float] = None,
-    contrast: Optional[float] = None,
-    seed: Optional[int] = None,
-    scale: Optional[float] = None,
+    dots: Optional[Count] = None,
+    radius: Optional[Number] = None,
+    gamma: Optional[Number] = None,
+    contrast: Optional[Number] = None,
+    seed: Optional[Count] = None,
+    scale: Optional[Number] = None,
     render: bool = False,
-    max_dots: Optional[int] = None,
-    max_raster_pixels: Optional[int] = None,
-    max_image_pixels: Optional[int] = None,
-    tileset: Optional[Union[str, os.PathLike]] = None,
+    max_dots: Optional[Count] = None,
+    max_raster_pixels: Optional[Count] = None,
+    max_image_pixels: Optional[Count] = None,
+    tileset: Optional[Union[str, "os.PathLike[str]"]] = None,
 ) -> Stipple:
     """Stipples a grey image with blue-noise dots whose blurred ink keeps its tone.
 
@@ -65,7 +66,7 @@ def stipple(
     >>> s.tone_error < s.white_noise_tone_error
     True
     """
-    counts = {k: None if v is None else _count(v, k) for k, v in
+    counts = {k: None if v is None else _count(v, k, MAX_SEED) for k, v in
               (("dots", dots), ("seed", seed), ("max_dots", max_dots),
                ("max_raster_pixels", max_raster_pixels),
                ("max_image_pixels", max_image_pixels))}
@@ -74,7 +75,10 @@ def stipple(
              (("radius", radius), ("gamma", gamma), ("contrast", contrast), ("scale", scale))}
     points, r, raster, tone = _rwt.stipple(
         grey, render=bool(render), tileset=None if tileset is None else os.fspath(tileset),
-        **counts, **reals)
+        dots=counts["dots"], seed=counts["seed"], max_dots=counts["max_dots"],
+        max_raster_pixels=counts["max_raster_pixels"],
+        max_image_pixels=counts["max_image_pixels"], radius=reals["radius"],
+        gamma=reals["gamma"], contrast=reals["contrast"], scale=reals["scale"])
     blue, white = tone if tone is not None else (None, None)
     return Stipple(points, r, raster, blue, white)
 
