@@ -12,7 +12,8 @@ if [ "${RWT_PY_KEEP:-0}" != 1 ] || [ ! -x "$venv/bin/python" ]; then
     rm -rf "$venv"
     python3 -m venv "$venv"
     "$venv/bin/pip" install --quiet --upgrade pip
-    "$venv/bin/pip" install --quiet "maturin>=1.7,<2" numpy pytest scipy "dask[array]" matplotlib mypy
+    "$venv/bin/pip" install --quiet "maturin>=1.7,<2" numpy pytest scipy "dask[array]" matplotlib mypy \
+        shapely geopandas
 fi
 # The wheel a user installs: one abi3 wheel for every CPython from 3.9 on, with the license
 # texts; the tests run on the package installed from it.

@@ -3,6 +3,8 @@
 //! densities and shapes the results; everything here runs with the GIL released.
 
 mod analyse;
+mod bench;
+mod columns;
 mod errors;
 mod interrupt;
 mod sample;
@@ -30,5 +32,6 @@ fn _rwt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stipple::stipple, m)?)?;
     m.add_function(wrap_pyfunction!(analyse::analyse, m)?)?;
     m.add_function(wrap_pyfunction!(zoneplate::zoneplate, m)?)?;
+    m.add_function(wrap_pyfunction!(bench::time_query, m)?)?;
     Ok(())
 }

@@ -1,22 +1,20 @@
 //! `rwt.sample`'s query: the points of a rectangle for a constant or a density map.
 
+use crate::columns::{Arrays, Columns};
 use crate::errors::{image_error, query_error};
 use crate::interrupt::{Cancellable, interruptible};
 use crate::tiles;
 use glam::DVec2;
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::PyReadonlyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use rwt_core::clumps::{ClumpKernel, ClumpParams, Clumps};
 use rwt_core::density::{Constant, Density, ImageDensity, Placement};
 use rwt_core::query::{DEFAULT_BUDGET, Point, QueryError, Rect, Sampler};
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::Arc;
-
-/// Hash salt of the 64-bit point ids (`PointId::hash`).
-const ID_SALT: u64 = 0x1d5;
 
 /// Rectangles of at least this many base tiles are queried on all cores by
 /// `Sampler::query_par`, as `rwt points` does: the same points in the same order.
@@ -53,15 +51,6 @@ pub enum DensityArg<'py> {
 
 /// `(x0, y0, x1, y1)`.
 type Corners = (f64, f64, f64, f64);
-
-/// What a query returns: positions `(N, 2)`, 64-bit ids, thresholds and the density at
-/// each point.
-type Arrays<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray1<u64>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-);
 
 /// The points of `rect` for `density` times `scale`: positions, ids, thresholds and the
 /// density at each point, in the query's order.
@@ -107,12 +96,19 @@ pub fn query<'py>(
     let sampler = tiles::sampler(tileset.as_deref(), seed)?
         .with_tile_size(tile_size)
         .with_budget(budget);
-    let inner = density.clone();
-    let points = interruptible(py, move |cancel| {
-        collect(&sampler, rect, &Cancellable { cancel, inner })
+    let columns = interruptible(py, move |cancel| {
+        collect(
+            &sampler,
+            rect,
+            &Cancellable {
+                cancel,
+                inner: density,
+            },
+            seed,
+        )
     })?
     .map_err(query_error)?;
-    Ok(arrays(py, &points, &*density, seed))
+    Ok(columns.into_arrays(py))
 }
 
 /// The clumps density of Python's parameters, its points per clump times `scale`.
@@ -139,35 +135,42 @@ fn clumps(
     Clumps::new(params).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// The points of `rect`: serially, on all cores by base tiles (the serial order), or on all
-/// cores by chunks (chunk by chunk) for many points over few base tiles.
-fn collect(
+/// The points of `rect` as columns: serially, on all cores by base tiles (the serial
+/// order), or on all cores by chunks (chunk by chunk) for many points over few base tiles.
+fn collect<D: Density + Sync + ?Sized>(
     sampler: &Sampler,
     rect: Rect,
-    density: &(dyn Density + Sync),
-) -> Result<Vec<Point>, QueryError> {
-    let mut out = Vec::new();
+    density: &D,
+    seed: u64,
+) -> Result<Columns, QueryError> {
     let tile = sampler.tile_size();
-    if rect.area() / (tile * tile) >= PARALLEL_TILES {
-        sampler.query_par(rect, density, &mut out)?;
-        return Ok(out);
-    }
-    // Refused queries are refused whole, before any chunk.
+    // Refused queries are refused whole, before any point or chunk.
     sampler.admits(&rect, density)?;
-    if sampler.work_bound(&rect, density) < PARALLEL_POINTS || rayon::current_num_threads() < 2 {
-        sampler.query(rect, density, &mut out)?;
+    let bound = sampler.work_bound(&rect, density);
+    let mut out = Columns::with_room(bound);
+    if rect.area() / (tile * tile) >= PARALLEL_TILES {
+        let run = |points: &[Point]| Columns::of(points, density, seed);
+        let append = |c: Columns| {
+            out.append(c);
+            ControlFlow::Continue(())
+        };
+        sampler.query_par_ordered(rect, density, run, append, &|_| {})?;
         return Ok(out);
     }
-    let parts: Vec<Result<Vec<Point>, QueryError>> = chunks(&rect, CHUNKS_PER_AXIS)
+    if bound < PARALLEL_POINTS || rayon::current_num_threads() < 2 {
+        sampler.query_with(rect, density, |p| out.push(&p, density, seed))?;
+        return Ok(out);
+    }
+    let parts: Vec<Result<Columns, QueryError>> = chunks(&rect, CHUNKS_PER_AXIS)
         .into_par_iter()
         .map(|chunk| {
-            let mut part = Vec::new();
-            sampler.query(chunk, density, &mut part)?;
+            let mut part = Columns::default();
+            sampler.query_with(chunk, density, |p| part.push(&p, density, seed))?;
             Ok(part)
         })
         .collect();
     for part in parts {
-        out.extend(part?);
+        out.append(part?);
     }
     Ok(out)
 }
@@ -246,28 +249,4 @@ fn map_density(
         scale: top * scale,
     };
     ImageDensity::from_values(w as u32, h as u32, &unit, at).map_err(image_error)
-}
-
-/// The points as numpy arrays.
-fn arrays<'py>(py: Python<'py>, points: &[Point], density: &dyn Density, seed: u64) -> Arrays<'py> {
-    let n = points.len();
-    let mut xy = Vec::with_capacity(2 * n);
-    let (mut ids, mut thresholds, mut at) = (
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    );
-    for p in points {
-        xy.extend([p.position.x, p.position.y]);
-        ids.push(p.id.hash(seed, ID_SALT));
-        thresholds.push(p.threshold);
-        at.push(density.density(p.position));
-    }
-    let xy = Array2::from_shape_vec((n, 2), xy).expect("two coordinates per point");
-    (
-        xy.into_pyarray(py),
-        ids.into_pyarray(py),
-        thresholds.into_pyarray(py),
-        at.into_pyarray(py),
-    )
 }

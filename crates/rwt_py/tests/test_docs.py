@@ -19,6 +19,14 @@ def test_docstring_examples(module):
     assert result.attempted > 0 and result.failed == 0
 
 
+def test_geo_docstring_example():
+    pytest.importorskip("geopandas")
+    import rwt_noise.geo
+
+    result = doctest.testmod(rwt_noise.geo)
+    assert result.attempted > 0 and result.failed == 0
+
+
 def test_typed_package():
     here = Path(rwt.__file__).parent
     assert (here / "py.typed").is_file() and (here / "_rwt.pyi").is_file()

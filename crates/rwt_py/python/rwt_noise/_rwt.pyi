@@ -45,3 +45,6 @@ def analyse(
 def zoneplate(
     *, size: int = 512, seed: int = 0
 ) -> Tuple[List[str], np.ndarray, np.ndarray]: ...
+def time_query(
+    rect: Corners, density: float, *, tile_size: float, seed: int = 0, repeat: int = 3
+) -> Tuple[int, float]: ...

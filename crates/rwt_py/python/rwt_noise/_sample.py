@@ -150,6 +150,7 @@ def sample(
     seed: Optional[Count] = None,
     rng: Optional[RngLike] = None,
     n: Optional[Count] = None,
+    mask: Optional[Any] = None,
     tileset: Optional[Union[str, "os.PathLike[str]"]] = None,
     extent: Optional[npt.ArrayLike] = None,
     max_density: Optional[Number] = None,
@@ -173,6 +174,11 @@ def sample(
       position exceeds its threshold, as for the other kinds. A known upper bound
       ``max_density=`` replaces the grid (then the result is exact for any ``f``; without
       it, features narrower than 1/256 of the rectangle may be missed).
+
+    ``mask`` is any shapely geometry (a polygon, a multipolygon, ...): only the points
+    inside it are kept (``rect`` defaults to its bounds), and ``n=`` counts the points
+    inside it. Masking keeps the point set as it is (the same points as without the mask,
+    those outside left out), so masked pieces of one region combine exactly.
 
     ``radius=r`` instead of a density asks for points at least ``r`` apart, as
     ``scipy.stats.qmc.PoissonDisk(radius=r)`` does: the uniform density
@@ -213,7 +219,7 @@ def sample(
     >>> bool(pdist(far.points).min() >= 0.05)
     True
     """
-    box = _bounds(rect, l_bounds, u_bounds)
+    box = _bounds(rect, l_bounds, u_bounds, mask)
     tile = auto_tile_size(box) if tile_size is None else _positive(tile_size, "tile_size")
     if radius is not None:
         density = _radius_density(radius, density, n, tile, tile_size is not None)
@@ -227,15 +233,20 @@ def sample(
     if max_density is not None and not callable(density):
         raise ValueError("max_density bounds a callable density; this density is not one")
     points_at, estimate = _density_source(box, density, extent, max_density, opts)
+    if mask is not None:
+        points_at, estimate = _masked(points_at, estimate, box, mask)
     if n is None:
         pos, ids, thr, _ = points_at(1.0)
         return Sample(pos, ids, thr, 1.0)
     return _first_n(points_at, _count(n, "n", MAX_SEED), estimate)
 
 
-def _bounds(rect: object, l_bounds: object, u_bounds: object) -> Rect:
-    """The rectangle, from ``rect`` or from ``l_bounds`` and ``u_bounds``."""
+def _bounds(rect: object, l_bounds: object, u_bounds: object, mask: object = None) -> Rect:
+    """The rectangle, from ``rect``, from ``l_bounds`` and ``u_bounds``, or from the bounds
+    of ``mask``."""
     if l_bounds is None and u_bounds is None:
+        if rect is None and mask is not None:
+            return _rect(_geometry(mask).bounds, "mask's bounds")
         if rect is None:
             raise ValueError("give rect=(x0, y0, x1, y1), or l_bounds= and u_bounds=")
         return _rect(rect, "rect")
@@ -249,6 +260,38 @@ def _bounds(rect: object, l_bounds: object, u_bounds: object) -> Rect:
             raise ValueError(f"{what} must be two numbers (x, y), got {v!r}") from None
         corners += [x, y]
     return _rect(corners, "l_bounds and u_bounds")
+
+
+def _geometry(mask: object) -> Any:
+    """``mask`` as a prepared shapely geometry (shapely is needed only for masks)."""
+    try:
+        import shapely  # type: ignore[import-untyped, unused-ignore]
+    except ImportError:
+        raise ValueError("mask= needs shapely: pip install \"rwt-noise[geo]\"") from None
+    if not isinstance(mask, shapely.Geometry):
+        raise ValueError(f"mask must be a shapely geometry, got {type(mask).__name__}")
+    if mask.is_empty or not mask.is_valid or not mask.area > 0:
+        raise ValueError("mask must be a valid geometry with an area (a polygon or several), "
+                         f"got {mask.wkt[:80]}")
+    shapely.prepare(mask)
+    return mask
+
+
+def _masked(points_at: PointsAt, estimate: float, box: Rect, mask: object) -> Tuple[PointsAt, float]:
+    """The points of ``points_at`` inside ``mask``, and their expected number (the
+    rectangle's, in proportion to the mask's share of its area)."""
+    import shapely  # type: ignore[import-untyped, unused-ignore]
+
+    geometry = _geometry(mask)
+
+    def inside(scale: float) -> Found:
+        pos, ids, thr, at = points_at(scale)
+        keep = shapely.contains_xy(geometry, pos[:, 0], pos[:, 1])
+        return pos[keep], ids[keep], thr[keep], at[keep]
+
+    area = (box[2] - box[0]) * (box[3] - box[1])
+    share = min(1.0, float(geometry.area) / area) if area > 0 else 0.0
+    return inside, estimate * share
 
 
 def _seed(seed: object, rng: object) -> int:

@@ -60,7 +60,7 @@ def stipple(
     more than ``max_image_pixels`` (2**22) raise :class:`rwt.BudgetError` before anything
     is allocated. Ctrl-C interrupts a long stipple within a fraction of a second.
 
-    >>> import numpy as np, rwt
+    >>> import numpy as np, rwt_noise as rwt
     >>> ramp = np.tile(np.linspace(1.0, 0.0, 64), (32, 1))  # white to black
     >>> s = rwt.stipple(ramp, render=True)
     >>> s.tone_error < s.white_noise_tone_error
