@@ -1,6 +1,6 @@
 """Benchmark: rwt against ``scipy.stats.qmc.PoissonDisk`` at an equal point count.
 
-    python -m rwt_noise.bench [--points 100000] [--repeat 5] [--scaling 100000,1000000,10000000]
+    python -m rwt_noise.bench [--points 100000] [--repeat 5] [--scaling 100000,1000000,2000000,10000000]
 
 Prints, from one run, points per second and rho (normalized minimum distance) of both on
 the unit square, scipy's radius set so that it fills the square with the same number of
@@ -62,7 +62,7 @@ def main(argv: List[str] | None = None) -> None:
     parser = argparse.ArgumentParser(prog="python -m rwt_noise.bench", description=__doc__)
     parser.add_argument("--points", type=int, default=100_000)
     parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--scaling", default="100000,1000000,10000000",
+    parser.add_argument("--scaling", default="100000,1000000,2000000,10000000",
                         help="point counts of the scaling table, comma-separated")
     args = parser.parse_args(argv)
     n, repeat = args.points, max(1, args.repeat)
@@ -119,9 +119,9 @@ def scaling(counts: List[int], repeat: int) -> None:
         side = float(np.sqrt(n / 2048.0))
         rect = (0.0, 0.0, side, side)
         t_py, points = best_time(
-            lambda: rwt.sample(rect, 2048.0, seed=1, tile_size=1.0).points, max(1, repeat // 2))
+            lambda: rwt.sample(rect, 2048.0, seed=1, tile_size=1.0).points, repeat)
         count, t_rust = _rwt.time_query(rect, 2048.0, tile_size=1.0, seed=1,
-                                        repeat=max(1, repeat // 2))
+                                        repeat=repeat)
         print(f"{'rwt.sample / Rust query':<34}{len(points):>9}{t_py:>10.4f}{t_rust:>10.4f}"
               f"{t_py / t_rust:>7.2f}{t_py / len(points) * 1e9:>10.1f}")
 
