@@ -31,17 +31,17 @@ pub fn run(size: usize, seed: u64, out: Option<&Path>) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
         let image = plate.reconstruct(samples);
         let e = plate.error(&image, &reference);
-        say(&format!(
+        say!(
             "zoneplate: pattern={} psnr={:.2} low={:.2} high={:.2}",
             pattern.name(),
             e.psnr,
             e.low,
             e.high
-        ));
+        );
         errors.push((pattern, e));
         images.push(image);
     }
-    say(&claim(&errors));
+    say!("{}", claim(&errors));
     if let Some(path) = out {
         write_strip(path, &images, size)?;
     }
@@ -66,10 +66,6 @@ fn claim(errors: &[(Pattern, PlateError)]) -> String {
          less_noise={noise} (high band rwt {:.2} dB, jitter {:.2})",
         rwt.low, jitter.low, grid.low, rwt.high, jitter.high
     )
-}
-
-fn say(line: &str) {
-    println!("{line}");
 }
 
 /// The images (values -1..1) side by side as one grey PNG.
