@@ -7,7 +7,7 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use rwt_core::analysis::{WindowAnalysis, WindowGrid};
+use rwt_core::analysis::{Spectrum, WindowGrid, rho};
 
 /// Largest periodogram side: a window's cost is its points times this squared.
 const MAX_SPECTRUM_SIZE: usize = 512;
@@ -66,16 +66,26 @@ pub fn analyse<'py>(
     }
     let grid = WindowGrid::new(min, max, inside.len())
         .map_err(|e| PyValueError::new_err(format!("window: {e}")))?;
-    let analysis = interruptible(py, move |_| {
-        WindowAnalysis::of(&grid.split(inside), grid.side, size)
+    // The spectrum's windows are sized to its frequencies: smaller ones for many points.
+    let spectral = WindowGrid::for_spectrum(min, max, inside.len(), size)
+        .map_err(|e| PyValueError::new_err(format!("window: {e}")))?;
+    let (rho, s) = interruptible(py, move |_| {
+        let area = grid.side * grid.side;
+        let rho = grid
+            .split(inside.iter().copied())
+            .iter()
+            .filter_map(|(_, p)| rho(p, p.len() as f64 / area))
+            .reduce(f64::min)
+            .unwrap_or(f64::NAN);
+        let windows = spectral.split(inside);
+        (rho, Spectrum::averaged(&windows, spectral.side, size))
     })?;
-    let s = analysis.spectrum;
     let power = Array2::from_shape_vec((s.size, s.size), s.power).expect("size x size");
     Ok((
-        analysis.rho,
+        rho,
         grid.density,
         s.windows,
-        grid.side,
+        spectral.side,
         power.into_pyarray(py),
         s.radial_mean.into_pyarray(py),
         s.anisotropy_db.into_pyarray(py),

@@ -45,3 +45,15 @@ def test_bad_inputs_are_value_errors(points, window):
 def test_a_bad_size_is_a_value_error():
     with pytest.raises(ValueError, match="size"):
         rwt.analyse(np.random.default_rng(0).uniform(size=(100, 2)), (0, 0, 1, 1), size=10_000)
+
+
+def test_the_spectrum_reaches_past_its_peak_at_any_count():
+    # 100 000 points: the windows shrink so that the spectrum reaches twice the peak,
+    # which lies at about 1.2 sqrt(density) cycles per unit (it read 0.8 with windows of
+    # 20 000 points, whose peak lay past the spectrum's edge).
+    window = (0.0, 0.0, 100.0, 100.0)
+    a = rwt.analyse(rwt.sample(window, 10.0, seed=3).points, window)
+    peak = a.frequencies[np.argmax(a.radial_power)] / np.sqrt(a.density)
+    assert 1.0 < peak < 1.4, peak
+    assert a.frequencies[-1] > 2.0 * peak * np.sqrt(a.density)
+    assert a.windows == 64 and a.rho > 0.6

@@ -8,6 +8,13 @@ use glam::DVec2;
 /// points (memory and time stay bounded however many points there are).
 pub const MAX_WINDOW_POINTS: f64 = 20_000.0;
 
+/// A spectrum's side over the frequencies it must reach in cycles per window: twice blue
+/// noise's principal peak (`2 x 1.2 sqrt(n)`), on both sides of zero.
+const SPECTRUM_PEAK_ROOM: f64 = 4.8;
+
+/// Most windows per axis of [`WindowGrid::for_spectrum`].
+const MAX_SPECTRUM_WINDOWS: usize = 8;
+
 /// Up to 4 x 4 square windows laid from a rectangle's lower corner, each with at least
 /// about 500 of its points and at most about [`MAX_WINDOW_POINTS`]: what an analysis of the
 /// rectangle's points averages over.
@@ -77,6 +84,34 @@ impl WindowGrid {
             cell,
             side,
             density,
+        })
+    }
+
+    /// Windows for a periodogram of `size x size` frequencies over `count` points on
+    /// `min..max`: each holds at most about `(size / 4.8)^2` points, so that its
+    /// frequencies (up to `size / 2` cycles per window) reach twice the principal peak of
+    /// blue noise (about `1.2 sqrt(n)` cycles per window of `n` points), and up to 8 x 8 of
+    /// them spread over the rectangle average the spectrum. Errors as [`WindowGrid::new`].
+    pub fn for_spectrum(
+        min: DVec2,
+        max: DVec2,
+        count: usize,
+        size: usize,
+    ) -> Result<Self, WindowError> {
+        let grid = Self::new(min, max, count)?;
+        let most = (size as f64 / SPECTRUM_PEAK_ROOM).powi(2).max(1.0);
+        let side = (most / grid.density).sqrt();
+        if side >= grid.side {
+            return Ok(grid);
+        }
+        let square = (max - min).min_element();
+        let per_axis = ((square / side).ceil() as usize).clamp(1, MAX_SPECTRUM_WINDOWS);
+        let cell = square / per_axis as f64;
+        Ok(Self {
+            per_axis,
+            cell,
+            side: side.min(cell),
+            ..grid
         })
     }
 
@@ -184,5 +219,18 @@ mod tests {
                 "{lo} {hi}"
             );
         }
+    }
+
+    #[test]
+    fn spectral_windows_hold_what_their_frequencies_resolve() {
+        let (min, max) = (DVec2::ZERO, DVec2::splat(100.0));
+        // 100 000 points: windows of at most (128 / 4.8)^2 = 711 points, 8 x 8 of them.
+        let grid = WindowGrid::for_spectrum(min, max, 100_000, 128).unwrap();
+        assert_eq!(grid.per_axis, 8);
+        assert!(grid.side * grid.side * grid.density <= 712.0, "{grid:?}");
+        assert!(grid.side <= grid.cell);
+        // Few points: the analysis windows as they are.
+        let few = WindowGrid::for_spectrum(min, max, 600, 128).unwrap();
+        assert_eq!(few, WindowGrid::new(min, max, 600).unwrap());
     }
 }

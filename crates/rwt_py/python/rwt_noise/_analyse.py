@@ -14,9 +14,11 @@ from ._sample import Count, _count, _rect
 class Analysis:
     """Figures of the points in a window, as ``rwt analyse`` computes them.
 
-    The window is split into up to 4 x 4 square sub-windows of ``side`` (each holding
-    about 500 to 20 000 points). ``rho``: the normalized minimum distance (the smallest of
-    any sub-window; 1 for a hexagonal lattice, about 0.75 for good Poisson-disk sets, near 0
+    ``rho`` is measured in up to 4 x 4 square sub-windows (each holding about 500 to
+    20 000 points); the spectrum in up to 8 x 8 sub-windows of ``side``, each of at most
+    about ``(size / 4.8) ** 2`` points, so that its frequencies reach twice blue noise's
+    principal peak (about ``1.2 sqrt(density)``) however many points there are. ``rho``:
+    the normalized minimum distance (the smallest of any sub-window; 1 for a hexagonal lattice, about 0.75 for good Poisson-disk sets, near 0
     for white noise). ``density``: points per unit area in the window. ``windows``: how many
     periodograms were averaged. ``power``: the averaged periodogram, ``(size, size)``,
     frequency zero at ``[size // 2, size // 2]``, 1 being the level of white noise.
