@@ -110,16 +110,7 @@ impl Placement {
     /// rectangle `[min, max]`, as its points' positions are computed.
     #[inline]
     pub fn world_rect(&self, min: DVec2, max: DVec2) -> Rect {
-        let corners = [
-            self.world(min),
-            self.world(max),
-            self.world(DVec2::new(min.x, max.y)),
-            self.world(DVec2::new(max.x, min.y)),
-        ];
-        let (mut lo, mut hi) = (corners[0], corners[0]);
-        for c in &corners[1..] {
-            (lo, hi) = (lo.min(*c), hi.max(*c));
-        }
+        let (lo, hi) = corner_box(min, max, |p| self.world(p));
         // The map's rounding follows the frame's coordinates and the offset (its two terms
         // may cancel to a world coordinate far smaller than either).
         let scale = min.abs().max(max.abs()).max_element() + self.offset.max_element();
@@ -134,17 +125,7 @@ impl Placement {
             let d = p - self.offset;
             DVec2::new(self.x_axis.dot(d), self.y_axis.dot(d)) / s
         };
-        let (min, max) = (rect.min(), rect.max());
-        let corners = [
-            back(min),
-            back(max),
-            back(DVec2::new(min.x, max.y)),
-            back(DVec2::new(max.x, min.y)),
-        ];
-        let (mut lo, mut hi) = (corners[0], corners[0]);
-        for c in &corners[1..] {
-            (lo, hi) = (lo.min(*c), hi.max(*c));
-        }
+        let (lo, hi) = corner_box(rect.min(), rect.max(), back);
         let slack = |v: f64| self.margin * (v.abs() + 1.0);
         [
             (lo.x - slack(lo.x)).floor() as i64,
@@ -153,6 +134,17 @@ impl Placement {
             (hi.y + slack(hi.y)).ceil() as i64,
         ]
     }
+}
+
+/// The box of the four corners of the rectangle `[min, max]` mapped by `map`.
+#[inline]
+fn corner_box(min: DVec2, max: DVec2, map: impl Fn(DVec2) -> DVec2) -> (DVec2, DVec2) {
+    let corners = [min, max, DVec2::new(min.x, max.y), DVec2::new(max.x, min.y)].map(map);
+    corners[1..]
+        .iter()
+        .fold((corners[0], corners[0]), |(lo, hi), c| {
+            (lo.min(*c), hi.max(*c))
+        })
 }
 
 #[cfg(test)]

@@ -219,7 +219,8 @@ def sample(
     >>> bool(pdist(far.points).min() >= 0.05)
     True
     """
-    box = _bounds(rect, l_bounds, u_bounds, mask)
+    geometry = None if mask is None else _geometry(mask)
+    box = _bounds(rect, l_bounds, u_bounds, geometry)
     tile = auto_tile_size(box) if tile_size is None else _positive(tile_size, "tile_size")
     if radius is not None:
         density = _radius_density(radius, density, n, tile, tile_size is not None)
@@ -233,20 +234,20 @@ def sample(
     if max_density is not None and not callable(density):
         raise ValueError("max_density bounds a callable density; this density is not one")
     points_at, estimate = _density_source(box, density, extent, max_density, opts)
-    if mask is not None:
-        points_at, estimate = _masked(points_at, estimate, box, mask)
+    if geometry is not None:
+        points_at, estimate = _masked(points_at, estimate, box, geometry)
     if n is None:
         pos, ids, thr, _ = points_at(1.0)
         return Sample(pos, ids, thr, 1.0)
     return _first_n(points_at, _count(n, "n", MAX_SEED), estimate)
 
 
-def _bounds(rect: object, l_bounds: object, u_bounds: object, mask: object = None) -> Rect:
+def _bounds(rect: object, l_bounds: object, u_bounds: object, mask: Any = None) -> Rect:
     """The rectangle, from ``rect``, from ``l_bounds`` and ``u_bounds``, or from the bounds
-    of ``mask``."""
+    of ``mask`` (a checked geometry)."""
     if l_bounds is None and u_bounds is None:
         if rect is None and mask is not None:
-            return _rect(_geometry(mask).bounds, "mask's bounds")
+            return _rect(mask.bounds, "mask's bounds")
         if rect is None:
             raise ValueError("give rect=(x0, y0, x1, y1), or l_bounds= and u_bounds=")
         return _rect(rect, "rect")
@@ -277,12 +278,12 @@ def _geometry(mask: object) -> Any:
     return mask
 
 
-def _masked(points_at: PointsAt, estimate: float, box: Rect, mask: object) -> Tuple[PointsAt, float]:
-    """The points of ``points_at`` inside ``mask``, and their expected number (the
-    rectangle's, in proportion to the mask's share of its area)."""
+def _masked(points_at: PointsAt, estimate: float, box: Rect,
+            geometry: Any) -> Tuple[PointsAt, float]:
+    """The points of ``points_at`` inside ``geometry`` (checked and prepared by
+    :func:`_geometry`), and their expected number (the rectangle's, in proportion to the
+    geometry's share of its area)."""
     import shapely  # type: ignore[import-untyped, unused-ignore]
-
-    geometry = _geometry(mask)
 
     def inside(scale: float) -> Found:
         pos, ids, thr, at = points_at(scale)
