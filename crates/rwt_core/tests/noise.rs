@@ -4,7 +4,7 @@
 
 use glam::DVec2;
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
-use rwt_core::density::{Density, FnDensity, NoiseDensity, NoiseParams, sanitize};
+use rwt_core::density::{Density, FnDensity, NoiseDensity, NoiseParams, Patch, sanitize};
 use rwt_core::query::{Point, PointId, Rect, Sampler};
 use rwt_core::rng::Rng;
 use rwt_core::tileset::TileSet;
@@ -131,6 +131,68 @@ fn queries_equal_the_plain_fbm_with_the_loosest_bounds() {
     }
 }
 
+/// A turned square of side `side` about `centre`, its box clipped on the left by `clip`
+/// (a share of the box's width, 0 for none).
+fn turned(centre: DVec2, side: f64, angle: f64, clip: f64) -> Patch {
+    let u = DVec2::from_angle(angle) * side * 0.5;
+    let v = u.perp();
+    let reach = u.abs() + v.abs();
+    let (min, max) = (centre - reach, centre + reach);
+    Patch {
+        min: DVec2::new(min.x + (max.x - min.x) * clip, min.y),
+        max,
+        centre,
+        u,
+        v,
+    }
+}
+
+/// Models of squares turned as seeded lattices turn their cells hold the density at every
+/// point of the square inside its (clipped) box, and leave narrower bounds than models of
+/// the square's whole box, whose corners reach lattice cells the square does not.
+#[test]
+fn local_models_of_turned_squares_hold_and_bend_less() {
+    let mut rng = Rng::new(40, 4);
+    for params in params() {
+        let d = NoiseDensity::new(params);
+        let (mut square_width, mut box_width) = (0.0, 0.0);
+        for _ in 0..3_000 {
+            let far = [1.0, 1e3, 1e7][rng.below(3)];
+            let centre = DVec2::new(rng.next_f64() - 0.5, rng.next_f64() - 0.5) * far;
+            let side = 0.3 / params.frequency * 4f64.powf(-3.0 * rng.next_f64());
+            let angle = rng.next_f64() * std::f64::consts::TAU;
+            let clip = [0.0, 0.0, 0.3, 0.7][rng.below(4)];
+            let patch = turned(centre, side, angle, clip);
+            let (Some(model), Some(whole)) = (
+                d.local_model(&patch),
+                d.local_model(&Patch::rect(patch.min, patch.max)),
+            ) else {
+                continue;
+            };
+            let (low, high) = model.bounds_over(&patch);
+            for _ in 0..40 {
+                let (a, b) = (rng.next_f64() * 2.0 - 1.0, rng.next_f64() * 2.0 - 1.0);
+                let p = patch.centre + patch.u * a + patch.v * b;
+                if p.cmplt(patch.min).any() || p.cmpgt(patch.max).any() {
+                    continue;
+                }
+                let (value, (lo, hi)) = (sanitize(d.density(p)), model.bounds_at(p));
+                let (box_lo, box_hi) = whole.bounds_at(p);
+                (square_width, box_width) = (square_width + hi - lo, box_width + box_hi - box_lo);
+                assert!(
+                    lo <= value && value <= hi && low <= lo && hi <= high,
+                    "{params:?} over {patch:?} at {p}: {value} not in {lo}..{hi}"
+                );
+            }
+        }
+        // 4 to 24 % narrower (1 to 16 octaves); a negative scale gives no models.
+        assert!(
+            params.scale < 0.0 || square_width < 0.97 * box_width,
+            "{params:?}: bounds {square_width} wide over squares, {box_width} over boxes"
+        );
+    }
+}
+
 /// Wherever a noise density gives a local model, the model's bounds hold its value at every
 /// point of the rectangle (near the origin and far from it, over cells of many sizes), and
 /// small cells almost always get one.
@@ -146,11 +208,12 @@ fn local_models_bound_the_density() {
             let side = 0.3 / params.frequency * 4f64.powf(-3.0 * rng.next_f64());
             let max = min + DVec2::new(side, side * (0.5 + rng.next_f64()));
             asked += 1;
-            let Some(model) = d.local_model(min, max) else {
+            let patch = Patch::rect(min, max);
+            let Some(model) = d.local_model(&patch) else {
                 continue;
             };
             given += 1;
-            let (low, high) = model.bounds_over(min, max);
+            let (low, high) = model.bounds_over(&patch);
             for _ in 0..40 {
                 let p = min + (max - min) * DVec2::new(rng.next_f64(), rng.next_f64());
                 let (value, (lo, hi)) = (sanitize(d.density(p)), model.bounds_at(p));

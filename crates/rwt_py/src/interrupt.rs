@@ -7,7 +7,7 @@
 use glam::DVec2;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
-use rwt_core::density::{Density, LocalModel};
+use rwt_core::density::{Density, LocalModel, Patch};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -117,11 +117,11 @@ impl<D: Density + ?Sized> Density for Cancellable<D> {
         !self.cancel.is_set() && self.inner.exceeds_near(p, factor, threshold)
     }
 
-    fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {
+    fn local_model(&self, patch: &Patch) -> Option<LocalModel> {
         if self.cancel.is_set() {
             None
         } else {
-            self.inner.local_model(min, max)
+            self.inner.local_model(patch)
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Densities made of densities: scaling, sums, products, masks, exclusions and distance
 //! fall-off. Each keeps its inputs' bounds conservative.
 
-use super::{Density, LocalModel, sanitize};
+use super::{Density, LocalModel, Patch, sanitize};
 use glam::DVec2;
 
 /// `inner * factor` (a negative inner density counts as 0 first).
@@ -25,10 +25,10 @@ impl<D: Density> Density for Scale<D> {
             0.0
         }
     }
-    fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {
+    fn local_model(&self, patch: &Patch) -> Option<LocalModel> {
         let factor = self.1;
         (factor >= 0.0 && factor.is_finite())
-            .then(|| self.0.local_model(min, max))
+            .then(|| self.0.local_model(patch))
             .flatten()
             .map(|m| m.scaled(factor))
     }

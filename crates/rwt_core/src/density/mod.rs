@@ -21,7 +21,7 @@ pub use self::image::{
     DENSITY_BYTES_PER_PIXEL, ImageDensity, ImageDensityError, MAX_DENSITY_BYTES, MAX_IMAGE_PIXELS,
     Placement, decode_image, decode_image_with_limit, open_image, open_image_with_limit,
 };
-pub use self::local::LocalModel;
+pub use self::local::{LocalModel, Patch};
 pub use self::noise::{NoiseDensity, NoiseParams};
 
 use glam::DVec2;
@@ -55,12 +55,11 @@ pub trait Density {
     fn exceeds_near(&self, p: DVec2, factor: f64, threshold: f64) -> bool {
         self.exceeds(p, factor, threshold)
     }
-    /// A [`LocalModel`] of the density valid over the rectangle `[min, max]`, where the
-    /// density has one cheaper than evaluating it at the rectangle's points: queries decide
-    /// the points of a cell by it and evaluate only those it leaves open. The default, `None`,
-    /// is always right.
-    fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {
-        let _ = (min, max);
+    /// A [`LocalModel`] of the density valid over `patch`, where the density has one
+    /// cheaper than evaluating it at the patch's points: queries decide the points of a cell
+    /// by it and evaluate only those it leaves open. The default, `None`, is always right.
+    fn local_model(&self, patch: &Patch) -> Option<LocalModel> {
+        let _ = patch;
         None
     }
 }
@@ -91,8 +90,8 @@ macro_rules! forward_density {
                 (**self).exceeds_near(p, factor, threshold)
             }
             #[inline]
-            fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {
-                (**self).local_model(min, max)
+            fn local_model(&self, patch: &Patch) -> Option<LocalModel> {
+                (**self).local_model(patch)
             }
         }
     )*};

@@ -7,7 +7,7 @@
 //! order of arithmetic. The core is the crate's `perlin_2d` written out with the table's
 //! lookups inlined (the crate hashes through a slice), which halves its cost.
 
-use super::{Density, LocalModel, sanitize};
+use super::{Density, LocalModel, Patch, sanitize};
 use glam::DVec2;
 use noise::permutationtable::{NoiseHasher, PermutationTable};
 use noise::{Fbm, Perlin};
@@ -250,11 +250,13 @@ impl NoiseDensity {
     /// The fBm as a plane at the rectangle's centre plus a bounded bend, octave by octave:
     /// each octave's value and gradient at the centre, its curvature bound scaled by its
     /// weight and its frequency squared. Where an octave's clamp to [-1, 1] may act inside
-    /// the rectangle (the bounds are for the noise before it), what the clamp can take off
-    /// widens the slack. `None` where inputs wrap.
-    fn fbm_model(&self, min: DVec2, max: DVec2) -> Option<FbmModel> {
+    /// the patch (the bounds are for the noise before it), what the clamp can take off
+    /// widens the slack. Curvature and clamp are bounded over the lattice cells the patch
+    /// itself may touch, not all those of its rectangle. `None` where inputs wrap.
+    fn fbm_model(&self, patch: &Patch) -> Option<FbmModel> {
+        let (min, max) = (patch.min, patch.max);
         let centre = (min + max) * 0.5;
-        let radius = (max - min).length() * 0.5;
+        let radius = patch.farthest_squared(centre).sqrt();
         let mut q = self.input(centre)?;
         if !self.within_wrap(min, max) {
             return None;
@@ -263,6 +265,7 @@ impl NoiseDensity {
         let half = (max - min) * 0.5;
         let (mut value, mut gradient, mut curvature, mut slack) = (0.0, DVec2::ZERO, 0.0, 0.0);
         let mut gain = self.params.frequency;
+        let mut shape = patch.scaled(gain);
         for (k, octave) in self.octaves.iter().enumerate() {
             // A point's input is rounded once per product that made it (frequency, then
             // the lacunarity per octave): the noise can move by its slope times that.
@@ -272,7 +275,9 @@ impl NoiseDensity {
             // The octave's reach within the rectangle, in its own input units.
             let r = radius * gain.abs();
             let reach = half * gain.abs() * (1.0 + ROUNDING_MARGIN) + ROUNDING_MARGIN;
-            let (cells_curvature, clamp_free) = lattice_bounds(&octave.table, q - reach, q + reach);
+            let touches = |lo, hi| shape.may_meet(lo, hi, rounding + ROUNDING_MARGIN);
+            let (cells_curvature, clamp_free) =
+                lattice_bounds(&octave.table, q - reach, q + reach, touches);
             if !clamp_free {
                 // The clamp takes off at most how far the noise can pass 1 in magnitude.
                 let peak = v.abs() + g.length() * r + 0.5 * cells_curvature * r * r;
@@ -283,6 +288,7 @@ impl NoiseDensity {
             curvature += 0.5 * cells_curvature * octave.weight * gain * gain;
             q *= LACUNARITY;
             gain *= LACUNARITY;
+            shape = shape.scaled(LACUNARITY);
         }
         Some(FbmModel {
             centre,
@@ -400,10 +406,16 @@ fn corner_combination(table: &[u8; 256], cx: isize, cy: isize) -> usize {
     pick(0, 0) | pick(1, 0) << 2 | pick(0, 1) << 4 | pick(1, 1) << 6
 }
 
-/// Over the lattice cells the input rectangle `[min, max]` touches: the largest curvature
-/// bound of the noise before its clamp, and whether it stays within [-1, 1] there (so that
-/// the clamp never acts); the global bounds where the rectangle spans many cells.
-fn lattice_bounds(table: &[u8; 256], min: DVec2, max: DVec2) -> (f64, bool) {
+/// Over the lattice cells the input rectangle `[min, max]` touches and `touches` keeps (it
+/// is given each cell's corners): the largest curvature bound of the noise before its
+/// clamp, and whether it stays within [-1, 1] there (so that the clamp never acts); the
+/// global bounds where the rectangle spans many cells.
+fn lattice_bounds(
+    table: &[u8; 256],
+    min: DVec2,
+    max: DVec2,
+    touches: impl Fn(DVec2, DVec2) -> bool,
+) -> (f64, bool) {
     let (x0, y0) = (min.x.floor() as isize, min.y.floor() as isize);
     let (x1, y1) = (max.x.floor() as isize, max.y.floor() as isize);
     // Apart by the distance, not the difference: infinite corners saturate to isize::MIN
@@ -415,6 +427,10 @@ fn lattice_bounds(table: &[u8; 256], min: DVec2, max: DVec2) -> (f64, bool) {
     let (mut tenths, mut free) = (0, true);
     for cy in y0..=y1 {
         for cx in x0..=x1 {
+            let corner = DVec2::new(cx as f64, cy as f64);
+            if !touches(corner, corner + 1.0) {
+                continue;
+            }
             let combo = corner_combination(table, cx, cy);
             tenths = tenths.max(CELL_CURVATURE[combo]);
             free &= CLAMP_FREE[combo / 64] >> (combo % 64) & 1 == 1;
@@ -486,12 +502,12 @@ impl Density for NoiseDensity {
     /// The fBm's plane and bend mapped through `scale * (base + amplitude * fbm)`, which is
     /// affine in the fBm: `None` for a negative or non-finite scale (its clamp at zero
     /// would not be the model's).
-    fn local_model(&self, min: DVec2, max: DVec2) -> Option<LocalModel> {
+    fn local_model(&self, patch: &Patch) -> Option<LocalModel> {
         let p = &self.params;
         if !self.finite || p.scale < 0.0 {
             return None;
         }
-        let fbm = self.fbm_model(min, max)?;
+        let fbm = self.fbm_model(patch)?;
         let gain = p.scale * p.amplitude * self.normalise;
         Some(LocalModel {
             centre: fbm.centre,

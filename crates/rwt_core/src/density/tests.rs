@@ -14,7 +14,7 @@ fn check_bound(d: &impl Density, rng: &mut Rng, world: f64) -> f64 {
         let b = a + ext;
         let bound = d.max_over(a, b);
         let low = sanitize(d.min_over(a, b));
-        let model = d.local_model(a, b);
+        let model = d.local_model(&Patch::rect(a, b));
         useful += usize::from(low > 0.0);
         for k in 0..40 {
             // Corners and edges too: bilinear blending is least exact there.
@@ -151,10 +151,14 @@ fn combinators_keep_bounds() {
     check_bound(&Scale(Constant(-2.0), -1.5), &mut rng, 10.0);
     // A scaled noise passes its local model on, scaled; a negative scale does not.
     let scaled = Scale(noise.clone(), 0.3);
-    assert!(scaled.local_model(DVec2::ONE, DVec2::splat(1.5)).is_some());
+    assert!(
+        scaled
+            .local_model(&Patch::rect(DVec2::ONE, DVec2::splat(1.5)))
+            .is_some()
+    );
     assert!(
         Scale(noise.clone(), -0.3)
-            .local_model(DVec2::ONE, DVec2::splat(1.5))
+            .local_model(&Patch::rect(DVec2::ONE, DVec2::splat(1.5)))
             .is_none()
     );
     check_bound(&scaled, &mut rng, 10.0);

@@ -18,6 +18,7 @@
 //! unions of rectangles stay as they are.
 
 use super::rect::Rect;
+use crate::density::Patch;
 use crate::rng::hash_words;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -111,11 +112,34 @@ impl Placement {
     #[inline]
     pub fn world_rect(&self, min: DVec2, max: DVec2) -> Rect {
         let (lo, hi) = corner_box(min, max, |p| self.world(p));
+        let e = self.rounding(min, max);
+        Rect::from_ordered(lo - e, hi + e)
+    }
+
+    /// The world patch of the frame's rectangle `[min, max]`: its world rectangle, and the
+    /// turned rectangle itself, widened by the map's rounding.
+    pub fn world_patch(&self, min: DVec2, max: DVec2) -> Patch {
+        let rect = self.world_rect(min, max);
+        // A point's position is off by at most `e` per coordinate: `sqrt(2) e` in all.
+        let e = 2.0 * self.rounding(min, max);
+        let half = (max - min) * 0.5;
+        Patch {
+            min: rect.min(),
+            max: rect.max(),
+            centre: self.world(min + half),
+            u: self.x_axis * (half.x + e),
+            v: self.y_axis * (half.y + e),
+        }
+    }
+
+    /// How far the map may move a point of the frame's rectangle `[min, max]` off its
+    /// place, per world coordinate, and more.
+    #[inline]
+    fn rounding(&self, min: DVec2, max: DVec2) -> f64 {
         // The map's rounding follows the frame's coordinates and the offset (its two terms
         // may cancel to a world coordinate far smaller than either).
         let scale = min.abs().max(max.abs()).max_element() + self.offset.max_element();
-        let e = self.margin * scale;
-        Rect::from_ordered(lo - e, hi + e)
+        self.margin * scale
     }
 
     /// The base tiles `[i0, i1) x [j0, j1)` of side `s` whose points may lie in `rect`: the

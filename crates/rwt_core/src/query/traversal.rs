@@ -5,7 +5,7 @@ use super::lattice::Placement;
 use super::point::{Point, PointId};
 use super::prepared::CellPoint;
 use super::{MAX_LEVEL, OFFSET_STREAM, Rect, Sampler, TileRange};
-use crate::density::{Density, LocalModel, sanitize};
+use crate::density::{Density, LocalModel, Patch, sanitize};
 use crate::rng::{hash_words, unit_f64};
 use crate::tiling::base_tile;
 use glam::DVec2;
@@ -138,12 +138,12 @@ impl TileAt {
         )
     }
 
-    /// The world square of the tile's cell `(a, b)` of `n x n` on `placement`.
-    fn cell_rect(&self, (a, b): (i64, i64), n: i64, placement: &Placement) -> Rect {
+    /// The world patch of the tile's cell `(a, b)` of `n x n` on `placement`.
+    fn cell_patch(&self, (a, b): (i64, i64), n: i64, placement: &Placement) -> Patch {
         let child_s = self.side / n as f64;
         let origin = DVec2::new(self.ix as f64 * self.side, self.iy as f64 * self.side);
         let cell = DVec2::new(a as f64, b as f64);
-        placement.world_rect(
+        placement.world_patch(
             origin + cell * child_s,
             origin + (cell + DVec2::ONE) * child_s,
         )
@@ -287,16 +287,22 @@ impl<'a, D: Density + ?Sized, F: Sink> Visit<'a, '_, D, F> {
         }
         let area = at.side * at.side;
         for cell in 0..cells {
-            let cell_rect = at.cell_rect((cell as i64 % n, cell as i64 / n), n, &placement);
+            let patch = at.cell_patch((cell as i64 % n, cell as i64 / n), n, &placement);
+            let cell_rect = Rect::from_ordered(patch.min, patch.max);
             let Some(r) = cell_rect.intersect(&self.rect) else {
                 (bounds.limit[cell], bounds.low[cell]) = (0.0, 0.0);
                 continue;
             };
-            let cell_model = self.density.local_model(r.min(), r.max());
+            let patch = Patch {
+                min: r.min(),
+                max: r.max(),
+                ..patch
+            };
+            let cell_model = self.density.local_model(&patch);
             let (max, cell_low) = match cell_model {
                 Some(m) => {
                     bounds.model[cell] = cell_model;
-                    let (lo, hi) = m.bounds_over(r.min(), r.max());
+                    let (lo, hi) = m.bounds_over(&patch);
                     let mut max = per_area(hi, area);
                     // A model may be looser than the density's maximum, which the work
                     // bound admitted the query by: a cell is only subdivided when both
