@@ -4,44 +4,50 @@
 //! the plate is resolved, the high band above jittering's), every pattern measured in the
 //! same run.
 
-use rwt_core::analysis::zoneplate::{Pattern, PlateError, ZonePlate};
+use rwt_core::analysis::zoneplate::ZonePlate;
 use rwt_core::query::Sampler;
 use rwt_core::tileset::TileSet;
-
-fn errors(size: usize, seed: u64) -> Vec<(Pattern, PlateError)> {
-    let plate = ZonePlate {
-        size,
-        ..ZonePlate::default()
-    };
-    let sampler = Sampler::new(&TileSet::embedded(), seed);
-    let reference = plate.reference_image();
-    Pattern::ALL
-        .iter()
-        .map(|&p| {
-            let image = plate.reconstruct(plate.samples(p, &sampler, seed).unwrap());
-            (p, plate.error(&image, &reference))
-        })
-        .collect()
-}
 
 #[test]
 fn rwt_removes_aliasing_like_jittering_with_less_noise() {
     for seed in [1, 2] {
-        let e = errors(192, seed);
-        for (p, err) in &e {
+        let plate = ZonePlate {
+            size: 192,
+            ..ZonePlate::default()
+        };
+        let sampler = Sampler::new(&TileSet::embedded(), seed);
+        let comparison = plate.compare(&sampler, seed, || true).unwrap();
+        for r in &comparison.renderings {
+            let e = r.error;
+            let name = r.pattern.name();
             println!(
-                "seed {seed} {}: psnr {:.2} low {:.2} high {:.2}",
-                p.name(),
-                err.psnr,
-                err.low,
-                err.high
+                "seed {seed} {name}: psnr {:.2} low {:.2} high {:.2}",
+                e.psnr, e.low, e.high
             );
         }
-        let of = |p: Pattern| e.iter().find(|x| x.0 == p).unwrap().1;
-        let (rwt, grid, jitter) = (of(Pattern::Rwt), of(Pattern::Grid), of(Pattern::Jitter));
-        // 10 % more squared error is 0.41 dB less PSNR.
-        assert!(rwt.low > grid.low + 1.0, "{rwt:?} {grid:?}");
-        assert!(rwt.low >= jitter.low - 0.41, "{rwt:?} {jitter:?}");
-        assert!(rwt.high > jitter.high, "{rwt:?} {jitter:?}");
+        let claim = comparison.claim().expect("every pattern rendered");
+        assert!(claim.aliasing_removed && claim.less_noise, "{claim:?}");
+        // Well above the grid, not only above it.
+        assert!(claim.rwt.low > claim.grid.low + 1.0, "{claim:?}");
     }
+}
+
+#[test]
+fn a_comparison_stops_when_told() {
+    let plate = ZonePlate {
+        size: 32,
+        ..ZonePlate::default()
+    };
+    let sampler = Sampler::new(&TileSet::embedded(), 3);
+    let mut asked = 0;
+    let comparison = plate
+        .compare(&sampler, 3, || {
+            asked += 1;
+            asked <= 2
+        })
+        .unwrap();
+    assert_eq!(comparison.renderings.len(), 2);
+    assert_eq!(comparison.reference.len(), 32 * 32);
+    // rwt and the grid, but not jittering: no claim.
+    assert!(comparison.claim().is_none());
 }

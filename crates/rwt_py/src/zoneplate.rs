@@ -5,17 +5,19 @@ use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2, PyArray3};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use rwt_core::analysis::zoneplate::{Pattern, ZonePlate};
+use rwt_core::analysis::zoneplate::ZonePlate;
 
 /// Most pixels on a side (the reference takes 16 samples a pixel).
 const MAX_SIZE: usize = 2048;
 
-/// Pattern names, their errors `(patterns, 3)`: PSNR, low band, high band (dB), and the
-/// images `(1 + patterns, size, size)`, the reference first.
+/// Pattern names, their errors `(patterns, 3)`: PSNR, low band, high band (dB), the
+/// images `(1 + patterns, size, size)`, the reference first, and the paper's claim checked
+/// (aliasing removed, less noise).
 type Plates<'py> = (
     Vec<&'static str>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray3<f64>>,
+    (bool, bool),
 );
 
 /// Renders the zone plate with every pattern at `size x size` pixels.
@@ -33,25 +35,31 @@ pub fn zoneplate(py: Python<'_>, size: usize, seed: u64) -> PyResult<Plates<'_>>
     };
     let sampler = crate::tiles::sampler(None, seed)?;
     let rendered = interruptible(py, move |cancel| {
-        let reference = plate.reference_image();
-        let mut errors = Vec::new();
-        let mut images = reference.clone();
-        for pattern in Pattern::ALL {
-            if cancel.is_set() {
-                break;
-            }
-            let samples = plate.samples(pattern, &sampler, seed)?;
-            let image = plate.reconstruct(samples);
-            let e = plate.error(&image, &reference);
-            errors.extend([e.psnr, e.low, e.high]);
-            images.extend(image);
-        }
-        Ok::<_, rwt_core::query::QueryError>((errors, images))
+        plate.compare(&sampler, seed, || !cancel.is_set())
     })?;
-    let (errors, images) = rendered.map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let k = Pattern::ALL.len();
-    let names = Pattern::ALL.iter().map(|p| p.name()).collect();
-    let errors = Array2::from_shape_vec((k, 3), errors).expect("three figures a pattern");
+    let comparison = rendered.map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let claim = comparison
+        .claim()
+        .map(|c| (c.aliasing_removed, c.less_noise))
+        .ok_or_else(|| PyValueError::new_err("the zone plate was interrupted"))?;
+    let k = comparison.renderings.len();
+    let names = comparison
+        .renderings
+        .iter()
+        .map(|r| r.pattern.name())
+        .collect();
+    let errors = comparison
+        .renderings
+        .iter()
+        .flat_map(|r| [r.error.psnr, r.error.low, r.error.high]);
+    let errors = Array2::from_shape_vec((k, 3), errors.collect()).expect("three figures a pattern");
+    let mut images = comparison.reference;
+    images.extend(comparison.renderings.into_iter().flat_map(|r| r.image));
     let images = Array3::from_shape_vec((k + 1, size, size), images).expect("an image each");
-    Ok((names, errors.into_pyarray(py), images.into_pyarray(py)))
+    Ok((
+        names,
+        errors.into_pyarray(py),
+        images.into_pyarray(py),
+        claim,
+    ))
 }

@@ -24,10 +24,6 @@ pub const INDEX_FILE: &str = "painted.ron";
 /// lattice; its files say so, and load as such).
 pub const SAVE_FORMAT: u32 = 2;
 
-fn format_1() -> u32 {
-    1
-}
-
 /// Largest index or layer file a load reads.
 const MAX_TEXT_BYTES: u64 = 1 << 20;
 
@@ -46,7 +42,7 @@ pub struct PaintedMapEntry {
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct PaintedMaps {
     /// The save's format ([`SAVE_FORMAT`]; an index without it is of format 1).
-    #[serde(default = "format_1")]
+    #[serde(default = "crate::layers::file::format_1")]
     pub format: u32,
     /// The maps.
     pub maps: Vec<PaintedMapEntry>,

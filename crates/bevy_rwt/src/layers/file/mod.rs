@@ -417,7 +417,9 @@ fn default_tile() -> f64 {
 /// [`Lattice::Aligned`].
 pub const LAYER_FORMAT: u32 = 2;
 
-fn format_1() -> u32 {
+/// The format of a layer file or save index without a `format` field: 1, written before
+/// formats were named (a serde default).
+pub(crate) fn format_1() -> u32 {
     1
 }
 
