@@ -2,6 +2,7 @@
 //! vector of `Point`s in between (56 bytes a point, written and read once more), and each
 //! point's id and density computed on the thread that found it.
 
+use crate::huge_pages;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -43,15 +44,10 @@ impl Columns {
         let mut c = Self::default();
         let _ = (c.xy.try_reserve_exact(2 * n), c.ids.try_reserve_exact(n));
         let _ = (c.thresholds.try_reserve_exact(n), c.at.try_reserve_exact(n));
-        c
-    }
-
-    /// The columns of `run`.
-    pub fn of<D: Density + ?Sized>(run: &[Point], density: &D, seed: u64) -> Self {
-        let mut c = Self::with_room(run.len() as f64);
-        for p in run {
-            c.push(p, density, seed);
-        }
+        huge_pages::advise(&mut c.xy);
+        huge_pages::advise(&mut c.ids);
+        huge_pages::advise(&mut c.thresholds);
+        huge_pages::advise(&mut c.at);
         c
     }
 
@@ -65,11 +61,19 @@ impl Columns {
     }
 
     /// Appends `other`'s points after these.
-    pub fn append(&mut self, other: Columns) {
+    pub fn append(&mut self, other: &Columns) {
         self.xy.extend_from_slice(&other.xy);
         self.ids.extend_from_slice(&other.ids);
         self.thresholds.extend_from_slice(&other.thresholds);
         self.at.extend_from_slice(&other.at);
+    }
+
+    /// No points, the memory kept.
+    pub fn clear(&mut self) {
+        self.xy.clear();
+        self.ids.clear();
+        self.thresholds.clear();
+        self.at.clear();
     }
 
     /// The columns as numpy arrays (moved, not copied).

@@ -6,6 +6,7 @@ mod analyse;
 mod bench;
 mod columns;
 mod errors;
+mod huge_pages;
 mod interrupt;
 mod sample;
 mod stipple;

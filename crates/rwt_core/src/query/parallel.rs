@@ -131,7 +131,7 @@ impl Sampler {
         rect: Rect,
         density: &D,
         map: M,
-        mut consume: C,
+        consume: C,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<usize, QueryError>
     where
@@ -139,6 +139,83 @@ impl Sampler {
         T: Send,
         M: Fn(&[Point]) -> T + Sync,
         C: FnMut(T) -> ControlFlow<()>,
+    {
+        let start = || Vec::new();
+        let add = |points: &mut Vec<Point>, p: Point| points.push(p);
+        let end = |points: Vec<Point>| map(&points);
+        self.query_par_blocks(rect, density, (start, add, end), consume, progress)
+    }
+
+    /// [`Sampler::query_par_ordered`] without a vector of points per block: each block
+    /// folds its points into what `start` gives it (a recycled buffer, say) with `add`, as
+    /// the traversal finds them, on the pool; `consume` receives each block's result in
+    /// order on the calling thread (`Break` stops the query), and `progress` the fraction
+    /// of base tiles done. Returns how many points were consumed.
+    ///
+    /// ```
+    /// use glam::DVec2;
+    /// use std::ops::ControlFlow;
+    /// use rwt_core::{Constant, Rect, Sampler, TileSet};
+    ///
+    /// let sampler = Sampler::new(&TileSet::embedded(), 3);
+    /// let rect = Rect::new(DVec2::ZERO, DVec2::splat(100.0)).unwrap();
+    /// let mut xs = Vec::new();
+    /// let mut ys = Vec::new();
+    /// sampler
+    ///     .query_par_fold(
+    ///         rect,
+    ///         &Constant(2.0),
+    ///         || (Vec::new(), Vec::new()),
+    ///         |(x, y): &mut (Vec<f64>, Vec<f64>), p: rwt_core::Point| {
+    ///             x.push(p.position.x);
+    ///             y.push(p.position.y);
+    ///         },
+    ///         |(x, y)| {
+    ///             xs.extend(x);
+    ///             ys.extend(y);
+    ///             ControlFlow::Continue(())
+    ///         },
+    ///         &|_| {},
+    ///     )
+    ///     .unwrap();
+    /// assert_eq!(xs.len(), sampler.query_par(rect, &Constant(2.0), &mut Vec::new()).unwrap());
+    /// ```
+    pub fn query_par_fold<D, T, S, A, C>(
+        &self,
+        rect: Rect,
+        density: &D,
+        start: S,
+        add: A,
+        consume: C,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<usize, QueryError>
+    where
+        D: Density + Sync + ?Sized,
+        T: Send,
+        S: Fn() -> T + Sync,
+        A: Fn(&mut T, Point) + Sync,
+        C: FnMut(T) -> ControlFlow<()>,
+    {
+        let build = (start, add, |t| t);
+        self.query_par_blocks(rect, density, build, consume, progress)
+    }
+
+    /// The ordered parallel query: `build` is how a block starts, adds a point and ends.
+    fn query_par_blocks<D, T, U, S, A, E, C>(
+        &self,
+        rect: Rect,
+        density: &D,
+        (start, add, end): (S, A, E),
+        mut consume: C,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<usize, QueryError>
+    where
+        D: Density + Sync + ?Sized,
+        U: Send,
+        S: Fn() -> T + Sync,
+        A: Fn(&mut T, Point) + Sync,
+        E: Fn(T) -> U + Sync,
+        C: FnMut(U) -> ControlFlow<()>,
     {
         let Some(range) = self.admit(&rect, density)? else {
             progress(1.0);
@@ -151,13 +228,17 @@ impl Sampler {
             fork.blocks(range, LEAF_BLOCK as usize),
             ahead,
             |block| {
-                let points = fork.points(block);
+                let (mut built, mut n) = (start(), 0);
+                fork.visit(block, &mut |p: Point| {
+                    n += 1;
+                    add(&mut built, p);
+                });
                 fork.progress.finished(&block);
-                (points.len(), map(&points))
+                (n, end(built))
             },
-            |(n, t)| {
+            |(n, u)| {
                 count += n;
-                consume(t)
+                consume(u)
             },
         );
         Ok(count)
