@@ -13,7 +13,6 @@ use rwt_core::tileset::TileSet;
 use std::io::Write;
 use std::ops::ControlFlow;
 use std::path::Path;
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -149,15 +148,6 @@ impl Query<'_> {
     /// many points there are); a progress bar appears when this takes longer than a second.
     fn parallel(&self, sink: &mut dyn Write) -> Result<usize, String> {
         let bar = LateBar::new(1000, "points");
-        // Each block's lines are written into the text the last written block used.
-        let spare = Mutex::new(Vec::<Vec<u8>>::new());
-        let start = || {
-            spare
-                .lock()
-                .ok()
-                .and_then(|mut s| s.pop())
-                .unwrap_or_default()
-        };
         let add = |text: &mut Vec<u8>, p: Point| {
             // Writing to memory cannot fail.
             let _ = write_point(text, &p, self.seed);
@@ -168,16 +158,9 @@ impl Query<'_> {
             .query_par_fold(
                 self.rect,
                 self.density,
-                start,
                 add,
-                |mut text| match sink.write_all(&text) {
-                    Ok(()) => {
-                        text.clear();
-                        if let Ok(mut s) = spare.lock() {
-                            s.push(text);
-                        }
-                        ControlFlow::Continue(())
-                    }
+                |text| match sink.write_all(text) {
+                    Ok(()) => ControlFlow::Continue(()),
                     Err(e) => {
                         failed = Some(e);
                         ControlFlow::Break(())

@@ -685,17 +685,14 @@ fn parallel_queries_return_the_serial_points_in_the_serial_order() {
                 )
                 .unwrap();
             assert_eq!((k, &ordered), (n, &serial), "{rect:?}");
-            // Folded into buffers the blocks take from (and give back to) a shared spare.
-            let (spare, mut folded) = (std::sync::Mutex::new(Vec::new()), Vec::new());
-            let start = || spare.lock().unwrap().pop().unwrap_or_default();
+            // Folded into buffers that later blocks reuse.
+            let mut folded = Vec::new();
             let add = |buffer: &mut Vec<Point>, p: Point| buffer.push(p);
-            let consume = |mut buffer: Vec<Point>| {
-                folded.extend_from_slice(&buffer);
-                buffer.clear();
-                spare.lock().unwrap().push(buffer);
+            let consume = |buffer: &Vec<Point>| {
+                folded.extend_from_slice(buffer);
                 std::ops::ControlFlow::Continue(())
             };
-            let folds = s.query_par_fold(*rect, density, start, add, consume, &|_| {});
+            let folds = s.query_par_fold(*rect, density, add, consume, &|_| {});
             assert_eq!(folds.unwrap(), n);
             assert!(folded == serial, "{rect:?}");
             empty += usize::from(n == 0);

@@ -7,7 +7,7 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use rwt_core::density::Density;
-use rwt_core::query::Point;
+use rwt_core::query::{Buffer, Point};
 
 /// Hash salt of the 64-bit point ids (`PointId::hash`).
 const ID_SALT: u64 = 0x1d5;
@@ -68,14 +68,6 @@ impl Columns {
         self.at.extend_from_slice(&other.at);
     }
 
-    /// No points, the memory kept.
-    pub fn clear(&mut self) {
-        self.xy.clear();
-        self.ids.clear();
-        self.thresholds.clear();
-        self.at.clear();
-    }
-
     /// The columns as numpy arrays (moved, not copied).
     pub fn into_arrays(self, py: Python<'_>) -> Arrays<'_> {
         let n = self.ids.len();
@@ -86,5 +78,15 @@ impl Columns {
             self.thresholds.into_pyarray(py),
             self.at.into_pyarray(py),
         )
+    }
+}
+
+/// A block's columns, emptied for the next block with their memory kept.
+impl Buffer for Columns {
+    fn clear(&mut self) {
+        self.xy.clear();
+        self.ids.clear();
+        self.thresholds.clear();
+        self.at.clear();
     }
 }

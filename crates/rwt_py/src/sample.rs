@@ -14,7 +14,7 @@ use rwt_core::density::{Constant, Density, ImageDensity, Placement};
 use rwt_core::query::{DEFAULT_BUDGET, Point, QueryError, Rect, Sampler};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// Rectangles of at least this many base tiles are queried on all cores by
 /// `Sampler::query_par`, as `rwt points` does: the same points in the same order.
@@ -149,26 +149,12 @@ fn collect<D: Density + Sync + ?Sized>(
     let bound = sampler.work_bound(&rect, density);
     let mut out = Columns::with_room(bound);
     if rect.area() / (tile * tile) >= PARALLEL_TILES {
-        // Each block's columns are written where the last finished block's were: their
-        // memory is touched once, not once a block.
-        let spare = Mutex::new(Vec::<Columns>::new());
-        let start = || {
-            spare
-                .lock()
-                .ok()
-                .and_then(|mut s| s.pop())
-                .unwrap_or_default()
-        };
         let add = |c: &mut Columns, p: Point| c.push(&p, density, seed);
-        let append = |mut c: Columns| {
-            out.append(&c);
-            c.clear();
-            if let Ok(mut s) = spare.lock() {
-                s.push(c);
-            }
+        let append = |c: &Columns| {
+            out.append(c);
             ControlFlow::Continue(())
         };
-        sampler.query_par_fold(rect, density, start, add, append, &|_| {})?;
+        sampler.query_par_fold(rect, density, add, append, &|_| {})?;
         return Ok(out);
     }
     if bound < PARALLEL_POINTS || rayon::current_num_threads() < 2 {

@@ -29,6 +29,8 @@ mod traversal;
 mod work_bound;
 
 pub use lattice::Lattice;
+#[cfg(feature = "parallel")]
+pub use parallel::Buffer;
 pub use point::{Point, PointId};
 pub use rect::Rect;
 

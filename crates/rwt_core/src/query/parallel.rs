@@ -91,6 +91,19 @@ impl Sampler {
     }
 }
 
+/// What [`Sampler::query_par_fold`] fills a block's points into: emptied after each block
+/// is consumed, its memory kept for a later block.
+pub trait Buffer: Default + Send {
+    /// Empties the buffer, keeping its memory.
+    fn clear(&mut self);
+}
+
+impl<T: Send> Buffer for Vec<T> {
+    fn clear(&mut self) {
+        Vec::clear(self);
+    }
+}
+
 /// Blocks computed ahead of the one [`Sampler::query_par_ordered`] hands over, per pool thread.
 const BLOCKS_AHEAD_PER_THREAD: usize = 4;
 
@@ -147,10 +160,11 @@ impl Sampler {
     }
 
     /// [`Sampler::query_par_ordered`] without a vector of points per block: each block
-    /// folds its points into what `start` gives it (a recycled buffer, say) with `add`, as
-    /// the traversal finds them, on the pool; `consume` receives each block's result in
-    /// order on the calling thread (`Break` stops the query), and `progress` the fraction
-    /// of base tiles done. Returns how many points were consumed.
+    /// adds its points to a buffer with `add` as the traversal finds them, on the pool;
+    /// `consume` reads each block's buffer in order on the calling thread (`Break` stops the
+    /// query), and the buffer, cleared, takes a later block's points: memory is touched
+    /// once, not once a block. `progress` receives the fraction of base tiles done. Returns
+    /// how many points were consumed.
     ///
     /// ```
     /// use glam::DVec2;
@@ -160,44 +174,47 @@ impl Sampler {
     /// let sampler = Sampler::new(&TileSet::embedded(), 3);
     /// let rect = Rect::new(DVec2::ZERO, DVec2::splat(100.0)).unwrap();
     /// let mut xs = Vec::new();
-    /// let mut ys = Vec::new();
-    /// sampler
+    /// let n = sampler
     ///     .query_par_fold(
     ///         rect,
     ///         &Constant(2.0),
-    ///         || (Vec::new(), Vec::new()),
-    ///         |(x, y): &mut (Vec<f64>, Vec<f64>), p: rwt_core::Point| {
-    ///             x.push(p.position.x);
-    ///             y.push(p.position.y);
-    ///         },
-    ///         |(x, y)| {
-    ///             xs.extend(x);
-    ///             ys.extend(y);
+    ///         |x: &mut Vec<f64>, p: rwt_core::Point| x.push(p.position.x),
+    ///         |x: &Vec<f64>| {
+    ///             xs.extend_from_slice(x);
     ///             ControlFlow::Continue(())
     ///         },
     ///         &|_| {},
     ///     )
     ///     .unwrap();
-    /// assert_eq!(xs.len(), sampler.query_par(rect, &Constant(2.0), &mut Vec::new()).unwrap());
+    /// assert_eq!((xs.len(), n), (n, sampler.query_par(rect, &Constant(2.0), &mut Vec::new()).unwrap()));
     /// ```
-    pub fn query_par_fold<D, T, S, A, C>(
+    pub fn query_par_fold<D, T, A, C>(
         &self,
         rect: Rect,
         density: &D,
-        start: S,
         add: A,
-        consume: C,
+        mut consume: C,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<usize, QueryError>
     where
         D: Density + Sync + ?Sized,
-        T: Send,
-        S: Fn() -> T + Sync,
+        T: Buffer,
         A: Fn(&mut T, Point) + Sync,
-        C: FnMut(T) -> ControlFlow<()>,
+        C: FnMut(&T) -> ControlFlow<()>,
     {
+        let spare = Mutex::new(Vec::<T>::new());
+        let start = || {
+            let mut spare = spare.lock().unwrap_or_else(|p| p.into_inner());
+            spare.pop().unwrap_or_default()
+        };
+        let recycle = |mut buffer: T| {
+            let flow = consume(&buffer);
+            buffer.clear();
+            spare.lock().unwrap_or_else(|p| p.into_inner()).push(buffer);
+            flow
+        };
         let build = (start, add, |t| t);
-        self.query_par_blocks(rect, density, build, consume, progress)
+        self.query_par_blocks(rect, density, build, recycle, progress)
     }
 
     /// The ordered parallel query: `build` is how a block starts, adds a point and ends.
