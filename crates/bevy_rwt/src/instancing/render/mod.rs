@@ -13,6 +13,8 @@ mod depth;
 mod draw;
 mod main_pass;
 mod retained;
+#[cfg(test)]
+mod shader_check;
 
 pub(super) use depth::{
     DrawInstancedDepth, InstancedDepthPipeline, init_depth_pipeline, queue_prepass, queue_shadows,

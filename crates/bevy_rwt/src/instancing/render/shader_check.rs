@@ -1,0 +1,218 @@
+//! The instanced shader against naga, without a GPU: composed with Bevy's own shader
+//! library (its WGSL sources, found through `cargo metadata`) for every permutation of the
+//! definitions the pipelines set, as Bevy's `ShaderCache` composes it (validating in test
+//! builds), and its uniform structs' layouts against the Rust structs that fill them.
+
+use super::{ChunkUniform, FrameUniform};
+use bevy::asset::AssetId;
+use bevy::asset::uuid::Uuid;
+use bevy::render::render_resource::{DownlevelFlags, WgpuFeatures};
+use bevy::shader::{Shader, ShaderCache, ShaderCacheSource, ShaderDefVal};
+use std::path::{Path, PathBuf};
+
+/// The crates whose WGSL the instanced shader imports, directly or through others.
+const LIBRARY: [&str; 5] = [
+    "bevy_pbr",
+    "bevy_render",
+    "bevy_core_pipeline",
+    "bevy_light",
+    "bevy_shader",
+];
+
+/// The host's target triple, from `rustc -vV`.
+fn host() -> String {
+    let out = std::process::Command::new("rustc")
+        .arg("-vV")
+        .output()
+        .expect("rustc runs");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    let line = text.lines().find_map(|l| l.strip_prefix("host: "));
+    line.expect("rustc names its host").to_string()
+}
+
+/// The `src` folders of the library's crates, from `cargo metadata` (for this platform
+/// only: offline, the others' packages are not there).
+fn library_sources() -> Vec<PathBuf> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args(["metadata", "--format-version", "1", "--offline"])
+        .args(["--filter-platform", &host()])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo metadata runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    let paths: Vec<PathBuf> = text
+        .split("\"manifest_path\":\"")
+        .skip(1)
+        .filter_map(|s| s.split('"').next())
+        .map(PathBuf::from)
+        .filter(|p| {
+            let dir = p.parent().and_then(Path::file_name);
+            let name = dir
+                .map(|d| d.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            LIBRARY.iter().any(|c| name.starts_with(&format!("{c}-")))
+        })
+        .filter_map(|p| p.parent().map(|d| d.join("src")))
+        .collect();
+    assert_eq!(paths.len(), LIBRARY.len(), "found {paths:?}");
+    paths
+}
+
+/// Every WGSL file below `dir` that names an import path.
+fn modules(dir: &Path, found: &mut Vec<(String, String)>) {
+    for entry in std::fs::read_dir(dir).expect("a crate's sources").flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            modules(&path, found);
+        } else if path.extension().is_some_and(|e| e == "wgsl") {
+            let source = std::fs::read_to_string(&path).expect("a WGSL file");
+            if source.contains("#define_import_path") {
+                found.push((path.display().to_string(), source));
+            }
+        }
+    }
+}
+
+/// A shader cache holding Bevy's library, set up as Bevy's plugins set it up; its modules
+/// are the `Debug` text of the composed naga module's types.
+fn cache_with_library() -> ShaderCache<String, ()> {
+    let mut cache = ShaderCache::new(
+        (),
+        WgpuFeatures::all(),
+        DownlevelFlags::all(),
+        |_, source, _| match source {
+            ShaderCacheSource::Naga(module) => Ok(format!("{:?}", module.types)),
+            _ => Ok(String::new()),
+        },
+    );
+    let mut found = Vec::new();
+    for dir in library_sources() {
+        modules(&dir, &mut found);
+    }
+    for (k, (path, source)) in found.into_iter().enumerate() {
+        // What bevy_pbr's plugin loads mesh_view_types.wgsl with.
+        let defs = if path.ends_with("mesh_view_types.wgsl") {
+            vec![
+                ShaderDefVal::UInt("MAX_DIRECTIONAL_LIGHTS".into(), 10),
+                ShaderDefVal::UInt("MAX_CASCADES_PER_LIGHT".into(), 4),
+                ShaderDefVal::UInt("MAX_RECT_LIGHTS".into(), 8),
+            ]
+        } else {
+            Vec::new()
+        };
+        let shader = Shader::from_wgsl_with_defs(source, path, defs);
+        cache.set_shader(AssetId::from(Uuid::from_u128(k as u128 + 1)), shader);
+    }
+    cache
+}
+
+/// The definitions of the main pass and of the depth passes (prepass and shadows), for
+/// every class feature and pass option the pipelines combine.
+fn permutations() -> Vec<Vec<ShaderDefVal>> {
+    let global = ShaderDefVal::UInt("AVAILABLE_STORAGE_BUFFER_BINDINGS".into(), 8);
+    let features = ["RWT_NORMALS", "RWT_BEND", "RWT_TEXTURE"];
+    let passes = [
+        "NORMAL_PREPASS",
+        "MOTION_VECTOR_PREPASS",
+        "UNCLIPPED_DEPTH_ORTHO_EMULATION",
+        "RWT_SHADOW_PASS",
+    ];
+    let subset = |names: &[&str], bits: usize| -> Vec<ShaderDefVal> {
+        let on = names.iter().enumerate().filter(|(i, _)| bits >> i & 1 == 1);
+        on.map(|(_, n)| ShaderDefVal::from(*n)).collect()
+    };
+    let mut all = Vec::new();
+    for f in 0..1 << features.len() {
+        let mut main = vec![
+            global.clone(),
+            ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 3),
+        ];
+        main.extend(subset(&features, f));
+        all.push(main);
+        for p in 0..1 << passes.len() {
+            let mut depth = vec![global.clone(), "PREPASS_PIPELINE".into()];
+            depth.extend(subset(&features, f));
+            depth.extend(subset(&passes, p));
+            // The depth pipeline writes a fragment where a prepass target or the
+            // emulation asks for one.
+            if p & 0b111 != 0 {
+                depth.push("PREPASS_FRAGMENT".into());
+            }
+            all.push(depth);
+        }
+    }
+    all
+}
+
+/// The members (name, offset) and size of struct `name` in a module's types' `Debug` text.
+fn struct_layout(types: &str, name: &str) -> (Vec<(String, usize)>, usize) {
+    let start = types
+        .find(&format!("name: Some(\"{name}\"), inner: Struct"))
+        .unwrap_or_else(|| panic!("no struct {name}"));
+    let body = &types[start..];
+    let end = body.find("span: ").expect("a struct's span");
+    let span = body[end + 6..]
+        .split(|c: char| !c.is_ascii_digit())
+        .next()
+        .and_then(|s| s.parse().ok())
+        .expect("a span");
+    let members = body[..end]
+        .split("StructMember { name: Some(\"")
+        .skip(1)
+        .map(|m| {
+            let member = m.split('"').next().unwrap_or_default().to_string();
+            let offset = m.split("offset: ").nth(1).unwrap_or_default();
+            let digits: String = offset.chars().take_while(char::is_ascii_digit).collect();
+            (member, digits.parse().expect("an offset"))
+        })
+        .collect();
+    (members, span)
+}
+
+#[test]
+fn every_permutation_composes_and_validates_with_the_uniform_layouts() {
+    let mut cache = cache_with_library();
+    let id = AssetId::from(Uuid::from_u128(u128::MAX));
+    let shader = Shader::from_wgsl(include_str!("instanced.wgsl"), "instanced.wgsl");
+    cache.set_shader(id, shader);
+    let mut failed = Vec::new();
+    let mut composed = Vec::new();
+    for (k, defs) in permutations().iter().enumerate() {
+        match cache.get(k, id, defs) {
+            Ok(types) => composed.push(types),
+            Err(e) => failed.push(format!("{defs:?}: {e:?}")),
+        }
+    }
+    assert!(
+        failed.is_empty(),
+        "{} failed:\n{}",
+        failed.len(),
+        failed.join("\n")
+    );
+    assert_eq!(composed.len(), 8 * 17);
+    use std::mem::{offset_of, size_of};
+    let chunk = [
+        ("origin", offset_of!(ChunkUniform, origin)),
+        ("base_color", offset_of!(ChunkUniform, base_color)),
+        ("tip_color", offset_of!(ChunkUniform, tip_color)),
+        ("params", offset_of!(ChunkUniform, params)),
+        ("falloff", offset_of!(ChunkUniform, falloff)),
+        ("wind", offset_of!(ChunkUniform, wind)),
+        ("wind_motion", offset_of!(ChunkUniform, wind_motion)),
+        ("shading", offset_of!(ChunkUniform, shading)),
+    ];
+    let frame = [
+        ("viewer", offset_of!(FrameUniform, viewer)),
+        ("bend", offset_of!(FrameUniform, bend)),
+    ];
+    let expect = |fields: &[(&str, usize)]| -> Vec<(String, usize)> {
+        fields.iter().map(|(n, o)| (n.to_string(), *o)).collect()
+    };
+    for types in &composed {
+        let ours = (expect(&chunk), size_of::<ChunkUniform>());
+        assert_eq!(struct_layout(types, "Chunk"), ours);
+        let ours = (expect(&frame), size_of::<FrameUniform>());
+        assert_eq!(struct_layout(types, "Frame"), ours);
+    }
+}
