@@ -26,16 +26,12 @@ use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass, NormalPrep
 use bevy::prelude::*;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::{Render, RenderApp, RenderSystems};
-use bevy_rwt::look::blade_mesh;
 use bevy_rwt::prelude::*;
+use rwt_examples::grass_field::{self, field_layer, nominal_density, set_instanced_shadows};
 use rwt_examples::prelude::*;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-/// Streaming radius of the field, metres.
-const RADIUS: f64 = 150.0;
-/// Chunk side, metres.
-const CHUNK: f64 = 32.0;
 /// Frames timed once streaming has settled.
 const TIMED: usize = 30;
 /// Frames run before, to warm up.
@@ -126,22 +122,11 @@ fn setup(
     commands.spawn((
         Camera3d::default(),
         RwtViewer::all_around(),
-        Transform::from_xyz(0.0, 2.0, 0.0).looking_at(Vec3::new(40.0, 0.0, 30.0), Vec3::Y),
+        grass_field::camera_transform(),
     ));
-    commands.spawn((
-        DirectionalLight {
-            shadow_maps_enabled: true,
-            ..default()
-        },
-        Transform::from_xyz(1.0, 2.0, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
-    ));
-    commands.spawn((
-        Mesh3d(meshes.add(Plane3d::default().mesh().size(600.0, 600.0))),
-        MeshMaterial3d(materials.add(Color::srgb(0.2, 0.3, 0.1))),
-    ));
-    let density =
-        LayerDensity::Constant(field.count / (std::f64::consts::PI * (RADIUS + CHUNK).powi(2)));
-    let blade = meshes.add(blade_mesh(0.09, 0.72, 0.12));
+    grass_field::spawn_sun_and_ground(&mut commands, &mut meshes, &mut materials);
+    let density = LayerDensity::Constant(nominal_density(field.count));
+    let blade = meshes.add(grass_field::blade());
     let grass = if field.entities {
         let material = materials.add(StandardMaterial {
             base_color: Color::srgb(0.3, 0.5, 0.15),
@@ -157,16 +142,7 @@ fn setup(
         };
         ScatterClass::instanced(density, blade, material)
     };
-    commands.spawn(
-        ScatterLayer::new(vec![grass])
-            .with_tile_size(2.0)
-            .with_streaming(StreamingConfig {
-                chunk_size: CHUNK,
-                load_distance: RADIUS,
-                unload_distance: RADIUS + 24.0,
-                near_distance: 48.0,
-            }),
-    );
+    commands.spawn(field_layer(grass));
 }
 
 fn start_frame(clock: Res<Clock>) {
@@ -273,11 +249,7 @@ fn apply(
 ) {
     for (entity, layer) in layers {
         let mut layer = layer.clone();
-        for class in &mut layer.classes {
-            if let ClassLook::Instanced(look) = &mut class.look {
-                look.material.shadows = shadows;
-            }
-        }
+        set_instanced_shadows(&mut layer, shadows);
         commands.entity(entity).insert(layer);
     }
     for camera in cameras {

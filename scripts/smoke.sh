@@ -10,7 +10,8 @@
 # (or took fewer than its three screenshots, 1x, 30x and 1000x), or mesh_ground placed an
 # instance off its glTF level's surfaces (floating, buried, on a wall); and runs
 # instanced_passes, which fails unless instanced grass receives and casts shadows and is
-# drawn with the prepasses, TAA and SSAO.
+# drawn with the prepasses, TAA and SSAO, and gpu_culling, which fails unless the frame culled
+# per instance on the GPU is the frame drawn whole and its indirect counts are the CPU's.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -22,10 +23,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes)
+examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -58,6 +59,16 @@ export BEVY_ASSET_ROOT=$PWD RUST_LOG=${RUST_LOG:-warn} RWT_PAINT_DIR=$PWD/$out/p
 if [ $docs = 0 ]; then export RWT_WINDOW=${RWT_WINDOW:-640x360}; fi
 
 failed=0
+# Runs example $ex (log $name) that checks itself: $1 (VAR=folder) names where it saves its
+# screenshots; it passes when it printed `$2: $3...` and no `$2: FAIL` or ERROR line.
+self_checked() {
+    env "$1" timeout 1200 "$bin/$ex" >"$out/$name.log" 2>&1 || true
+    line=$(grep -E "^$2: $3" "$out/$name.log" || true)
+    echo "$name: ${line:-no result line}, $(( $(date +%s) - start )) s"
+    if [ -z "$line" ] || grep -qE "^$2: FAIL|ERROR" "$out/$name.log"; then
+        echo "FAIL $name"; grep -E 'FAIL|ERROR' -A6 "$out/$name.log" | head -30; failed=1
+    fi
+}
 for run in "${runs[@]}"; do
     ex=${run%%:*}
     view=${run#*:}; [ "$view" = "$run" ] && view=
@@ -68,12 +79,13 @@ for run in "${runs[@]}"; do
     if [ "$ex" = instanced_passes ]; then
         # Its own screenshots, compared region by region: grass receives and casts
         # shadows, and is drawn with the prepasses, TAA and SSAO.
-        RWT_PASSES_DIR=$out/passes timeout 1200 "$bin/$ex" >"$out/$name.log" 2>&1 || true
-        line=$(grep -E '^rwt-passes: cards' "$out/$name.log" || true)
-        echo "$name: ${line:-no result line}, $(( $(date +%s) - start )) s"
-        if [ -z "$line" ] || grep -qE '^rwt-passes: FAIL|ERROR' "$out/$name.log"; then
-            echo "FAIL $name"; grep -E 'FAIL|ERROR' -A6 "$out/$name.log" | head -30; failed=1
-        fi
+        self_checked RWT_PASSES_DIR=$out/passes rwt-passes 'cards'
+        continue
+    fi
+    if [ "$ex" = gpu_culling ]; then
+        # Culling per instance: the frame matches the whole chunks' and the GPU's counts
+        # the CPU's.
+        self_checked RWT_CULLING_DIR=$out/culling rwt-culling 'draws'
         continue
     fi
     # CI's open_world flies its path in 100 frames instead of 150 (the same checks: the

@@ -1,6 +1,7 @@
 //! What the examples share: the scripted smoke session that lets CI run each example in a
 //! real renderer ([`smoke`]), a fly camera ([`fly_camera`]), a text HUD ([`hud`]) and the
-//! brush's last answer for it ([`brush_status`]).
+//! brush's last answer for it ([`brush_status`]), and the field of grass the cost benchmarks
+//! time ([`grass_field`]).
 //!
 //! Run an example as a user would (`cargo run --release --example open_world`), or as CI
 //! does: `RWT_SCREENSHOT=out.png cargo run --example open_world` plays the example's script,
@@ -9,6 +10,7 @@
 pub mod brush_status;
 pub mod fly_camera;
 pub mod foliage;
+pub mod grass_field;
 pub mod hud;
 pub mod smoke;
 pub mod terrain;

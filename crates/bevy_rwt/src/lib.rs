@@ -165,7 +165,9 @@ use bevy::app::PluginGroupBuilder;
 use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 pub use diagnostics::{RwtDiagnosticsPlugin, RwtStats};
-pub use instancing::{Bender, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind};
+pub use instancing::{
+    Bender, InstanceCulling, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind,
+};
 pub use layers::RwtLayersPlugin;
 pub use layers::{
     AssetFailure, AssetProblem, AssetStatus, DEFAULT_SCALE_VARIATION, DEFAULT_TILE_SIZE, GroundMap,
@@ -174,7 +176,7 @@ pub use layers::{
 };
 pub use look::{
     ClassLook, Footing, GroundPlane, InstanceInserter, InstancedLook, InstancedShading,
-    InstancedShadows, MeshLod, Pose, Stance,
+    InstancedShadows, InstancedThinning, MeshLod, Pose, Stance,
 };
 pub use rwt_core;
 use rwt_core::tileset::TileSet;
@@ -198,11 +200,11 @@ pub mod prelude {
     pub use crate::save::{LoadWorld, NamedMap, RwtSavePlugin, SaveWorld, WorldLoaded, WorldSaved};
     pub use crate::{
         AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundMap,
-        GroundPlane, HeightSource, InstancedChunk, InstancedShading, InstancedShadows,
-        LayerDensity, RwtDiagnosticsPlugin, RwtFadeIn, RwtInstancingPlugin, RwtLayersPlugin,
-        RwtPlugins, RwtSettings, RwtStats, RwtStreamingPlugin, RwtSystems, RwtViewer,
-        RwtViewersPlugin, RwtWind, ScatterClass, ScatterEntity, ScatterLayer, ScatterLayerStatus,
-        ViewCone,
+        GroundPlane, HeightSource, InstanceCulling, InstancedChunk, InstancedShading,
+        InstancedShadows, InstancedThinning, LayerDensity, RwtDiagnosticsPlugin, RwtFadeIn,
+        RwtInstancingPlugin, RwtLayersPlugin, RwtPlugins, RwtSettings, RwtStats,
+        RwtStreamingPlugin, RwtSystems, RwtViewer, RwtViewersPlugin, RwtWind, ScatterClass,
+        ScatterEntity, ScatterLayer, ScatterLayerStatus, ViewCone,
     };
     pub use rwt_core::Lattice;
     pub use rwt_core::streaming::{Falloff, StreamingConfig};

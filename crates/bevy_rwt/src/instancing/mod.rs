@@ -28,6 +28,8 @@ pub(crate) use pack::{InstancedClasses, PackedClass};
 pub use plugin::RwtInstancingPlugin;
 pub use promote::PromotedInstance;
 pub(crate) use queue::{InstancedQueue, Upload};
+#[cfg(feature = "testing")]
+pub use render::{CullingCheck, CullingReport};
 
 use crate::look::InstancedShading;
 use bevy::camera::primitives::Aabb;
@@ -74,6 +76,28 @@ impl Default for RwtFadeIn {
     fn default() -> Self {
         Self(true)
     }
+}
+
+/// How instanced chunks are culled.
+///
+/// Every chunk is first culled whole on the CPU, by its bounds against each view (cameras
+/// and shadow views). With culling per instance, a compute pass then tests each instance of
+/// the kept chunks against the view (its frustum, grown by the instance's reach and sway;
+/// the level-of-detail fade, which shrinks far instances to nothing; the class's shadow
+/// distance in shadow views) and writes the instances kept and the draw's arguments, and
+/// each chunk is drawn indirectly: a chunk at the edge of the view draws only the instances
+/// inside it.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Reflect)]
+#[reflect(Resource, Clone, Debug, PartialEq, Default)]
+pub enum InstanceCulling {
+    /// Per instance on the GPU where the adapter runs compute shaders and indirect draws
+    /// (not WebGL2-class adapters), per chunk otherwise.
+    #[default]
+    Auto,
+    /// Per chunk on the CPU only: each kept chunk draws all its instances.
+    PerChunk,
+    /// Per instance on the GPU (per chunk where the adapter cannot).
+    PerInstance,
 }
 
 /// One instance as the GPU reads it: 24 bytes.

@@ -1,7 +1,9 @@
 //! The instancing feature plugin: the wind resource, and the render-world systems that draw
 //! every [`InstancedChunk`] with one instanced draw.
 
-use super::{BendField, Bender, InstancedChunk, InstancedMeshes, RwtFadeIn, RwtWind};
+use super::{
+    BendField, Bender, InstanceCulling, InstancedChunk, InstancedMeshes, RwtFadeIn, RwtWind,
+};
 use super::{bend, far, mesh, render};
 use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use bevy::core_pipeline::core_3d::Opaque3d;
@@ -29,12 +31,14 @@ impl Plugin for RwtInstancingPlugin {
         configure_sets(app, self.schedule);
         app.init_resource::<RwtWind>()
             .init_resource::<RwtFadeIn>()
+            .init_resource::<InstanceCulling>()
             .init_resource::<InstancedMeshes>()
             .init_resource::<BendField>()
             .register_type::<Bender>()
             .register_type::<BendField>()
             .register_type::<RwtWind>()
             .register_type::<RwtFadeIn>()
+            .register_type::<InstanceCulling>()
             .register_type::<InstancedChunk>()
             .add_systems(
                 self.schedule,
@@ -55,8 +59,18 @@ impl Plugin for RwtInstancingPlugin {
             ExtractComponentPlugin::<InstancedChunk>::default(),
             ExtractResourcePlugin::<RwtWind>::default(),
             ExtractResourcePlugin::<RwtFadeIn>::default(),
+            ExtractResourcePlugin::<InstanceCulling>::default(),
             ExtractResourcePlugin::<BendField>::default(),
         ));
+        #[cfg(feature = "testing")]
+        app.add_plugins(ExtractResourcePlugin::<super::CullingCheck>::default())
+            .sub_app_mut(RenderApp)
+            .add_systems(
+                Render,
+                render::check_culling
+                    .after(RenderSystems::Render)
+                    .before(RenderSystems::Cleanup),
+            );
         let render_app = app.sub_app_mut(RenderApp);
         render_app
             .add_render_command::<Opaque3d, render::DrawInstancedChunk>()
@@ -75,6 +89,7 @@ impl Plugin for RwtInstancingPlugin {
                     render::init_bindings,
                     render::init_main_pipeline.after(MeshPipelineSystems),
                     render::init_depth_pipeline.after(init_prepass_pipeline),
+                    render::init_culler,
                 )
                     .chain(),
             )
@@ -89,6 +104,7 @@ impl Plugin for RwtInstancingPlugin {
                         render::queue_shadows,
                     )
                         .in_set(RenderSystems::QueueMeshes),
+                    render::cull_instances.in_set(RenderSystems::PrepareBindGroups),
                 ),
             );
     }

@@ -30,6 +30,37 @@ impl InstancedShadows {
     }
 }
 
+/// Far thinning of an instanced class ([`InstancedShading::thinning`]): beyond `from`
+/// metres from the camera the class keeps the fraction `(from / distance)^2` of its
+/// instances, never less than `floor`: those of lowest rank, a blue-noise subset, the rest
+/// shrinking away over the fade band. Each kept instance is widened (across, not up) by
+/// the inverse of the fraction, so that the far field, seen from the side, covers as it did
+/// while its instances fall in number as the pixels they cover. With culling per instance
+/// ([`InstanceCulling`](crate::InstanceCulling)) the thinned instances cost nothing;
+/// drawn whole, they are shrunk to nothing in the vertex shader.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
+pub struct InstancedThinning {
+    /// Distance from the camera where thinning starts (metres).
+    pub from: f32,
+    /// Smallest fraction kept (0..=1), which bounds the widening (a floor of 0.25 widens by
+    /// up to 4).
+    pub floor: f32,
+}
+
+impl InstancedThinning {
+    /// Thinning from `from` metres, down to a quarter of the instances.
+    pub fn from(from: f32) -> Self {
+        Self { from, floor: 0.25 }
+    }
+
+    /// The fraction of instances kept `distance` metres from the camera.
+    pub fn kept_at(&self, distance: f32) -> f32 {
+        let ratio = self.from / distance.max(1e-3);
+        (ratio * ratio).clamp(self.floor.clamp(1e-3, 1.0), 1.0)
+    }
+}
+
 /// [`InstancedShading::alpha_cutoff`]'s default.
 pub const DEFAULT_ALPHA_CUTOFF: f32 = 0.5;
 
@@ -73,6 +104,8 @@ pub struct InstancedShading {
     /// fraction of the field's lean (1 lays a blade flat where the field says so); 0 for
     /// instances that do not bend (pebbles).
     pub bend_response: f32,
+    /// Far thinning (`None`: every instance drawn at every distance).
+    pub thinning: Option<InstancedThinning>,
 }
 
 impl Default for InstancedShading {
@@ -89,6 +122,7 @@ impl Default for InstancedShading {
             bend_response: 1.0,
             texture: None,
             alpha_cutoff: DEFAULT_ALPHA_CUTOFF,
+            thinning: None,
         }
     }
 }

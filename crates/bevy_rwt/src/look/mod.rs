@@ -13,6 +13,7 @@ pub use check::{InstancedClassError, check_instanced_mesh};
 pub(crate) use check::{check_texture, check_topology};
 pub use instanced::{
     DEFAULT_ALPHA_CUTOFF, InstancedFar, InstancedLook, InstancedShading, InstancedShadows,
+    InstancedThinning,
 };
 
 use bevy::camera::visibility::VisibilityRange;

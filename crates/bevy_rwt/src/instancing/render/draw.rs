@@ -1,8 +1,10 @@
-//! The draw of one chunk: its bind group, its mesh once per instance.
+//! The draw of one chunk: its bind group, its mesh once per instance: the instances culling
+//! kept for the view, drawn indirectly, or all of them.
 
-use super::{ExtractedChunk, GpuChunk};
+use super::{ExtractedChunk, GpuChunk, InstanceCuller};
 use bevy::ecs::system::{SystemParamItem, lifetimeless::*};
 use bevy::pbr::{SetMeshViewBindGroup, SetMeshViewBindingArrayBindGroup};
+use bevy::prelude::Entity;
 use bevy::render::mesh::allocator::MeshAllocator;
 use bevy::render::mesh::{RenderMesh, RenderMeshBufferInfo};
 use bevy::render::render_asset::RenderAssets;
@@ -42,22 +44,27 @@ impl<P: PhaseItem, const I: usize> RenderCommand<P> for SetChunkBindGroup<I> {
     }
 }
 
-/// Draws a chunk's mesh once per instance.
+/// Draws a chunk's mesh once per instance: those culling kept for the view, or all.
 pub(in crate::instancing) struct DrawChunkInstances;
 
 impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
-    type Param = (SRes<RenderAssets<RenderMesh>>, SRes<MeshAllocator>);
-    type ViewQuery = ();
+    type Param = (
+        SRes<RenderAssets<RenderMesh>>,
+        SRes<MeshAllocator>,
+        Option<SRes<InstanceCuller>>,
+    );
+    type ViewQuery = Entity;
     type ItemQuery = (Read<ExtractedChunk>, Read<GpuChunk>);
 
     fn render<'w>(
-        _: &P,
-        _: (),
+        item_of: &P,
+        view: Entity,
         item: Option<(&'w ExtractedChunk, &'w GpuChunk)>,
-        (meshes, allocator): SystemParamItem<'w, '_, Self::Param>,
+        (meshes, allocator, culler): SystemParamItem<'w, '_, Self::Param>,
         pass: &mut TrackedRenderPass<'w>,
     ) -> RenderCommandResult {
         let (meshes, allocator) = (meshes.into_inner(), allocator.into_inner());
+        let culled = culler.and_then(|c| c.into_inner().draw(view, item_of.entity()));
         let Some((chunk, gpu)) = item else {
             return RenderCommandResult::Skip;
         };
@@ -68,6 +75,20 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
             return RenderCommandResult::Skip;
         };
         pass.set_vertex_buffer(0, vertices.buffer.slice(..));
+        if let Some((draw, kept, args)) = culled {
+            pass.set_vertex_buffer(1, kept.slice(draw.kept.clone()));
+            match &mesh.buffer_info {
+                RenderMeshBufferInfo::Indexed { index_format, .. } => {
+                    let Some(indices) = allocator.mesh_index_slice(&chunk.mesh) else {
+                        return RenderCommandResult::Skip;
+                    };
+                    pass.set_index_buffer(indices.buffer.slice(..), *index_format);
+                    pass.draw_indexed_indirect(args, draw.args);
+                }
+                RenderMeshBufferInfo::NonIndexed => pass.draw_indirect(args, draw.args),
+            }
+            return RenderCommandResult::Success;
+        }
         pass.set_vertex_buffer(1, gpu.instances.slice(..));
         match &mesh.buffer_info {
             RenderMeshBufferInfo::Indexed {

@@ -33,6 +33,8 @@ struct Chunk {
     // Height fraction where the tip colour starts, bend response, alpha cut-off, 1 when
     // textured.
     shading: vec4<f32>,
+    // Far thinning: its distance, its floor, 1 when on.
+    thinning: vec4<f32>,
 };
 
 @group(2) @binding(0) var<uniform> chunk: Chunk;
@@ -109,19 +111,34 @@ fn value_noise(p: vec2<f32>) -> f32 {
 // values it has not seen, which with one draw per chunk and view is a compile per draw,
 // and memory that grows by megabytes a second.
 
+// Where the level of detail is measured from: the view's camera, or the main camera in
+// shadow passes.
+fn eye_xz() -> vec2<f32> {
+#ifdef RWT_SHADOW_PASS
+    return frame.viewer.xz;
+#else
+    return view.world_position.xz;
+#endif
+}
+
+// Far thinning at `root`: the fraction of instances kept there (1 without thinning).
+fn kept_fraction(root: vec3<f32>) -> f32 {
+    let ratio = chunk.thinning.x / max(length(root.xz - eye_xz()), 1e-3);
+    let kept = clamp(ratio * ratio, chunk.thinning.y, 1.0);
+    return select(1.0, kept, chunk.thinning.z != 0.0);
+}
+
 // Growth of an instance: 0 until the level-of-detail factor at its place reaches the one at
 // which its point appears, then up to 1 over the fade band (always 1 without fall-off).
-fn growth(root: vec3<f32>, appear: f32) -> f32 {
-#ifdef RWT_SHADOW_PASS
-    let eye = frame.viewer.xz;
-#else
-    let eye = view.world_position.xz;
-#endif
-    let distance = length(root.xz - eye);
+// The far thinning keeps the instances of rank below its fraction the same way (all of
+// them at a fraction of 1).
+fn growth(root: vec3<f32>, appear: f32, kept: f32) -> f32 {
+    let distance = length(root.xz - eye_xz());
     let span = max(chunk.falloff.y - chunk.falloff.x, 1e-3);
     let factor = max(chunk.falloff.w, clamp(1.0 - (distance - chunk.falloff.x) / span, 0.0, 1.0));
     let grown = clamp((factor - appear) / chunk.params.w, 0.0, 1.0);
-    return select(grown, 1.0, chunk.falloff.z == 0.0);
+    let thinned = clamp((kept * (1.0 + chunk.params.w) - appear) / chunk.params.w, 0.0, 1.0);
+    return select(grown, 1.0, chunk.falloff.z == 0.0) * thinned;
 }
 
 // Sideways displacement of a point at height fraction `t` (0 root, 1 tip) of an instance
@@ -192,10 +209,14 @@ fn place(in: Vertex, time: f32) -> Placed {
     let root = chunk.origin.xyz + in.offset_scale.xyz;
     let yaw = in.yaw_appear_tint.x * 6.2831853;
     let tint = in.yaw_appear_tint.z;
-    let scale = in.offset_scale.w * growth(root, in.yaw_appear_tint.y);
+    let kept = kept_fraction(root);
+    let scale = in.offset_scale.w * growth(root, in.yaw_appear_tint.y, kept);
     let c = cos(yaw);
     let s = sin(yaw);
-    let local = in.position * scale;
+    // A thinned field's instances are widened to cover as the whole field did (seen from
+    // the side, an instance's cover grows with its width).
+    let widen = 1.0 / kept;
+    let local = in.position * scale * vec3<f32>(widen, 1.0, widen);
     var turned = vec3<f32>(c * local.x + s * local.z, local.y, -s * local.x + c * local.z);
 #ifdef RWT_NORMALS
     let n = in.normal;

@@ -9,6 +9,9 @@
 //! bounds per view. The phases are binned and retained; [`retained`] keeps our items in
 //! them true frame by frame.
 
+mod cull;
+#[cfg(feature = "testing")]
+mod cull_check;
 mod depth;
 mod draw;
 mod main_pass;
@@ -16,6 +19,11 @@ mod retained;
 #[cfg(test)]
 mod shader_check;
 
+pub(super) use cull::{InstanceCuller, cull_instances, init_culler};
+#[cfg(feature = "testing")]
+pub(super) use cull_check::check_culling;
+#[cfg(feature = "testing")]
+pub use cull_check::{CullingCheck, CullingReport};
 pub(super) use depth::{
     DrawInstancedDepth, InstancedDepthPipeline, init_depth_pipeline, queue_prepass, queue_shadows,
 };
@@ -25,7 +33,7 @@ use retained::BinnedChunk;
 pub(super) use retained::Queued;
 
 use super::bend::{BEND_FIELD_TEXELS, BendField};
-use super::{GpuInstance, InstanceBuffer, InstancedChunk, RwtFadeIn, RwtWind};
+use super::{GpuInstance, InstanceBuffer, InstanceCulling, InstancedChunk, RwtFadeIn, RwtWind};
 use crate::look::{InstancedShadows, check_texture, check_topology};
 use bevy::camera::primitives::Aabb;
 use bevy::ecs::query::QueryItem;
@@ -55,6 +63,7 @@ const INSTANCE_LOCATIONS: [u32; 2] = [8, 9];
 /// Adds the instanced shader to the app's embedded assets.
 pub(super) fn embed_shader(app: &mut App) {
     bevy::asset::embedded_asset!(app, "instanced.wgsl");
+    bevy::asset::embedded_asset!(app, "cull.wgsl");
 }
 
 /// The per-chunk uniform, as the shader reads it.
@@ -76,6 +85,8 @@ struct ChunkUniform {
     /// Height fraction where the tip colour starts, bend response, alpha cut-off, 1 when
     /// textured.
     shading: [f32; 4],
+    /// Far thinning: its distance, its floor, 1 when on.
+    thinning: [f32; 4],
 }
 
 /// The per-frame uniform every chunk shares: where the main camera is (shadow passes grow
@@ -97,6 +108,9 @@ pub struct ExtractedChunk {
     uniform: ChunkUniform,
     /// World-space bounds of the drawn instances, for culling shadow views.
     bounds: Aabb,
+    /// Distance from an instance's root (at scale 1) that its mesh reaches, turned, tilted
+    /// or swaying any way: the radius culling per instance tests.
+    reach: f32,
     shadows: InstancedShadows,
     /// The base-colour texture, if the class has one.
     texture: Option<AssetId<Image>>,
@@ -151,6 +165,7 @@ impl ExtractComponent for InstancedChunk {
             Aabb::from_min_max(lo, hi)
         });
         Some(ExtractedChunk {
+            reach: reach(&local, chunk.buffer.bounds, chunk.max_scale, aabb.is_some()),
             buffer: chunk.buffer.clone(),
             mesh: chunk.mesh.id(),
             uniform: ChunkUniform {
@@ -170,6 +185,9 @@ impl ExtractComponent for InstancedChunk {
                     m.alpha_cutoff,
                     if m.texture.is_some() { 1.0 } else { 0.0 },
                 ],
+                thinning: m.thinning.map_or([0.0; 4], |t| {
+                    [t.from.max(0.0), t.floor.clamp(1e-3, 1.0), 1.0, 0.0]
+                }),
                 ..default()
             },
             bounds: Aabb {
@@ -180,6 +198,22 @@ impl ExtractComponent for InstancedChunk {
             texture: m.texture.as_ref().map(Handle::id),
         })
     }
+}
+
+/// The radius around an instance's root (at scale 1) that holds its mesh however it turns
+/// and sways: from the chunk's bounds `local` around its instances' roots `roots` at the
+/// class's largest scale (infinite when the chunk has no bounds).
+fn reach(local: &Aabb, roots: (Vec3, Vec3), max_scale: f32, bounded: bool) -> f32 {
+    if !bounded || max_scale <= 0.0 {
+        return f32::MAX;
+    }
+    let (min, max) = (Vec3::from(local.min()), Vec3::from(local.max()));
+    let (lo, hi) = roots;
+    let below = (lo - min).max(Vec3::ZERO);
+    let above = (max - hi).max(Vec3::ZERO);
+    let across = below.x.max(below.z).max(above.x).max(above.z);
+    let up = below.y.max(above.y);
+    (2.0 * across * across + up * up).sqrt() / max_scale
 }
 
 impl ExtractResource for RwtWind {
@@ -200,6 +234,14 @@ impl ExtractResource for BendField {
 
 impl ExtractResource for RwtFadeIn {
     type Source = RwtFadeIn;
+
+    fn extract_resource(source: &Self::Source) -> Self {
+        *source
+    }
+}
+
+impl ExtractResource for InstanceCulling {
+    type Source = InstanceCulling;
 
     fn extract_resource(source: &Self::Source) -> Self {
         *source
@@ -465,7 +507,8 @@ fn upload(
     let instances = device.create_buffer_with_data(&BufferInitDescriptor {
         label: Some("rwt_instances"),
         contents: bytemuck::cast_slice(&chunk.buffer.instances),
-        usage: BufferUsages::VERTEX,
+        // Read as a storage buffer by culling per instance.
+        usage: BufferUsages::VERTEX | BufferUsages::STORAGE,
     });
     let uniform_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
         label: Some("rwt_instanced_chunk"),

@@ -66,6 +66,11 @@ impl<P: BinnedPhaseItem> Queued<P> {
         self.seen.push(view);
     }
 
+    /// The chunks binned into each view (by main entity).
+    pub fn binned(&self) -> impl Iterator<Item = (&RetainedViewEntity, &MainEntityHashSet)> {
+        self.views.iter()
+    }
+
     /// Forgets the views not binned this frame (their phases are gone with them).
     pub fn end_frame(&mut self) {
         let seen = std::mem::take(&mut self.seen);

@@ -74,10 +74,10 @@ fn modules(dir: &Path, found: &mut Vec<(String, String)>) {
     }
 }
 
-/// A shader cache holding Bevy's library, set up as Bevy's plugins set it up; its modules
-/// are the `Debug` text of the composed naga module's types.
-fn cache_with_library() -> ShaderCache<String, ()> {
-    let mut cache = ShaderCache::new(
+/// A shader cache that validates what it composes (in test builds) and whose modules are
+/// the `Debug` text of the composed naga module's types.
+pub(super) fn bare_cache() -> ShaderCache<String, ()> {
+    ShaderCache::new(
         (),
         WgpuFeatures::all(),
         DownlevelFlags::all(),
@@ -85,7 +85,12 @@ fn cache_with_library() -> ShaderCache<String, ()> {
             ShaderCacheSource::Naga(module) => Ok(format!("{:?}", module.types)),
             _ => Ok(String::new()),
         },
-    );
+    )
+}
+
+/// A [`bare_cache`] holding Bevy's library, set up as Bevy's plugins set it up.
+fn cache_with_library() -> ShaderCache<String, ()> {
+    let mut cache = bare_cache();
     let mut found = Vec::new();
     for dir in library_sources() {
         modules(&dir, &mut found);
@@ -146,7 +151,7 @@ fn permutations() -> Vec<Vec<ShaderDefVal>> {
 }
 
 /// The members (name, offset) and size of struct `name` in a module's types' `Debug` text.
-fn struct_layout(types: &str, name: &str) -> (Vec<(String, usize)>, usize) {
+pub(super) fn struct_layout(types: &str, name: &str) -> (Vec<(String, usize)>, usize) {
     let start = types
         .find(&format!("name: Some(\"{name}\"), inner: Struct"))
         .unwrap_or_else(|| panic!("no struct {name}"));
@@ -201,6 +206,7 @@ fn every_permutation_composes_and_validates_with_the_uniform_layouts() {
         ("wind", offset_of!(ChunkUniform, wind)),
         ("wind_motion", offset_of!(ChunkUniform, wind_motion)),
         ("shading", offset_of!(ChunkUniform, shading)),
+        ("thinning", offset_of!(ChunkUniform, thinning)),
     ];
     let frame = [
         ("viewer", offset_of!(FrameUniform, viewer)),

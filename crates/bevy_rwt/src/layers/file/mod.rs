@@ -100,7 +100,9 @@ use super::{
     LayerRef, Promotion, ScatterClass, ScatterLayer,
 };
 use crate::ground::SurfacePolicy;
-use crate::look::{GroundPlane, InstancedShading, InstancedShadows, MeshLod, Stance, blade_mesh};
+use crate::look::{
+    GroundPlane, InstancedShading, InstancedShadows, InstancedThinning, MeshLod, Stance, blade_mesh,
+};
 use bevy::prelude::*;
 use rwt_core::Lattice;
 use rwt_core::clumps::{ClumpParams, Clumps};
@@ -272,6 +274,8 @@ pub struct InstancedShadingDescription {
     pub texture: Option<String>,
     /// See [`InstancedShading::alpha_cutoff`].
     pub alpha_cutoff: f32,
+    /// See [`InstancedShading::thinning`]: `Some((from: 20.0, floor: 0.1))`.
+    pub thinning: Option<InstancedThinning>,
 }
 
 impl Default for InstancedShadingDescription {
@@ -299,6 +303,7 @@ impl From<&InstancedShading> for InstancedShadingDescription {
             // The texture's path is the describer's to give (it knows where images are).
             texture: None,
             alpha_cutoff: m.alpha_cutoff,
+            thinning: m.thinning,
         }
     }
 }
@@ -319,6 +324,7 @@ impl InstancedShadingDescription {
             bend_response: self.bend_response,
             texture: self.texture.as_deref().map(image),
             alpha_cutoff: self.alpha_cutoff,
+            thinning: self.thinning,
         }
     }
 }

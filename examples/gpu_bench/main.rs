@@ -1,0 +1,471 @@
+//! The GPU benchmark: open_world-like grass rendered headless, no window and no display.
+//!
+//! `scripts/gpu_bench.sh` runs it (built on any machine, run on one with a GPU), or
+//! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
+//! [--thin 25] [--shots DIR] [--detail]`; `--shots` saves one frame of each case there as
+//! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
+//! ([`detail`]).
+//!
+//! The scene is [`grass_field`]'s: instanced blades streamed around a camera 2 m above a
+//! field, under a sun with cascaded shadow maps, drawn into an image; the grass thins out
+//! from `--thin` metres (25 by default, as a game sets it; 0: never), see
+//! [`InstancedThinning`]. For each blade count
+//! (millions of live blades) with the grass's shadows off, then on, each with culling per
+//! instance on the GPU off, then on ([`InstanceCulling`]), it waits for streaming to settle,
+//! warms up for 2 s, times `--frames` frames and prints exactly one line:
+//!
+//! `gpu-bench: blades=B shadows=S cull=C fps_median=F frame_ms_p95=P adapter=NAME`
+//!
+//! `B` is the live count measured (a first pass measures the streamed area, so the densities
+//! meet the counts asked for). A frame is the time from one main-world frame to the next, with
+//! Bevy's pipelined rendering on as in a game, and the render world waits for the GPU to finish
+//! each frame: the time is that of the slower of the main world and render world plus GPU.
+//! `cull=off` culls whole chunks on the CPU and draws every blade of those kept; `cull=on`
+//! also culls each blade on the GPU and draws indirectly.
+
+use bevy::app::ScheduleRunnerPlugin;
+use bevy::camera::RenderTarget;
+use bevy::diagnostic::DiagnosticsStore;
+use bevy::log::{Level, LogPlugin};
+use bevy::prelude::*;
+use bevy::render::render_resource::{PollType, TextureFormat};
+use bevy::render::renderer::{RenderAdapterInfo, RenderDevice};
+use bevy::render::view::screenshot::{Screenshot, save_to_disk};
+use bevy::render::{Render, RenderApp, RenderSystems};
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+use bevy_rwt::prelude::*;
+use rwt_examples::grass_field::{self, field_layer, set_instanced_shadows};
+use std::time::{Duration, Instant};
+
+mod detail;
+
+/// Distance from which the grass thins out by default ([`InstancedThinning`]), metres.
+const THIN_FROM: f32 = 25.0;
+/// Density of the pass that measures the streamed area, blades a square metre.
+const CALIBRATION_DENSITY: f64 = 1.0;
+/// Frames with an unchanged live count and nothing in flight before streaming counts as
+/// settled.
+const SETTLED_FRAMES: u32 = 10;
+/// Warm-up before timing (pipelines compile in the background).
+const WARM_UP: Duration = Duration::from_secs(2);
+/// Longest a case is timed, whatever `--frames` asks.
+const LONGEST_TIMING: Duration = Duration::from_secs(15);
+/// Longest streaming may take to settle before the bench gives up.
+const LONGEST_STREAMING: Duration = Duration::from_secs(180);
+
+fn main() {
+    let options = match Options::parse(std::env::args().skip(1)) {
+        Ok(options) => options,
+        Err(message) => {
+            eprintln!("gpu_bench: {message}");
+            eprintln!(
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] (M: millions)"
+            );
+            std::process::exit(2);
+        }
+    };
+    if let Some(dir) = &options.shots
+        && let Err(error) = std::fs::create_dir_all(dir)
+    {
+        eprintln!("gpu_bench: cannot make {}: {error}", dir.display());
+        std::process::exit(1);
+    }
+    let detailed = options.detail;
+    let mut app = App::new();
+    app.add_plugins((
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .set(LogPlugin {
+                level: Level::WARN,
+                ..default()
+            })
+            .disable::<WinitPlugin>(),
+        ScheduleRunnerPlugin::run_loop(Duration::ZERO),
+        RwtPlugins::default()
+            .with_upload_budget(4_000_000)
+            .with_despawn_budget(1_000_000)
+            .with_max_tasks(32),
+    ))
+    .insert_resource(Bench::new(options))
+    .insert_resource(InstanceCulling::PerChunk)
+    .add_systems(Startup, setup)
+    .add_systems(First, tick)
+    .add_systems(Last, step);
+    app.sub_app_mut(RenderApp).add_systems(
+        Render,
+        wait_for_gpu.in_set(GpuWait).after(RenderSystems::Render),
+    );
+    if detailed {
+        detail::add(&mut app, GpuWait);
+    }
+    app.run();
+}
+
+/// What the command line asks.
+struct Options {
+    /// Live blades of each case, millions.
+    blades: Vec<f64>,
+    /// Frames timed per case.
+    frames: usize,
+    /// The image's size, pixels.
+    size: UVec2,
+    /// Where to save a frame of each case.
+    shots: Option<std::path::PathBuf>,
+    /// Whether to print where each case's frame time goes.
+    detail: bool,
+    /// Distance from which the grass thins out (metres; 0: it does not).
+    thin: f32,
+}
+
+impl Options {
+    fn parse(mut args: impl Iterator<Item = String>) -> Result<Self, String> {
+        let mut options = Options {
+            blades: vec![1.0, 5.0, 10.0],
+            frames: 240,
+            size: UVec2::new(1920, 1080),
+            shots: None,
+            detail: false,
+            thin: THIN_FROM,
+        };
+        while let Some(flag) = args.next() {
+            if flag == "--detail" {
+                options.detail = true;
+                continue;
+            }
+            let value = args.next().ok_or(format!("{flag} needs a value"))?;
+            let bad = || format!("{flag} {value:?} is not valid");
+            match flag.as_str() {
+                "--blades" => {
+                    options.blades = value
+                        .split(',')
+                        .map(|m| {
+                            m.trim()
+                                .parse::<f64>()
+                                .ok()
+                                .filter(|m| *m > 0.0 && *m <= 100.0)
+                        })
+                        .collect::<Option<_>>()
+                        .ok_or_else(bad)?;
+                }
+                "--frames" => {
+                    options.frames = value
+                        .parse()
+                        .ok()
+                        .filter(|n| (10..=10_000).contains(n))
+                        .ok_or_else(bad)?;
+                }
+                "--size" => {
+                    let (w, h) = value.split_once('x').ok_or_else(bad)?;
+                    let side = |v: &str| v.parse::<u32>().ok().filter(|v| (64..=8192).contains(v));
+                    options.size = UVec2::new(side(w).ok_or_else(bad)?, side(h).ok_or_else(bad)?);
+                }
+                "--shots" => options.shots = Some(value.into()),
+                "--thin" => {
+                    options.thin = value
+                        .parse()
+                        .ok()
+                        .filter(|m: &f32| (0.0..=1e4).contains(m))
+                        .ok_or_else(bad)?;
+                }
+                _ => return Err(format!("unknown option {flag:?}")),
+            }
+        }
+        Ok(options)
+    }
+}
+
+/// One timed case.
+#[derive(Clone, Copy, PartialEq)]
+struct Case {
+    /// Live blades asked for.
+    blades: f64,
+    shadows: bool,
+    /// Culling per instance on the GPU.
+    cull: bool,
+}
+
+/// The image the camera draws into.
+#[derive(Resource)]
+struct Target(Handle<Image>);
+
+/// Where the bench stands.
+enum Phase {
+    /// Waiting for the layer to stream in.
+    Streaming {
+        since: Instant,
+        stable: u32,
+        live: usize,
+    },
+    /// Warming up; a frame is saved half-way (with `--shots`).
+    WarmingUp {
+        since: Instant,
+        shot: bool,
+    },
+    Timing {
+        since: Instant,
+    },
+}
+
+#[derive(Resource)]
+struct Bench {
+    options: Options,
+    cases: Vec<Case>,
+    /// The case streaming, warming up or timed; `None` while the area is measured.
+    case: Option<usize>,
+    /// Streamed area, square metres, once measured.
+    area: Option<f64>,
+    phase: Phase,
+    /// Start of the last main-world frame.
+    last_frame: Option<Instant>,
+    /// Times of the frames timed so far in this case, ms.
+    frame_ms: Vec<f64>,
+}
+
+impl Bench {
+    fn new(options: Options) -> Self {
+        let cases = options
+            .blades
+            .iter()
+            .flat_map(|&m| {
+                [(false, false), (false, true), (true, false), (true, true)].map(
+                    |(shadows, cull)| Case {
+                        blades: m * 1e6,
+                        shadows,
+                        cull,
+                    },
+                )
+            })
+            .collect();
+        Self {
+            options,
+            cases,
+            case: None,
+            area: None,
+            phase: Phase::Streaming {
+                since: Instant::now(),
+                stable: 0,
+                live: 0,
+            },
+            last_frame: None,
+            frame_ms: Vec::new(),
+        }
+    }
+
+    /// The layer's density and shadows now: the calibration pass's, or the case's.
+    fn density_and_shadows(&self) -> (f64, InstancedShadows) {
+        match (self.case, self.area) {
+            (Some(i), Some(area)) => {
+                let case = self.cases[i];
+                let shadows = if case.shadows {
+                    InstancedShadows::On
+                } else {
+                    InstancedShadows::Off
+                };
+                (case.blades / area, shadows)
+            }
+            _ => (CALIBRATION_DENSITY, InstancedShadows::Off),
+        }
+    }
+}
+
+fn setup(
+    mut commands: Commands,
+    bench: Res<Bench>,
+    mut images: ResMut<Assets<Image>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let size = bench.options.size;
+    let target = Image::new_target_texture(size.x, size.y, TextureFormat::Rgba8UnormSrgb, None);
+    let target = images.add(target);
+    commands.insert_resource(Target(target.clone()));
+    commands.spawn((
+        Camera3d::default(),
+        RenderTarget::Image(target.into()),
+        RwtViewer::all_around(),
+        grass_field::camera_transform(),
+    ));
+    grass_field::spawn_sun_and_ground(&mut commands, &mut meshes, &mut materials);
+    let (density, shadows) = bench.density_and_shadows();
+    let material = InstancedShading {
+        shadows,
+        thinning: (bench.options.thin > 0.0).then(|| InstancedThinning::from(bench.options.thin)),
+        ..default()
+    };
+    let blade = meshes.add(grass_field::blade());
+    let grass = ScatterClass::instanced(LayerDensity::Constant(density), blade, material);
+    commands.spawn(field_layer(grass));
+}
+
+/// Times the frame that just ended, while a case is timed.
+fn tick(mut bench: ResMut<Bench>) {
+    let now = Instant::now();
+    if let (Phase::Timing { .. }, Some(last)) = (&bench.phase, bench.last_frame) {
+        bench.frame_ms.push((now - last).as_secs_f64() * 1e3);
+    }
+    bench.last_frame = Some(now);
+}
+
+/// Moves the bench on: streaming settles, the frame warms up, a case is timed and printed,
+/// the next case streams in; after the last, the app exits.
+fn step(
+    mut bench: ResMut<Bench>,
+    stats: Res<RwtStats>,
+    mut layers: Query<&mut ScatterLayer>,
+    mut culling: ResMut<InstanceCulling>,
+    report: Report,
+    mut commands: Commands,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let now = Instant::now();
+    let frames = bench.options.frames;
+    match bench.phase {
+        Phase::Streaming {
+            since,
+            stable,
+            live,
+        } => {
+            let settled_now = stats.pending_tasks == 0
+                && stats.queued_spawns == 0
+                && stats.live_instanced > 0
+                && stats.live_instanced == live;
+            let stable = if settled_now { stable + 1 } else { 0 };
+            bench.phase = Phase::Streaming {
+                since,
+                stable,
+                live: stats.live_instanced,
+            };
+            if stable >= SETTLED_FRAMES {
+                settled(&mut bench, stats.live_instanced, &mut layers);
+            } else if since.elapsed() > LONGEST_STREAMING {
+                eprintln!("gpu_bench: streaming did not settle in {LONGEST_STREAMING:?}");
+                exit.write(AppExit::error());
+            }
+        }
+        Phase::WarmingUp { since, .. } if since.elapsed() >= WARM_UP => {
+            bench.frame_ms.clear();
+            bench.phase = Phase::Timing { since: now };
+        }
+        Phase::WarmingUp { since, shot: false } if since.elapsed() >= WARM_UP / 2 => {
+            bench.phase = Phase::WarmingUp { since, shot: true };
+            if let (Some(dir), Some(case)) = (&bench.options.shots, bench.case) {
+                let case = bench.cases[case];
+                let on_off = |on| if on { "on" } else { "off" };
+                let name = format!(
+                    "blades-{}-shadows-{}-cull-{}.png",
+                    case.blades / 1e6,
+                    on_off(case.shadows),
+                    on_off(case.cull)
+                );
+                commands
+                    .spawn(Screenshot::image(report.target.0.clone()))
+                    .observe(save_to_disk(dir.join(name)));
+            }
+        }
+        Phase::Timing { since }
+            if bench.frame_ms.len() >= frames
+                || (since.elapsed() >= LONGEST_TIMING && bench.frame_ms.len() >= 10) =>
+        {
+            print_case(&bench, stats.live_instanced, &report);
+            let (this, next) = bench.case.map_or((0, 0), |i| (i, i + 1));
+            let Some(&case) = bench.cases.get(next) else {
+                exit.write(AppExit::Success);
+                return;
+            };
+            let same_field = |a: Case, b: Case| a.blades == b.blades && a.shadows == b.shadows;
+            bench.case = Some(next);
+            *culling = if case.cull {
+                InstanceCulling::PerInstance
+            } else {
+                InstanceCulling::PerChunk
+            };
+            if same_field(bench.cases[this], case) {
+                bench.phase = Phase::WarmingUp {
+                    since: now,
+                    shot: false,
+                };
+            } else {
+                restream(&mut bench, &mut layers);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Streaming has settled with `live` blades: measure the area (the first time), or warm up.
+fn settled(bench: &mut Bench, live: usize, layers: &mut Query<&mut ScatterLayer>) {
+    if bench.area.is_none() {
+        bench.area = Some(live as f64 / CALIBRATION_DENSITY);
+        bench.case = Some(0);
+        restream(bench, layers);
+    } else {
+        bench.phase = Phase::WarmingUp {
+            since: Instant::now(),
+            shot: false,
+        };
+    }
+}
+
+/// Gives the layer the density and shadows of the bench's case (it streams anew).
+fn restream(bench: &mut Bench, layers: &mut Query<&mut ScatterLayer>) {
+    let (density, shadows) = bench.density_and_shadows();
+    for mut layer in layers {
+        set_instanced_shadows(&mut layer, shadows);
+        for class in &mut layer.classes {
+            class.density = LayerDensity::Constant(density);
+        }
+    }
+    bench.phase = Phase::Streaming {
+        since: Instant::now(),
+        stable: 0,
+        live: 0,
+    };
+}
+
+/// What the case lines read beside the bench: the adapter, the image (for `--shots`) and,
+/// with `--detail`, the frame's split and the render diagnostics.
+#[derive(bevy::ecs::system::SystemParam)]
+struct Report<'w> {
+    adapter: Res<'w, RenderAdapterInfo>,
+    target: Res<'w, Target>,
+    split: Option<Res<'w, detail::Split>>,
+    store: Option<Res<'w, DiagnosticsStore>>,
+}
+
+fn print_case(bench: &Bench, live: usize, report: &Report) {
+    let Some(case) = bench.case.map(|i| bench.cases[i]) else {
+        return;
+    };
+    let mut ms = bench.frame_ms.clone();
+    ms.sort_by(f64::total_cmp);
+    let median = ms[ms.len() / 2];
+    let p95 = ms[(ms.len() * 95 / 100).min(ms.len() - 1)];
+    let on_off = |on| if on { "on" } else { "off" };
+    let (shadows, cull) = (on_off(case.shadows), on_off(case.cull));
+    println!(
+        "gpu-bench: blades={live} shadows={shadows} cull={cull} fps_median={:.1} frame_ms_p95={p95:.2} adapter={}",
+        1e3 / median,
+        report.adapter.name
+    );
+    if let (Some(split), Some(store)) = (&report.split, &report.store) {
+        let case = format!("blades={live} shadows={shadows} cull={cull}");
+        println!("{}", detail::line(&case, ms.len(), split, store));
+    }
+}
+
+/// The render world's wait for the GPU.
+#[derive(SystemSet, Clone, Debug, PartialEq, Eq, Hash)]
+struct GpuWait;
+
+/// Waits for the GPU to finish the frame just submitted, so that a frame's time includes its
+/// drawing (without a window nothing else paces the frames).
+fn wait_for_gpu(device: Res<RenderDevice>) {
+    if let Err(error) = device.poll(PollType::wait_indefinitely()) {
+        error!("gpu_bench: waiting for the GPU failed: {error}");
+    }
+}

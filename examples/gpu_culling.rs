@@ -1,0 +1,227 @@
+//! Culling per instance on the GPU, checked in a real renderer (`scripts/smoke.sh` runs it
+//! under Xvfb and lavapipe): `cargo run --example gpu_culling`.
+//!
+//! A field of grass that thins out with distance ([`InstancedThinning`]), no wind (so that
+//! two frames can match), a sun with shadows, and a camera at the field's edge looking
+//! across it, so that many chunks are cut by the view's sides. Two screenshots: chunks
+//! drawn whole ([`InstanceCulling::PerChunk`]), then culled per instance
+//! ([`InstanceCulling::PerInstance`]), whose frame is also checked by
+//! [`CullingCheck`]: every culled draw's instance count, read back from its indirect
+//! arguments, must equal the count of the same test run on the CPU over every instance.
+//!
+//! It prints `rwt-culling: draws D instances N kept G (gpu) C (cpu) mismatched M, pixel
+//! difference P` and exits with an error unless the counts agree, culling kept fewer
+//! instances than it was given, and the frames differ by less than [`MOST_DIFFERENCE`] in
+//! the mean (0..255 a channel). Screenshots go to `RWT_CULLING_DIR` (default
+//! `target/culling`).
+
+use bevy::app::AppExit;
+use bevy::light::CascadeShadowConfigBuilder;
+use bevy::prelude::*;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy_rwt::prelude::*;
+use bevy_rwt::testing::{CullingCheck, CullingReport};
+use rwt_examples::grass_field;
+use rwt_examples::prelude::*;
+use std::path::PathBuf;
+
+/// Most mean difference between the two frames (0..255 a channel).
+const MOST_DIFFERENCE: f64 = 1.0;
+/// Frames each step waits once streaming has settled (pipelines compile on the CPU).
+const WAIT: u32 = 12;
+/// Most frames the check may take.
+const PATIENCE: u32 = 600;
+
+fn main() -> AppExit {
+    App::new()
+        .add_plugins(example_plugins("rwt gpu_culling"))
+        .add_plugins(RwtPlugins::default())
+        .insert_resource(RwtWind {
+            strength: 0.0,
+            ..default()
+        })
+        .insert_resource(InstanceCulling::PerChunk)
+        .init_resource::<CullingCheck>()
+        .init_resource::<Check>()
+        .add_systems(Startup, setup)
+        .add_systems(Update, run_check)
+        .run()
+}
+
+fn setup(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(120.0, 120.0))),
+        MeshMaterial3d(materials.add(Color::srgb(0.2, 0.3, 0.1))),
+    ));
+    commands.spawn((
+        Camera3d::default(),
+        RwtViewer::all_around(),
+        Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            shadow_maps_enabled: true,
+            ..default()
+        },
+        Transform::from_xyz(1.0, 2.0, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
+        // One cascade: a software driver draws every cascade on the CPU.
+        CascadeShadowConfigBuilder {
+            num_cascades: 1,
+            maximum_distance: 60.0,
+            ..default()
+        }
+        .build(),
+    ));
+    let material = InstancedShading {
+        thinning: Some(InstancedThinning::from(10.0)),
+        ..default()
+    };
+    let blade = meshes.add(grass_field::blade());
+    let grass = ScatterClass::instanced(LayerDensity::Constant(12.0), blade, material);
+    commands.spawn(
+        ScatterLayer::new(vec![grass])
+            .with_tile_size(2.0)
+            .with_streaming(StreamingConfig {
+                chunk_size: 8.0,
+                load_distance: 40.0,
+                unload_distance: 48.0,
+                near_distance: 40.0,
+            }),
+    );
+}
+
+/// The check's progress: frames since streaming settled, the frames captured, the report.
+#[derive(Resource, Default)]
+struct Check {
+    settled_at: Option<u32>,
+    frame: u32,
+    whole: Option<image::RgbImage>,
+    culled: Option<image::RgbImage>,
+    pending: bool,
+    report: Option<CullingReport>,
+}
+
+fn run_check(
+    mut check: ResMut<Check>,
+    stats: Res<RwtStats>,
+    mut culling: ResMut<InstanceCulling>,
+    culling_check: Res<CullingCheck>,
+    mut commands: Commands,
+    mut exit: MessageWriter<AppExit>,
+) {
+    check.frame += 1;
+    if check.frame > PATIENCE {
+        eprintln!("rwt-culling: FAIL no result in {PATIENCE} frames");
+        exit.write(AppExit::error());
+        return;
+    }
+    let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && stats.live_instanced > 0;
+    let Some(since) = check.settled_at else {
+        if settled {
+            check.settled_at = Some(check.frame);
+        }
+        return;
+    };
+    if check.report.is_none() {
+        check.report = culling_check.report();
+    }
+    if check.pending || check.frame < since + WAIT {
+        return;
+    }
+    match (&check.whole, &check.culled) {
+        (None, _) => capture(&mut check, &mut commands, false),
+        (Some(_), None) if *culling == InstanceCulling::PerChunk => {
+            *culling = InstanceCulling::PerInstance;
+            culling_check.request();
+            check.settled_at = Some(check.frame);
+        }
+        (Some(_), None) => capture(&mut check, &mut commands, true),
+        (Some(whole), Some(culled)) => {
+            let Some(report) = check.report else { return };
+            let passed = conclude(&report, whole, culled);
+            exit.write(if passed {
+                AppExit::Success
+            } else {
+                AppExit::error()
+            });
+        }
+    }
+}
+
+/// Takes a screenshot into the check's whole or culled frame, and saves it.
+fn capture(check: &mut Check, commands: &mut Commands, culled: bool) {
+    check.pending = true;
+    commands.spawn(Screenshot::primary_window()).observe(
+        move |captured: On<ScreenshotCaptured>, mut check: ResMut<Check>| {
+            check.pending = false;
+            let Ok(image) = captured.image.clone().try_into_dynamic() else {
+                return;
+            };
+            let rgb = image.to_rgb8();
+            let name = if culled { "culled.png" } else { "whole.png" };
+            let dir = std::env::var_os("RWT_CULLING_DIR")
+                .map(PathBuf::from)
+                .unwrap_or_else(|| PathBuf::from("target/culling"));
+            if std::fs::create_dir_all(&dir).is_ok()
+                && let Err(error) = rgb.save(dir.join(name))
+            {
+                eprintln!("rwt-culling: cannot save {name}: {error}");
+            }
+            if culled {
+                check.culled = Some(rgb);
+            } else {
+                check.whole = Some(rgb);
+            }
+        },
+    );
+}
+
+/// Prints the result line; whether every check passed.
+fn conclude(report: &CullingReport, whole: &image::RgbImage, culled: &image::RgbImage) -> bool {
+    let difference = mean_difference(whole, culled);
+    println!(
+        "rwt-culling: draws {} instances {} kept {} (gpu) {} (cpu) mismatched {}, pixel difference {difference:.3}",
+        report.draws, report.instances, report.gpu_kept, report.cpu_kept, report.mismatched
+    );
+    let failures = [
+        (report.draws == 0, "no culled draw"),
+        (
+            report.mismatched > 0 || report.gpu_kept != report.cpu_kept,
+            "the GPU's counts differ from the CPU's",
+        ),
+        (
+            report.gpu_kept >= report.instances,
+            "culling kept every instance",
+        ),
+        (
+            difference >= MOST_DIFFERENCE,
+            "the culled frame differs from the whole one",
+        ),
+    ];
+    let mut passed = true;
+    for (failed, what) in failures {
+        if failed {
+            println!("rwt-culling: FAIL {what}");
+            passed = false;
+        }
+    }
+    passed
+}
+
+/// Mean absolute difference of two images' channels (255 when their sizes differ).
+fn mean_difference(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
+    if a.dimensions() != b.dimensions() {
+        return 255.0;
+    }
+    let total: u64 = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| u64::from(x.abs_diff(*y)))
+        .sum();
+    total as f64 / a.as_raw().len().max(1) as f64
+}
