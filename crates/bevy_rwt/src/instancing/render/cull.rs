@@ -316,6 +316,10 @@ pub(in crate::instancing) fn cull_instances(
         culler
             .checked
             .push((uniform(d, &o), d.extracted.buffer.clone()));
+        if !culler.chunks.contains_key(&d.chunk) {
+            // Not dispatched (no bind group): its arguments count nothing; drawn whole.
+            continue;
+        }
         let kept = o.kept..o.kept + u64::from(d.gpu.count) * INSTANCE_BYTES;
         let args = u64::from(o.draw * ARGS_WORDS * 4);
         culler
