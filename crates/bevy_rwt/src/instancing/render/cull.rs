@@ -9,6 +9,7 @@
 //! what it wrote. A chunk without a culled draw (culling off, the adapter unable, the pool
 //! full) is drawn directly, whole.
 
+use super::draw::MeshSlices;
 use super::{ExtractedChunk, GpuChunk, MainViewer, Queued};
 #[cfg(any(test, feature = "testing"))]
 use crate::instancing::GpuInstance;
@@ -20,8 +21,8 @@ use bevy::core_pipeline::prepass::Opaque3dPrepass;
 use bevy::pbr::{LightEntity, Shadow};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
+use bevy::render::mesh::RenderMesh;
 use bevy::render::mesh::allocator::MeshAllocator;
-use bevy::render::mesh::{RenderMesh, RenderMeshBufferInfo};
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
     storage_buffer_read_only_sized, storage_buffer_sized, uniform_buffer,
@@ -405,21 +406,7 @@ impl CullInputs<'_, '_> {
 
     /// A chunk's draw arguments before culling, as the direct draw would give them.
     fn args(&self, chunk: &ExtractedChunk) -> Option<[u32; ARGS_WORDS as usize]> {
-        let mesh = self.meshes.get(chunk.mesh)?;
-        let vertices = self.allocator.mesh_vertex_slice(&chunk.mesh)?;
-        Some(match &mesh.buffer_info {
-            RenderMeshBufferInfo::Indexed { count, .. } => {
-                let indices = self.allocator.mesh_index_slice(&chunk.mesh)?;
-                [*count, 0, indices.range.start, vertices.range.start, 0]
-            }
-            RenderMeshBufferInfo::NonIndexed => [
-                vertices.range.end - vertices.range.start,
-                0,
-                vertices.range.start,
-                0,
-                0,
-            ],
-        })
+        MeshSlices::of(&self.meshes, &self.allocator, chunk.mesh).map(|s| s.args)
     }
 }
 

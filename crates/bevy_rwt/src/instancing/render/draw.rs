@@ -4,13 +4,14 @@
 use super::{ExtractedChunk, GpuChunk, InstanceCuller};
 use bevy::ecs::system::{SystemParamItem, lifetimeless::*};
 use bevy::pbr::{SetMeshViewBindGroup, SetMeshViewBindingArrayBindGroup};
-use bevy::prelude::Entity;
+use bevy::prelude::{AssetId, Entity, Mesh};
 use bevy::render::mesh::allocator::MeshAllocator;
 use bevy::render::mesh::{RenderMesh, RenderMeshBufferInfo};
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_phase::{
     PhaseItem, RenderCommand, RenderCommandResult, SetItemPipeline, TrackedRenderPass,
 };
+use bevy::render::render_resource::{Buffer, IndexFormat};
 
 /// The draw of one chunk in the main pass.
 pub(in crate::instancing) type DrawInstancedChunk = (
@@ -68,47 +69,72 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
         let Some((chunk, gpu)) = item else {
             return RenderCommandResult::Skip;
         };
-        let (Some(mesh), Some(vertices)) = (
-            meshes.get(chunk.mesh),
-            allocator.mesh_vertex_slice(&chunk.mesh),
-        ) else {
+        let Some(slices) = MeshSlices::of(meshes, allocator, chunk.mesh) else {
             return RenderCommandResult::Skip;
         };
-        pass.set_vertex_buffer(0, vertices.buffer.slice(..));
-        if let Some((draw, kept, args)) = culled {
-            pass.set_vertex_buffer(1, kept.slice(draw.kept.clone()));
-            match &mesh.buffer_info {
-                RenderMeshBufferInfo::Indexed { index_format, .. } => {
-                    let Some(indices) = allocator.mesh_index_slice(&chunk.mesh) else {
-                        return RenderCommandResult::Skip;
-                    };
-                    pass.set_index_buffer(indices.buffer.slice(..), *index_format);
-                    pass.draw_indexed_indirect(args, draw.args);
-                }
-                RenderMeshBufferInfo::NonIndexed => pass.draw_indirect(args, draw.args),
-            }
-            return RenderCommandResult::Success;
+        pass.set_vertex_buffer(0, slices.vertices.slice(..));
+        if let Some((buffer, format)) = slices.indices {
+            pass.set_index_buffer(buffer.slice(..), format);
         }
-        pass.set_vertex_buffer(1, gpu.instances.slice(..));
-        match &mesh.buffer_info {
+        let [count, _, first, base, _] = slices.args;
+        match (culled, slices.indices.is_some()) {
+            (Some((draw, kept, args)), indexed) => {
+                pass.set_vertex_buffer(1, kept.slice(draw.kept.clone()));
+                if indexed {
+                    pass.draw_indexed_indirect(args, draw.args);
+                } else {
+                    pass.draw_indirect(args, draw.args);
+                }
+            }
+            (None, true) => {
+                pass.set_vertex_buffer(1, gpu.instances.slice(..));
+                pass.draw_indexed(first..first + count, base as i32, 0..gpu.count);
+            }
+            (None, false) => {
+                pass.set_vertex_buffer(1, gpu.instances.slice(..));
+                pass.draw(first..first + count, 0..gpu.count);
+            }
+        }
+        RenderCommandResult::Success
+    }
+}
+
+/// Where a mesh lies in the mesh allocator's slabs: its vertex buffer, its index buffer and
+/// format (indexed meshes), and the draw's arguments for an instance count of 0 (indexed:
+/// index count, 0, first index, base vertex, 0; direct: vertex count, 0, first vertex, 0, 0),
+/// as both the direct draw and culling's indirect arguments read them.
+pub(super) struct MeshSlices<'a> {
+    pub vertices: &'a Buffer,
+    pub indices: Option<(&'a Buffer, IndexFormat)>,
+    pub args: [u32; 5],
+}
+
+impl<'a> MeshSlices<'a> {
+    /// The slices of `mesh`, once it is prepared and allocated.
+    pub fn of(
+        meshes: &'a RenderAssets<RenderMesh>,
+        allocator: &'a MeshAllocator,
+        mesh: AssetId<Mesh>,
+    ) -> Option<Self> {
+        let info = meshes.get(mesh)?;
+        let vertices = allocator.mesh_vertex_slice(&mesh)?;
+        Some(match &info.buffer_info {
             RenderMeshBufferInfo::Indexed {
                 index_format,
                 count,
             } => {
-                let Some(indices) = allocator.mesh_index_slice(&chunk.mesh) else {
-                    return RenderCommandResult::Skip;
-                };
-                pass.set_index_buffer(indices.buffer.slice(..), *index_format);
-                pass.draw_indexed(
-                    indices.range.start..indices.range.start + count,
-                    vertices.range.start as i32,
-                    0..gpu.count,
-                );
+                let indices = allocator.mesh_index_slice(&mesh)?;
+                Self {
+                    vertices: vertices.buffer,
+                    indices: Some((indices.buffer, *index_format)),
+                    args: [*count, 0, indices.range.start, vertices.range.start, 0],
+                }
             }
-            RenderMeshBufferInfo::NonIndexed => {
-                pass.draw(vertices.range, 0..gpu.count);
-            }
-        }
-        RenderCommandResult::Success
+            RenderMeshBufferInfo::NonIndexed => Self {
+                vertices: vertices.buffer,
+                indices: None,
+                args: [vertices.range.len() as u32, 0, vertices.range.start, 0, 0],
+            },
+        })
     }
 }
