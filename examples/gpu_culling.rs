@@ -6,8 +6,8 @@
 //! across it, so that many chunks are cut by the view's sides. Two screenshots: chunks
 //! drawn whole ([`InstanceCulling::PerChunk`]), then culled per instance
 //! ([`InstanceCulling::PerInstance`]), whose frame is also checked by
-//! [`CullingCheck`]: every culled draw's instance count, read back from its indirect
-//! arguments, must equal the count of the same test run on the CPU over every instance.
+//! [`CullingCheck`]: every culled draw's instances, read back from its indirect arguments
+//! and the pool of kept instances, must be those the same test keeps on the CPU.
 //!
 //! It prints `rwt-culling: draws D instances N kept G (gpu) C (cpu) mismatched M, pixel
 //! difference P` and exits with an error unless the counts agree, culling kept fewer
@@ -18,12 +18,11 @@
 use bevy::app::AppExit;
 use bevy::light::CascadeShadowConfigBuilder;
 use bevy::prelude::*;
-use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
+use rwt_examples::frame_check::{Captures, mean_difference, output_dir};
 use rwt_examples::grass_field;
 use rwt_examples::prelude::*;
-use std::path::PathBuf;
 
 /// Most mean difference between the two frames (0..255 a channel).
 const MOST_DIFFERENCE: f64 = 1.0;
@@ -43,6 +42,7 @@ fn main() -> AppExit {
         .insert_resource(InstanceCulling::PerChunk)
         .init_resource::<CullingCheck>()
         .init_resource::<Check>()
+        .init_resource::<Captures>()
         .add_systems(Startup, setup)
         .add_systems(Update, run_check)
         .run()
@@ -94,19 +94,17 @@ fn setup(
     );
 }
 
-/// The check's progress: frames since streaming settled, the frames captured, the report.
+/// The check's progress: frames since streaming settled, the report.
 #[derive(Resource, Default)]
 struct Check {
     settled_at: Option<u32>,
     frame: u32,
-    whole: Option<image::RgbImage>,
-    culled: Option<image::RgbImage>,
-    pending: bool,
     report: Option<CullingReport>,
 }
 
 fn run_check(
     mut check: ResMut<Check>,
+    mut captures: ResMut<Captures>,
     stats: Res<RwtStats>,
     mut culling: ResMut<InstanceCulling>,
     culling_check: Res<CullingCheck>,
@@ -129,17 +127,18 @@ fn run_check(
     if check.report.is_none() {
         check.report = culling_check.report();
     }
-    if check.pending || check.frame < since + WAIT {
+    if captures.pending() || check.frame < since + WAIT {
         return;
     }
-    match (&check.whole, &check.culled) {
-        (None, _) => capture(&mut check, &mut commands, false),
+    let dir = output_dir("RWT_CULLING_DIR", "target/culling");
+    match (captures.get("whole"), captures.get("culled")) {
+        (None, _) => captures.capture(&mut commands, "whole", dir),
         (Some(_), None) if *culling == InstanceCulling::PerChunk => {
             *culling = InstanceCulling::PerInstance;
             culling_check.request();
             check.settled_at = Some(check.frame);
         }
-        (Some(_), None) => capture(&mut check, &mut commands, true),
+        (Some(_), None) => captures.capture(&mut commands, "culled", dir),
         (Some(whole), Some(culled)) => {
             let Some(report) = check.report else { return };
             let passed = conclude(&report, whole, culled);
@@ -150,34 +149,6 @@ fn run_check(
             });
         }
     }
-}
-
-/// Takes a screenshot into the check's whole or culled frame, and saves it.
-fn capture(check: &mut Check, commands: &mut Commands, culled: bool) {
-    check.pending = true;
-    commands.spawn(Screenshot::primary_window()).observe(
-        move |captured: On<ScreenshotCaptured>, mut check: ResMut<Check>| {
-            check.pending = false;
-            let Ok(image) = captured.image.clone().try_into_dynamic() else {
-                return;
-            };
-            let rgb = image.to_rgb8();
-            let name = if culled { "culled.png" } else { "whole.png" };
-            let dir = std::env::var_os("RWT_CULLING_DIR")
-                .map(PathBuf::from)
-                .unwrap_or_else(|| PathBuf::from("target/culling"));
-            if std::fs::create_dir_all(&dir).is_ok()
-                && let Err(error) = rgb.save(dir.join(name))
-            {
-                eprintln!("rwt-culling: cannot save {name}: {error}");
-            }
-            if culled {
-                check.culled = Some(rgb);
-            } else {
-                check.whole = Some(rgb);
-            }
-        },
-    );
 }
 
 /// Prints the result line; whether every check passed.
@@ -191,7 +162,7 @@ fn conclude(report: &CullingReport, whole: &image::RgbImage, culled: &image::Rgb
         (report.draws == 0, "no culled draw"),
         (
             report.mismatched > 0 || report.gpu_kept != report.cpu_kept,
-            "the GPU's counts differ from the CPU's",
+            "the GPU's kept instances differ from the CPU's",
         ),
         (
             report.gpu_kept >= report.instances,
@@ -210,18 +181,4 @@ fn conclude(report: &CullingReport, whole: &image::RgbImage, culled: &image::Rgb
         }
     }
     passed
-}
-
-/// Mean absolute difference of two images' channels (255 when their sizes differ).
-fn mean_difference(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
-    if a.dimensions() != b.dimensions() {
-        return 255.0;
-    }
-    let total: u64 = a
-        .as_raw()
-        .iter()
-        .zip(b.as_raw())
-        .map(|(x, y)| u64::from(x.abs_diff(*y)))
-        .sum();
-    total as f64 / a.as_raw().len().max(1) as f64
 }

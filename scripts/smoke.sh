@@ -10,8 +10,10 @@
 # (or took fewer than its three screenshots, 1x, 30x and 1000x), or mesh_ground placed an
 # instance off its glTF level's surfaces (floating, buried, on a wall); and runs
 # instanced_passes, which fails unless instanced grass receives and casts shadows and is
-# drawn with the prepasses, TAA and SSAO, and gpu_culling, which fails unless the frame culled
-# per instance on the GPU is the frame drawn whole and its indirect counts are the CPU's.
+# drawn with the prepasses, TAA and SSAO, gpu_culling, which fails unless the frame culled
+# per instance on the GPU is the frame drawn whole and its indirect counts are the CPU's, and
+# gpu_occlusion, which fails unless a camera rising over a hill, occluding, draws the frame
+# drawn whole (the blades peeking over the crest included) and occlusion dropped instances.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -23,10 +25,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling)
+examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -86,6 +88,12 @@ for run in "${runs[@]}"; do
         # Culling per instance: the frame matches the whole chunks' and the GPU's counts
         # the CPU's.
         self_checked RWT_CULLING_DIR=$out/culling rwt-culling 'draws'
+        continue
+    fi
+    if [ "$ex" = gpu_occlusion ]; then
+        # Occlusion: the frame of a camera rising over a hill matches the whole chunks',
+        # its late phase kept what the early phase's stale depth hid.
+        self_checked RWT_OCCLUSION_DIR=$out/occlusion rwt-occlusion 'draws'
         continue
     fi
     # CI's open_world flies its path in 100 frames instead of 150 (the same checks: the

@@ -1,7 +1,8 @@
 //! What the examples share: the scripted smoke session that lets CI run each example in a
 //! real renderer ([`smoke`]), a fly camera ([`fly_camera`]), a text HUD ([`hud`]) and the
-//! brush's last answer for it ([`brush_status`]), and the field of grass the cost benchmarks
-//! time ([`grass_field`]).
+//! brush's last answer for it ([`brush_status`]), the field of grass the cost benchmarks
+//! time ([`grass_field`]), and frames captured and compared by the examples that check
+//! themselves ([`frame_check`]).
 //!
 //! Run an example as a user would (`cargo run --release --example open_world`), or as CI
 //! does: `RWT_SCREENSHOT=out.png cargo run --example open_world` plays the example's script,
@@ -10,6 +11,7 @@
 pub mod brush_status;
 pub mod fly_camera;
 pub mod foliage;
+pub mod frame_check;
 pub mod grass_field;
 pub mod hud;
 pub mod smoke;

@@ -7,7 +7,10 @@ use super::{
 use super::{bend, far, mesh, render};
 use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use bevy::core_pipeline::core_3d::Opaque3d;
+use bevy::core_pipeline::mip_generation::experimental::depth::early_downsample_depth;
 use bevy::core_pipeline::prepass::Opaque3dPrepass;
+use bevy::core_pipeline::prepass::node::late_prepass;
+use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::ecs::schedule::InternedScheduleLabel;
 use bevy::pbr::{MeshPipelineSystems, Shadow, init_prepass_pipeline};
 use bevy::prelude::*;
@@ -63,8 +66,9 @@ impl Plugin for RwtInstancingPlugin {
             ExtractResourcePlugin::<BendField>::default(),
         ));
         #[cfg(feature = "testing")]
-        app.add_plugins(ExtractResourcePlugin::<super::CullingCheck>::default())
-            .sub_app_mut(RenderApp)
+        app.sub_app_mut(RenderApp)
+            .init_resource::<render::FrameCheck>()
+            .add_systems(ExtractSchedule, render::extract_culling_check)
             .add_systems(
                 Render,
                 render::check_culling
@@ -105,6 +109,17 @@ impl Plugin for RwtInstancingPlugin {
                     )
                         .in_set(RenderSystems::QueueMeshes),
                     render::cull_instances.in_set(RenderSystems::PrepareBindGroups),
+                ),
+            )
+            .add_systems(
+                Core3d,
+                (
+                    render::cull_late
+                        .after(early_downsample_depth)
+                        .before(late_prepass),
+                    render::restore_early
+                        .after(late_prepass)
+                        .before(Core3dSystems::MainPass),
                 ),
             );
     }

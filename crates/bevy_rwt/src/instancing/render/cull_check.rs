@@ -1,13 +1,15 @@
 //! The check of culling per instance against the CPU (feature `testing`): on request, the
-//! render world reads back a frame's indirect arguments and counts, for every culled draw,
-//! the instances the same test keeps on the CPU ([`CullingCheck`]).
+//! render world reads back a frame's indirect arguments and kept instances and compares,
+//! for every culled draw, the instances it draws with those the same test keeps on the CPU
+//! ([`CullingCheck`]).
 
 use super::cull::{ARGS_WORDS, CullUniform, InstanceCuller};
 use crate::instancing::InstanceBuffer;
 use bevy::prelude::*;
-use bevy::render::extract_resource::ExtractResource;
+use bevy::render::Extract;
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
+use std::ops::Range;
 use std::sync::{Arc, Mutex};
 
 /// Asks the render world to check one frame's culling per instance against a brute-force
@@ -31,14 +33,22 @@ pub struct CullingReport {
     pub instances: u64,
     /// Instances the GPU kept (read back from the indirect arguments).
     pub gpu_kept: u64,
-    /// Instances the CPU keeps.
+    /// Instances the CPU keeps (by the view's frustum, the fade and far thinning).
     pub cpu_kept: u64,
-    /// Draws whose two counts differ.
+    /// Draws whose instances disagree: those the GPU kept (read back from the pool, as many
+    /// as its arguments count) are not those the CPU keeps, or in a view that occludes, not
+    /// among them (the CPU tests no depth, so occlusion may only drop instances).
     pub mismatched: usize,
+    /// Culled draws in views that occlude.
+    pub occluding_draws: usize,
+    /// Instances the late phase of occlusion kept: hidden by last frame's depth, not by
+    /// this frame's.
+    pub late_kept: u64,
 }
 
 impl CullingCheck {
-    /// Checks the next frame that culls per instance (a report waiting is dropped).
+    /// Checks the next frame that culls per instance (a report waiting is dropped): the
+    /// frame of the main-world update that asks, or the first after it that culls.
     pub fn request(&self) {
         let mut state = self.0.lock().unwrap_or_else(|e| e.into_inner());
         state.requested = true;
@@ -59,33 +69,112 @@ impl CullingCheck {
     }
 }
 
-impl ExtractResource for CullingCheck {
-    type Source = CullingCheck;
-
-    fn extract_resource(source: &Self::Source) -> Self {
-        source.clone()
-    }
+/// The render world's side of a [`CullingCheck`]: the check, and whether the frame being
+/// rendered is the one asked for (the request is taken as the frame is extracted, so that
+/// the frame checked is the one whose main-world state asked, pipelined or not).
+#[derive(Resource, Default)]
+pub(in crate::instancing) struct FrameCheck {
+    check: Option<CullingCheck>,
+    requested: bool,
 }
 
-/// One culled draw as the check sees it: the dispatch's uniform and the chunk's instances.
-pub(super) type Checked = (CullUniform, Arc<InstanceBuffer>);
+/// Takes this frame's request, if any.
+pub(in crate::instancing) fn extract_culling_check(
+    source: Extract<Option<Res<CullingCheck>>>,
+    mut frame: ResMut<FrameCheck>,
+) {
+    frame.check = source.as_deref().cloned();
+    frame.requested = frame.check.as_ref().is_some_and(CullingCheck::take_request);
+}
 
-/// After the frame's work is submitted: reads the arguments back when a check was asked
-/// for and the frame culled per instance, and answers it.
+/// One culled draw as the check sees it: the dispatch's uniform, the chunk's instances,
+/// whether its view occludes.
+pub(super) struct Checked {
+    pub uniform: CullUniform,
+    pub instances: Arc<InstanceBuffer>,
+    pub occludes: bool,
+    /// The byte ranges of the pool its early and late phases keep into.
+    pub kept: Range<u64>,
+    pub late: Option<Range<u64>>,
+}
+
+/// After the frame's work is submitted: reads the arguments and the kept instances back
+/// when a check was asked for and the frame culled per instance, and answers it.
 pub(in crate::instancing) fn check_culling(
-    check: Option<Res<CullingCheck>>,
+    frame: Res<FrameCheck>,
     culler: Res<InstanceCuller>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
 ) {
-    let Some(check) = check else { return };
-    let (checked, Some(args)) = (culler.checked(), culler.args()) else {
+    let Some(check) = frame.check.as_ref().filter(|_| frame.requested) else {
         return;
     };
-    if checked.is_empty() || !check.take_request() {
+    let (checked, Some(args), Some(kept)) = (culler.checked(), culler.args(), culler.kept_pool())
+    else {
+        // Nothing culled per instance this frame: the next frame that does is checked.
+        check.request();
+        return;
+    };
+    if checked.is_empty() {
+        check.request();
         return;
     }
-    let size = checked.len() as u64 * u64::from(ARGS_WORDS) * 4;
+    // Both blocks of arguments: the early one, then the late one.
+    let size = 2 * checked.len() as u64 * u64::from(ARGS_WORDS) * 4;
+    let pool_size = checked
+        .iter()
+        .flat_map(|c| std::iter::once(&c.kept).chain(&c.late))
+        .map(|r| r.end)
+        .max()
+        .unwrap_or(0);
+    let (Some(words), Some(pool)) = (
+        read_back(&device, &queue, args, size),
+        read_back(&device, &queue, kept, pool_size),
+    ) else {
+        return;
+    };
+    let count = |draw: usize| words[draw * ARGS_WORDS as usize + 1];
+    let mut report = CullingReport::default();
+    for (i, c) in checked.iter().enumerate() {
+        let (early, late) = (count(i), count(checked.len() + i));
+        let mut gpu = kept_words(&pool, &c.kept, early);
+        if let Some(range) = &c.late {
+            gpu.extend(kept_words(&pool, range, late));
+        }
+        let mut cpu: Vec<[u32; 6]> = c
+            .instances
+            .instances
+            .iter()
+            .filter(|g| c.uniform.keeps(g))
+            .map(|g| bytemuck::cast(*g))
+            .collect();
+        gpu.sort_unstable();
+        cpu.sort_unstable();
+        report.draws += 1;
+        report.instances += c.instances.instances.len() as u64;
+        report.gpu_kept += gpu.len() as u64;
+        report.cpu_kept += cpu.len() as u64;
+        if c.occludes {
+            // What the pyramid hid is dropped from the frustum's instances, never added.
+            report.occluding_draws += 1;
+            report.late_kept += u64::from(late);
+            cpu.dedup();
+            report.mismatched += usize::from(gpu.iter().any(|g| cpu.binary_search(g).is_err()));
+        } else {
+            report.mismatched += usize::from(gpu != cpu || late != 0);
+        }
+    }
+    check.answer(report);
+}
+
+/// The first `size` bytes of `buffer`, as words, once the GPU has done its work.
+fn read_back(
+    device: &RenderDevice,
+    queue: &RenderQueue,
+    buffer: &Buffer,
+    size: u64,
+) -> Option<Vec<u32>> {
+    let size = size.max(4);
     let staging = device.create_buffer(&BufferDescriptor {
         label: Some("rwt_cull_check"),
         size,
@@ -95,23 +184,23 @@ pub(in crate::instancing) fn check_culling(
     let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor {
         label: Some("rwt_cull_check"),
     });
-    encoder.copy_buffer_to_buffer(args, 0, &staging, 0, size);
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
     queue.submit([encoder.finish()]);
     let slice = staging.slice(..);
     slice.map_async(MapMode::Read, |_| {});
-    if device.poll(PollType::wait_indefinitely()).is_err() {
-        return;
-    }
-    let words: Vec<u32> = bytemuck::pod_collect_to_vec(&slice.get_mapped_range());
-    let mut report = CullingReport::default();
-    for (i, (uniform, buffer)) in checked.iter().enumerate() {
-        let gpu = u64::from(words[i * ARGS_WORDS as usize + 1]);
-        let cpu = buffer.instances.iter().filter(|g| uniform.keeps(g)).count() as u64;
-        report.draws += 1;
-        report.instances += buffer.instances.len() as u64;
-        report.gpu_kept += gpu;
-        report.cpu_kept += cpu;
-        report.mismatched += usize::from(gpu != cpu);
-    }
-    check.answer(report);
+    device.poll(PollType::wait_indefinitely()).ok()?;
+    let words = bytemuck::pod_collect_to_vec(&slice.get_mapped_range());
+    Some(words)
+}
+
+/// The `count` instances kept at the start of the byte range `kept` of the pool.
+fn kept_words(pool: &[u32], kept: &Range<u64>, count: u32) -> Vec<[u32; 6]> {
+    let first = (kept.start / 4) as usize;
+    let words = pool
+        .get(first..first + count as usize * 6)
+        .unwrap_or_default();
+    words
+        .chunks_exact(6)
+        .map(|w| [w[0], w[1], w[2], w[3], w[4], w[5]])
+        .collect()
 }

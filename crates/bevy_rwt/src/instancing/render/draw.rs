@@ -45,7 +45,8 @@ impl<P: PhaseItem, const I: usize> RenderCommand<P> for SetChunkBindGroup<I> {
     }
 }
 
-/// Draws a chunk's mesh once per instance: those culling kept for the view, or all.
+/// Draws a chunk's mesh once per instance: those culling kept for the view (in each of
+/// its ranges), or all.
 pub(in crate::instancing) struct DrawChunkInstances;
 
 impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
@@ -79,11 +80,13 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
         let [count, _, first, base, _] = slices.args;
         match (culled, slices.indices.is_some()) {
             (Some((draw, kept, args)), indexed) => {
-                pass.set_vertex_buffer(1, kept.slice(draw.kept.clone()));
-                if indexed {
-                    pass.draw_indexed_indirect(args, draw.args);
-                } else {
-                    pass.draw_indirect(args, draw.args);
+                for range in std::iter::once(&draw.early).chain(&draw.late) {
+                    pass.set_vertex_buffer(1, kept.slice(range.kept.clone()));
+                    if indexed {
+                        pass.draw_indexed_indirect(args, range.args);
+                    } else {
+                        pass.draw_indirect(args, range.args);
+                    }
                 }
             }
             (None, true) => {

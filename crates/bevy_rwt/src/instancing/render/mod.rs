@@ -19,11 +19,11 @@ mod retained;
 #[cfg(test)]
 mod shader_check;
 
-pub(super) use cull::{InstanceCuller, cull_instances, init_culler};
-#[cfg(feature = "testing")]
-pub(super) use cull_check::check_culling;
+pub(super) use cull::{InstanceCuller, cull_instances, cull_late, init_culler, restore_early};
 #[cfg(feature = "testing")]
 pub use cull_check::{CullingCheck, CullingReport};
+#[cfg(feature = "testing")]
+pub(super) use cull_check::{FrameCheck, check_culling, extract_culling_check};
 pub(super) use depth::{
     DrawInstancedDepth, InstancedDepthPipeline, init_depth_pipeline, queue_prepass, queue_shadows,
 };
@@ -63,7 +63,7 @@ const INSTANCE_LOCATIONS: [u32; 2] = [8, 9];
 /// Adds the instanced shader to the app's embedded assets.
 pub(super) fn embed_shader(app: &mut App) {
     bevy::asset::embedded_asset!(app, "instanced.wgsl");
-    bevy::asset::embedded_asset!(app, "cull.wgsl");
+    bevy::asset::embedded_asset!(app, "cull/cull.wgsl");
 }
 
 /// The per-chunk uniform, as the shader reads it.

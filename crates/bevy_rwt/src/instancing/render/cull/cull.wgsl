@@ -1,6 +1,13 @@
 // Culling per instance: one dispatch per (view, chunk) the CPU kept. Each invocation tests
 // one instance against the view and, when it may be seen, copies it into the view's kept
 // instances and counts it in the chunk's indirect draw arguments.
+//
+// Occlusion takes two phases in a camera with a depth pyramid. The early phase (before the
+// frame's passes) also tests each instance against last frame's pyramid, seen from last
+// frame's view: one hidden there is not kept but marked. The late phase (after the early
+// depth prepass has been reduced into this frame's pyramid) tests the marked ones against
+// it and keeps those it does not hide, into the draw's second range. A blade seen this
+// frame is kept by one of the two: what the early depth holds, the frame holds too.
 
 struct Cull {
     // The view's half-spaces (normal, distance; inside where dot(n, p) + d > 0).
@@ -20,6 +27,11 @@ struct Cull {
     // Instances in the chunk, the word of its draw's instance count in the arguments,
     // workgroups along x.
     slots: vec4<u32>,
+    // The view's clip space from world space: last frame's in the early phase, this
+    // frame's in the late one.
+    clip_from_world: mat4x4<f32>,
+    // Occlusion's phase (0: none, 1: early, 2: late), the chunk's first word of marks.
+    occlusion: vec4<u32>,
 };
 
 @group(0) @binding(0) var<storage, read> instances: array<u32>;
@@ -27,6 +39,10 @@ struct Cull {
 // The chunk's kept instances in this view (bound at its place in the frame's pool).
 @group(0) @binding(2) var<storage, read_write> kept_instances: array<u32>;
 @group(0) @binding(3) var<storage, read_write> args: array<atomic<u32>>;
+// One bit per instance: hidden in the early phase, to be tested again in the late one.
+@group(0) @binding(4) var<storage, read_write> marks: array<atomic<u32>>;
+// The view's depth pyramid (reversed depth, each texel the farthest of those it covers).
+@group(1) @binding(0) var pyramid: texture_2d<f32>;
 
 // Words of one instance (`GpuInstance`: offset and scale, yaw and appearance, tint and
 // tilt).
@@ -70,12 +86,74 @@ fn seen(root: vec3<f32>, scale: f32, widen: f32) -> bool {
     return true;
 }
 
+// The pyramid's farthest depth at `at` on `level`; 0 (hides nothing) off its edge.
+fn farthest(at: vec2<u32>, level: u32) -> f32 {
+    let size = textureDimensions(pyramid, level);
+    if any(at >= size) {
+        return 0.0;
+    }
+    return textureLoad(pyramid, at, level).x;
+}
+
+// Whether the pyramid hides the box of half side `radius` around `center`, seen through
+// `clip_from_world`: the box's nearest depth is farther than the farthest depth of the
+// texels (at most two by two, on the level that makes them so) its screen rectangle covers.
+// Never hidden when any corner is behind the eye or past the near plane, or the rectangle
+// leaves the screen.
+fn hidden(center: vec3<f32>, radius: f32, clip_from_world: mat4x4<f32>) -> bool {
+    var lo = vec2<f32>(1.0);
+    var hi = vec2<f32>(0.0);
+    var nearest = 0.0;
+    for (var i = 0u; i < 8u; i++) {
+        let side = vec3<bool>((i & 1u) != 0u, (i & 2u) != 0u, (i & 4u) != 0u);
+        let corner = center + select(vec3<f32>(-radius), vec3<f32>(radius), side);
+        let clip = clip_from_world * vec4<f32>(corner, 1.0);
+        if clip.w <= 0.0 {
+            return false;
+        }
+        let ndc = clip.xyz / clip.w;
+        let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+        lo = min(lo, uv);
+        hi = max(hi, uv);
+        nearest = max(nearest, ndc.z);
+    }
+    if nearest >= 1.0 || any(lo < vec2<f32>(0.0)) || any(hi > vec2<f32>(1.0)) {
+        return false;
+    }
+    let pixels = (hi - lo) * vec2<f32>(textureDimensions(pyramid, 0));
+    let level = u32(max(ceil(log2(max(max(pixels.x, pixels.y), 1.0))), 0.0));
+    if level >= textureNumLevels(pyramid) {
+        return false;
+    }
+    let at = vec2<u32>(lo * vec2<f32>(textureDimensions(pyramid, level)));
+    let far = min(
+        min(farthest(at, level), farthest(at + vec2<u32>(1u, 0u), level)),
+        min(farthest(at + vec2<u32>(0u, 1u), level), farthest(at + vec2<u32>(1u, 1u), level)),
+    );
+    return nearest < far;
+}
+
+// Copies instance `i` into the kept instances, counted in the arguments' word `count`.
+fn keep(i: u32, count: u32) {
+    let w = i * WORDS;
+    let to = atomicAdd(&args[count], 1u) * WORDS;
+    for (var k = 0u; k < WORDS; k++) {
+        kept_instances[to + k] = instances[w + k];
+    }
+}
+
 @compute @workgroup_size(64)
 fn cull_instances(
     @builtin(global_invocation_id) id: vec3<u32>,
 ) {
     let i = id.x + id.y * cull.slots.z * 64u;
     if i >= cull.slots.x {
+        return;
+    }
+    let mark = cull.occlusion.y + i / 32u;
+    let bit = 1u << (i % 32u);
+    let late = cull.occlusion.x == 2u;
+    if late && (atomicLoad(&marks[mark]) & bit) == 0u {
         return;
     }
     let w = i * WORDS;
@@ -92,8 +170,11 @@ fn cull_instances(
     if !seen(root, scale, 1.0 / kept) {
         return;
     }
-    let to = atomicAdd(&args[cull.slots.y], 1u) * WORDS;
-    for (var k = 0u; k < WORDS; k++) {
-        kept_instances[to + k] = instances[w + k];
+    if cull.occlusion.x != 0u && hidden(root, cull.origin.w * scale / kept, cull.clip_from_world) {
+        if !late {
+            atomicOr(&marks[mark], bit);
+        }
+        return;
     }
+    keep(i, cull.slots.y);
 }

@@ -8,6 +8,16 @@
 //! the frame's passes, so every pass of the view (prepasses, main pass, shadow map) reads
 //! what it wrote. A chunk without a culled draw (culling off, the adapter unable, the pool
 //! full) is drawn directly, whole.
+//!
+//! A camera with Bevy's `OcclusionCulling` and `DepthPrepass` also culls what its depth
+//! pyramid hides, in two phases ([`occlusion`]): what last frame's depth hid is tested again
+//! once this frame's early depth is reduced, and drawn from the late prepass on.
+
+mod occlusion;
+#[cfg(test)]
+mod tests;
+
+pub(in crate::instancing) use occlusion::{cull_late, restore_early};
 
 use super::draw::MeshSlices;
 use super::{ExtractedChunk, GpuChunk, MainViewer, Queued};
@@ -60,6 +70,11 @@ pub(super) struct CullUniform {
     thinning: Vec4,
     /// Instances, the word of the draw's instance count, workgroups along x.
     slots: UVec4,
+    /// The view's clip space from world space: last frame's (early phase), this frame's
+    /// (late phase).
+    clip_from_world: Mat4,
+    /// Occlusion's phase (0: none, 1: early, 2: late), the chunk's first word of marks.
+    occlusion: UVec4,
 }
 
 #[cfg(any(test, feature = "testing"))]
@@ -106,17 +121,25 @@ impl CullUniform {
     }
 }
 
-/// Where one chunk's culled draw in one view reads: its arguments (a byte offset into
+/// Where one culled draw reads: its arguments (a byte offset into
 /// [`InstanceCuller::args`]) and its kept instances (a byte range of the pool).
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub(in crate::instancing) struct CulledDraw {
+pub(in crate::instancing) struct CulledRange {
     pub args: u64,
     pub kept: Range<u64>,
 }
 
+/// One chunk's culled draw in one view: the instances its early phase kept, and in a view
+/// that occludes, those its late phase kept.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(in crate::instancing) struct CulledDraw {
+    pub early: CulledRange,
+    pub late: Option<CulledRange>,
+}
+
 /// A chunk's cull bind group, and the buffers it was made with.
 struct ChunkCull {
-    made_with: [BufferId; 4],
+    made_with: [BufferId; 5],
     kept_binding: u64,
     bind_group: BindGroup,
 }
@@ -130,11 +153,24 @@ pub(in crate::instancing) struct InstanceCuller {
     uniforms: DynamicUniformBuffer<CullUniform>,
     /// The pool of kept instances.
     kept: Option<Buffer>,
-    /// Every draw's indirect arguments.
+    /// Whether the pool was made this frame and not yet cleared.
+    fresh_pool: bool,
+    /// Every draw's indirect arguments: the early block, then the late block.
     args: Option<Buffer>,
+    /// One bit per instance of an occluding dispatch: hidden in the early phase.
+    marks: Option<Buffer>,
+    /// The early block put aside during the late prepass, then the early block with no
+    /// instances ([`occlusion`]).
+    phases: Option<Buffer>,
+    /// The pyramids views occlude with.
+    pyramids: occlusion::Pyramids,
     chunks: HashMap<Entity, ChunkCull>,
     /// This frame's culled draws, by (view, chunk) render entity.
     draws: HashMap<(Entity, Entity), CulledDraw>,
+    /// This frame's late phase, by view.
+    late: HashMap<Entity, occlusion::LateWork>,
+    /// This frame's draws (records in each block of the arguments).
+    draw_count: u32,
     /// This frame's dispatches, in the order of their arguments, for the check.
     #[cfg(feature = "testing")]
     checked: Vec<super::cull_check::Checked>,
@@ -147,7 +183,8 @@ impl InstanceCuller {
         Some((draw, self.kept.as_ref()?, self.args.as_ref()?))
     }
 
-    /// This frame's dispatches (uniform and instances), in the order of their arguments.
+    /// This frame's dispatches (uniform, instances, whether it occludes), in the order of
+    /// their arguments.
     #[cfg(feature = "testing")]
     pub(super) fn checked(&self) -> &[super::cull_check::Checked] {
         &self.checked
@@ -157,6 +194,12 @@ impl InstanceCuller {
     #[cfg(feature = "testing")]
     pub(super) fn args(&self) -> Option<&Buffer> {
         self.args.as_ref()
+    }
+
+    /// The pool of kept instances.
+    #[cfg(feature = "testing")]
+    pub(super) fn kept_pool(&self) -> Option<&Buffer> {
+        self.kept.as_ref()
     }
 }
 
@@ -176,13 +219,15 @@ pub(in crate::instancing) fn init_culler(
                 uniform_buffer::<CullUniform>(true),
                 storage_buffer_sized(true, NonZero::new(INSTANCE_BYTES)),
                 storage_buffer_sized(false, None),
+                storage_buffer_sized(false, None),
             ),
         ),
     );
+    let pyramids = occlusion::Pyramids::new(&device);
     let pipeline = culls_on(&device, &adapter).then(|| {
         cache.queue_compute_pipeline(ComputePipelineDescriptor {
             label: Some("rwt_cull".into()),
-            layout: vec![layout.clone()],
+            layout: vec![layout.clone(), pyramids.layout().clone()],
             shader: bevy::asset::load_embedded_asset!(asset_server.as_ref(), "cull.wgsl"),
             entry_point: Some("cull_instances".into()),
             ..default()
@@ -193,9 +238,15 @@ pub(in crate::instancing) fn init_culler(
         layout,
         uniforms: DynamicUniformBuffer::default(),
         kept: None,
+        fresh_pool: false,
         args: None,
+        marks: None,
+        phases: None,
+        pyramids,
         chunks: HashMap::default(),
         draws: HashMap::default(),
+        late: HashMap::default(),
+        draw_count: 0,
         #[cfg(feature = "testing")]
         checked: Vec::new(),
     });
@@ -209,17 +260,19 @@ fn culls_on(device: &RenderDevice, adapter: &RenderAdapter) -> bool {
     flags.contains(DownlevelFlags::COMPUTE_SHADERS | DownlevelFlags::INDIRECT_EXECUTION)
         && limits.max_compute_workgroup_size_x >= WORKGROUP
         && limits.max_compute_invocations_per_workgroup >= WORKGROUP
-        && limits.max_storage_buffers_per_shader_stage >= 3
+        && limits.max_storage_buffers_per_shader_stage >= 4
         && limits.max_dynamic_storage_buffers_per_pipeline_layout >= 1
 }
 
-/// How each view culls: its half-spaces, and where its level of detail is measured from.
+/// How each view culls: its half-spaces, where its level of detail is measured from, and
+/// how it occludes.
 #[derive(Clone, Copy)]
 struct ViewCull {
     entity: Entity,
     planes: [Vec4; 6],
     eye: Vec3,
     shadow: bool,
+    occluding: Option<occlusion::Occluding>,
 }
 
 /// One dispatch: a chunk in a view.
@@ -232,6 +285,24 @@ struct Dispatch<'a> {
     args: [u32; ARGS_WORDS as usize],
 }
 
+impl Dispatch<'_> {
+    /// Last frame's and this frame's clip space from world space, where the dispatch
+    /// occludes in two phases.
+    fn occludes(&self) -> Option<(Mat4, Mat4)> {
+        let occluding = self.view.occluding?;
+        Some((occluding.previous?, occluding.current))
+    }
+}
+
+/// What culling reads of a view: its frustum, whether it is a shadow view, its pyramid.
+type ViewData = (
+    Entity,
+    &'static ExtractedView,
+    Option<&'static Frustum>,
+    Has<LightEntity>,
+    occlusion::PyramidQuery,
+);
+
 /// What the culling pass reads of the render world.
 #[derive(bevy::ecs::system::SystemParam)]
 pub(in crate::instancing) struct CullInputs<'w, 's> {
@@ -239,16 +310,7 @@ pub(in crate::instancing) struct CullInputs<'w, 's> {
     main: Res<'w, Queued<Opaque3d>>,
     prepass: Res<'w, Queued<Opaque3dPrepass>>,
     shadow: Res<'w, Queued<Shadow>>,
-    views: Query<
-        'w,
-        's,
-        (
-            Entity,
-            &'static ExtractedView,
-            Option<&'static Frustum>,
-            Has<LightEntity>,
-        ),
-    >,
+    views: Query<'w, 's, ViewData>,
     chunks: Query<
         'w,
         's,
@@ -274,6 +336,7 @@ pub(in crate::instancing) fn cull_instances(
     cache: Res<PipelineCache>,
 ) {
     culler.draws.clear();
+    culler.late.clear();
     #[cfg(feature = "testing")]
     culler.checked.clear();
     let on = inputs.setting.as_deref().copied().unwrap_or_default() != InstanceCulling::PerChunk;
@@ -283,11 +346,16 @@ pub(in crate::instancing) fn cull_instances(
     let Some(pipeline) = cache.get_compute_pipeline(pipeline) else {
         return;
     };
-    let dispatches = inputs.dispatches();
+    let culler = culler.as_mut();
+    let views = inputs
+        .views
+        .iter()
+        .map(|(e, view, _, shadow, p)| (e, view, shadow, p));
+    let occluding = culler.pyramids.prepare(views, &device, &cache);
+    let dispatches = inputs.dispatches(&occluding);
     if dispatches.is_empty() {
         return;
     }
-    let culler = culler.as_mut();
     let Some(mut offsets) = culler.lay_out(&dispatches, &device) else {
         return;
     };
@@ -296,36 +364,87 @@ pub(in crate::instancing) fn cull_instances(
     let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor {
         label: Some("rwt_cull"),
     });
-    {
+    if let Some(marks) = &culler.marks {
+        encoder.clear_buffer(marks, 0, None);
+    }
+    // wgpu zeroes the parts of a new buffer it has not seen written before their first use,
+    // and it did not see the compute writes through dynamic offsets: a pool drawn the frame
+    // it was made lost instances (readback). Cleared whole once, the pool counts as written.
+    if let Some(kept) = culler.kept.as_ref().filter(|_| culler.fresh_pool) {
+        encoder.clear_buffer(kept, 0, None);
+        culler.fresh_pool = false;
+    }
+    culler.dispatch_early(&mut encoder, pipeline, &dispatches, &offsets);
+    queue.submit([encoder.finish()]);
+    culler.record(&dispatches, offsets);
+}
+
+impl InstanceCuller {
+    /// Encodes the early phase (the only one, where the view does not occlude).
+    fn dispatch_early(
+        &self,
+        encoder: &mut CommandEncoder,
+        pipeline: &ComputePipeline,
+        dispatches: &[Dispatch],
+        offsets: &[Offsets],
+    ) {
         let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor {
             label: Some("rwt_cull"),
             timestamp_writes: None,
         });
         pass.set_pipeline(pipeline);
-        for (d, o) in dispatches.iter().zip(&offsets) {
-            let Some(chunk) = culler.chunks.get(&d.chunk) else {
+        let mut bound_view = None;
+        for (d, o) in dispatches.iter().zip(offsets) {
+            let (Some(chunk), Some(pyramid)) = (
+                self.chunks.get(&d.chunk),
+                self.pyramids.bind_group(d.view.entity),
+            ) else {
                 continue;
             };
+            if bound_view != Some(d.view.entity) {
+                pass.set_bind_group(1, pyramid, &[]);
+                bound_view = Some(d.view.entity);
+            }
             pass.set_bind_group(0, &chunk.bind_group, &[o.uniform, o.kept as u32]);
             let (x, y) = workgroups(d.gpu.count);
             pass.dispatch_workgroups(x, y, 1);
         }
     }
-    queue.submit([encoder.finish()]);
-    for (d, o) in dispatches.iter().zip(offsets) {
-        #[cfg(feature = "testing")]
-        culler
-            .checked
-            .push((uniform(d, &o), d.extracted.buffer.clone()));
-        if !culler.chunks.contains_key(&d.chunk) {
-            // Not dispatched (no bind group): its arguments count nothing; drawn whole.
-            continue;
+
+    /// Records this frame's culled draws and each occluding view's late phase.
+    fn record(&mut self, dispatches: &[Dispatch], offsets: Vec<Offsets>) {
+        self.draw_count = dispatches.len() as u32;
+        for (d, o) in dispatches.iter().zip(offsets) {
+            let bytes = u64::from(d.gpu.count) * INSTANCE_BYTES;
+            #[cfg(feature = "testing")]
+            self.checked.push(super::cull_check::Checked {
+                uniform: uniform(d, &o),
+                instances: d.extracted.buffer.clone(),
+                occludes: o.late.is_some(),
+                kept: o.kept..o.kept + bytes,
+                late: o.late.as_ref().map(|l| l.kept..l.kept + bytes),
+            });
+            if !self.chunks.contains_key(&d.chunk) {
+                // Not dispatched (no bind group): its arguments count nothing; drawn whole.
+                continue;
+            }
+            let early = CulledRange {
+                args: u64::from(o.draw * ARGS_WORDS * 4),
+                kept: o.kept..o.kept + bytes,
+            };
+            let late = o.late.as_ref().map(|late| {
+                self.late
+                    .entry(d.view.entity)
+                    .or_insert_with(|| occlusion::LateWork::new(o.draw))
+                    .push(d.chunk, o.draw, late, d.gpu.count);
+                CulledRange {
+                    args: u64::from((self.draw_count + o.draw) * ARGS_WORDS * 4),
+                    kept: late.kept..late.kept + bytes,
+                }
+            });
+            self.draws
+                .insert((d.view.entity, d.chunk), CulledDraw { early, late });
         }
-        let kept = o.kept..o.kept + u64::from(d.gpu.count) * INSTANCE_BYTES;
-        let args = u64::from(o.draw * ARGS_WORDS * 4);
-        culler
-            .draws
-            .insert((d.view.entity, d.chunk), CulledDraw { args, kept });
     }
 }
 
@@ -336,20 +455,23 @@ fn workgroups(count: u32) -> (u32, u32) {
     (x, groups.div_ceil(x))
 }
 
-/// Where one dispatch's data lies: its uniform, its kept instances (bytes), its draw.
+/// Where one dispatch's data lies: its uniform, its kept instances (bytes), its draw; and
+/// its late phase's, where it occludes.
 struct Offsets {
     uniform: u32,
     kept: u64,
     draw: u32,
+    late: Option<occlusion::LateOffsets>,
 }
 
 impl CullInputs<'_, '_> {
-    /// Every (view, chunk) binned this frame, once each, in a stable order.
-    fn dispatches(&self) -> Vec<Dispatch<'_>> {
+    /// Every (view, chunk) binned this frame, once each, in a stable order (a view's
+    /// dispatches together).
+    fn dispatches(&self, occluding: &HashMap<Entity, occlusion::Occluding>) -> Vec<Dispatch<'_>> {
         let views: HashMap<RetainedViewEntity, ViewCull> = self
             .views
             .iter()
-            .map(|(entity, view, frustum, shadow)| {
+            .map(|(entity, view, frustum, shadow, _)| {
                 let eye = match (shadow, self.viewer.0) {
                     (true, Some(eye)) => eye,
                     _ => view.world_from_view.translation(),
@@ -361,6 +483,7 @@ impl CullInputs<'_, '_> {
                     planes,
                     eye,
                     shadow,
+                    occluding: occluding.get(&entity).copied(),
                 };
                 (view.retained_view_entity, cull)
             })
@@ -411,13 +534,14 @@ impl CullInputs<'_, '_> {
 }
 
 impl InstanceCuller {
-    /// Places each dispatch's kept instances in the pool (at the storage offset alignment)
-    /// and makes the pool and argument buffers large enough; `None` when the pool would
-    /// pass the device's largest buffer (the frame draws directly).
+    /// Places each dispatch's kept instances in the pool (at the storage offset alignment;
+    /// twice where it occludes, once a phase) and its marks, and makes the buffers large
+    /// enough; `None` when the pool would pass the device's largest buffer (the frame
+    /// draws directly).
     fn lay_out(&mut self, dispatches: &[Dispatch], device: &RenderDevice) -> Option<Vec<Offsets>> {
         let limits = device.limits();
         let align = u64::from(limits.min_storage_buffer_offset_alignment.max(4));
-        let binding = self.kept_binding(dispatches);
+        let binding = kept_binding(dispatches);
         if binding > limits.max_storage_buffer_binding_size {
             warn_once!(
                 "rwt: a chunk holds more instances than a GPU binding; drawing chunks whole"
@@ -425,17 +549,35 @@ impl InstanceCuller {
             return None;
         }
         let mut offsets = Vec::with_capacity(dispatches.len());
-        let mut end = 0u64;
+        let (mut end, mut marks) = (0u64, 0u32);
+        let mut place = |count: u32| {
+            let at = end.next_multiple_of(align);
+            end = at + u64::from(count) * INSTANCE_BYTES;
+            at
+        };
         for (i, d) in dispatches.iter().enumerate() {
-            let kept = end.next_multiple_of(align);
-            end = kept + u64::from(d.gpu.count) * INSTANCE_BYTES;
+            let kept = place(d.gpu.count);
+            let late = d.occludes().map(|_| {
+                let late = occlusion::LateOffsets {
+                    uniform: 0,
+                    kept: place(d.gpu.count),
+                    marks,
+                };
+                marks += d.gpu.count.div_ceil(32);
+                late
+            });
             offsets.push(Offsets {
                 uniform: 0,
                 kept,
                 draw: i as u32,
+                late,
             });
         }
-        let last = offsets.last().map_or(0, |o| o.kept);
+        let last = offsets
+            .iter()
+            .map(|o| o.late.as_ref().map_or(o.kept, |l| l.kept))
+            .max()
+            .unwrap_or(0);
         let size = (last + binding).max(end);
         if size > limits.max_buffer_size || last > u64::from(u32::MAX) {
             warn_once!(
@@ -443,32 +585,40 @@ impl InstanceCuller {
             );
             return None;
         }
-        grow(
-            &mut self.kept,
-            device,
-            size,
-            "rwt_kept_instances",
-            BufferUsages::VERTEX | BufferUsages::STORAGE,
-        );
-        let args = dispatches.len() as u64 * u64::from(ARGS_WORDS) * 4;
-        // Copied from by the check (`testing`).
+        self.grow(dispatches.len() as u64, size, marks, device);
+        Some(offsets)
+    }
+
+    /// Grows the buffers for `draws` draws, a pool of `kept` bytes and `marks` words.
+    fn grow(&mut self, draws: u64, kept: u64, marks: u32, device: &RenderDevice) {
+        // Cleared once made (below), copied from by the check (`testing`).
+        let usage = BufferUsages::VERTEX
+            | BufferUsages::STORAGE
+            | BufferUsages::COPY_DST
+            | BufferUsages::COPY_SRC;
+        self.fresh_pool |= grow(&mut self.kept, device, kept, "rwt_kept_instances", usage);
+        let block = draws * u64::from(ARGS_WORDS) * 4;
+        // Copied from by the check (`testing`) and the late phase, into by the late phase.
         let usage = BufferUsages::INDIRECT
             | BufferUsages::STORAGE
             | BufferUsages::COPY_DST
             | BufferUsages::COPY_SRC;
-        grow(&mut self.args, device, args, "rwt_cull_args", usage);
-        Some(offsets)
+        grow(&mut self.args, device, 2 * block, "rwt_cull_args", usage);
+        let usage = BufferUsages::COPY_DST | BufferUsages::COPY_SRC;
+        grow(
+            &mut self.phases,
+            device,
+            2 * block,
+            "rwt_cull_phases",
+            usage,
+        );
+        let usage = BufferUsages::STORAGE | BufferUsages::COPY_DST;
+        let marks = u64::from(marks.max(1)) * 4;
+        grow(&mut self.marks, device, marks, "rwt_cull_marks", usage);
     }
 
-    /// The size every chunk's binding of the pool has: the largest chunk's instances.
-    fn kept_binding(&self, dispatches: &[Dispatch]) -> u64 {
-        let most = dispatches.iter().map(|d| d.gpu.count).max().unwrap_or(1);
-        let size = u64::from(most.max(1)) * INSTANCE_BYTES;
-        // Grown in steps, so that bind groups are not made anew for every new largest chunk.
-        size.next_power_of_two()
-    }
-
-    /// Writes the uniforms (their offsets into `offsets`) and the arguments.
+    /// Writes the uniforms (their offsets into `offsets`), the arguments (both blocks with
+    /// no instances) and the early block with no instances the late phase restores.
     fn write(
         &mut self,
         dispatches: &[Dispatch],
@@ -478,35 +628,55 @@ impl InstanceCuller {
     ) {
         self.uniforms.clear();
         let mut args = Vec::with_capacity(dispatches.len() * ARGS_WORDS as usize);
+        let late_block = dispatches.len() as u32 * ARGS_WORDS;
         for (d, o) in dispatches.iter().zip(offsets.iter_mut()) {
-            o.uniform = self.uniforms.push(&uniform(d, o));
+            let early = uniform(d, o);
+            o.uniform = self.uniforms.push(&early);
+            if let (Some(late), Some((_, current))) = (o.late.as_mut(), d.occludes()) {
+                late.uniform = self.uniforms.push(&CullUniform {
+                    clip_from_world: current,
+                    occlusion: UVec4::new(2, late.marks, 0, 0),
+                    slots: early.slots.with_y(late_block + o.draw * ARGS_WORDS + 1),
+                    ..early
+                });
+            }
             args.extend_from_slice(&d.args);
         }
         self.uniforms.write_buffer(device, queue);
-        if let Some(buffer) = &self.args {
-            queue.write_buffer(buffer, 0, bytemuck::cast_slice(&args));
+        let block: &[u8] = bytemuck::cast_slice(&args);
+        if let (Some(buffer), Some(phases)) = (&self.args, &self.phases) {
+            queue.write_buffer(buffer, 0, block);
+            queue.write_buffer(buffer, block.len() as u64, block);
+            queue.write_buffer(phases, block.len() as u64, block);
         }
     }
 
     /// Makes the bind group of each dispatched chunk whose buffers changed; forgets those of
     /// chunks not dispatched.
     fn bind(&mut self, dispatches: &[Dispatch], device: &RenderDevice, cache: &PipelineCache) {
-        let (Some(kept), Some(args), Some(uniforms), Some(uniform)) = (
+        let (Some(kept), Some(args), Some(marks), Some(uniforms), Some(uniform)) = (
             &self.kept,
             &self.args,
+            &self.marks,
             self.uniforms.buffer(),
             self.uniforms.binding(),
         ) else {
             return;
         };
-        let binding = self.kept_binding(dispatches);
+        let binding = kept_binding(dispatches);
         let layout = cache.get_bind_group_layout(&self.layout);
         let mut chunks = HashMap::default();
         for d in dispatches {
             if chunks.contains_key(&d.chunk) {
                 continue;
             }
-            let made_with = [d.gpu.instances.id(), uniforms.id(), kept.id(), args.id()];
+            let made_with = [
+                d.gpu.instances.id(),
+                uniforms.id(),
+                kept.id(),
+                args.id(),
+                marks.id(),
+            ];
             let chunk = match self.chunks.remove(&d.chunk) {
                 Some(c) if c.made_with == made_with && c.kept_binding == binding => c,
                 _ => ChunkCull {
@@ -524,6 +694,7 @@ impl InstanceCuller {
                                 size: NonZero::new(binding),
                             },
                             args.as_entire_binding(),
+                            marks.as_entire_binding(),
                         )),
                     ),
                 },
@@ -534,16 +705,25 @@ impl InstanceCuller {
     }
 }
 
-/// Makes `buffer` anew, of at least `size` bytes (grown by halves), when it is smaller.
+/// The size every chunk's binding of the pool has: the largest chunk's instances.
+fn kept_binding(dispatches: &[Dispatch]) -> u64 {
+    let most = dispatches.iter().map(|d| d.gpu.count).max().unwrap_or(1);
+    let size = u64::from(most.max(1)) * INSTANCE_BYTES;
+    // Grown in steps, so that bind groups are not made anew for every new largest chunk.
+    size.next_power_of_two()
+}
+
+/// Makes `buffer` anew, of at least `size` bytes (grown by halves), when it is smaller;
+/// whether it did.
 fn grow(
     buffer: &mut Option<Buffer>,
     device: &RenderDevice,
     size: u64,
     label: &str,
     usage: BufferUsages,
-) {
+) -> bool {
     if buffer.as_ref().is_some_and(|b| b.size() >= size) {
-        return;
+        return false;
     }
     let size = (size + size / 2).next_multiple_of(256);
     *buffer = Some(device.create_buffer(&BufferDescriptor {
@@ -552,9 +732,10 @@ fn grow(
         usage,
         mapped_at_creation: false,
     }));
+    true
 }
 
-/// The uniform of one dispatch.
+/// The early phase's uniform of one dispatch.
 fn uniform(d: &Dispatch, o: &Offsets) -> CullUniform {
     let u = &d.gpu.uniform;
     let shadow_distance = match (d.view.shadow, d.extracted.shadows) {
@@ -562,6 +743,10 @@ fn uniform(d: &Dispatch, o: &Offsets) -> CullUniform {
         _ => -1.0,
     };
     let (x, _) = workgroups(d.gpu.count);
+    let (clip_from_world, occlusion) = match (d.occludes(), &o.late) {
+        (Some((previous, _)), Some(late)) => (previous, UVec4::new(1, late.marks, 0, 0)),
+        _ => (Mat4::IDENTITY, UVec4::ZERO),
+    };
     CullUniform {
         planes: d.view.planes,
         origin: Vec3::from_slice(&u.origin).extend(d.extracted.reach),
@@ -570,175 +755,7 @@ fn uniform(d: &Dispatch, o: &Offsets) -> CullUniform {
         fade: Vec4::new(u.params[3], 0.0, 0.0, 0.0),
         thinning: Vec4::from_array(u.thinning),
         slots: UVec4::new(d.gpu.count, o.draw * ARGS_WORDS + 1, x, 0),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::reach;
-    use super::super::shader_check::{bare_cache, struct_layout};
-    use super::*;
-    use bevy::asset::uuid::Uuid;
-    use bevy::camera::primitives::Aabb;
-    use bevy::render::render_resource::encase::UniformBuffer;
-    use bevy::shader::Shader;
-
-    #[test]
-    fn the_cull_shader_validates_and_reads_the_uniform_as_rust_writes_it() {
-        let mut cache = bare_cache();
-        let id = AssetId::from(Uuid::from_u128(7));
-        cache.set_shader(
-            id,
-            Shader::from_wgsl(include_str!("cull.wgsl"), "cull.wgsl"),
-        );
-        let types = cache
-            .get(0, id, &[])
-            .expect("cull.wgsl composes and validates");
-        // Each member's first word marked, then found in encase's bytes.
-        let marked = CullUniform {
-            planes: [Vec4::new(1.0, 0.0, 0.0, 0.0); 6],
-            origin: Vec4::new(2.0, 0.0, 0.0, 0.0),
-            eye: Vec4::new(3.0, 0.0, 0.0, 0.0),
-            falloff: Vec4::new(4.0, 0.0, 0.0, 0.0),
-            fade: Vec4::new(5.0, 0.0, 0.0, 0.0),
-            thinning: Vec4::new(7.0, 0.0, 0.0, 0.0),
-            slots: UVec4::new(6, 0, 0, 0),
-        };
-        let mut bytes = UniformBuffer::new(Vec::<u8>::new());
-        bytes.write(&marked).expect("encase writes it");
-        let words: Vec<u32> = bytemuck::pod_collect_to_vec(bytes.as_ref());
-        let at = |word: u32| 4 * words.iter().position(|w| *w == word).expect("a marker");
-        let ours: Vec<(String, usize)> = [
-            ("planes", at(1.0f32.to_bits())),
-            ("origin", at(2.0f32.to_bits())),
-            ("eye", at(3.0f32.to_bits())),
-            ("falloff", at(4.0f32.to_bits())),
-            ("fade", at(5.0f32.to_bits())),
-            ("thinning", at(7.0f32.to_bits())),
-            ("slots", at(6)),
-        ]
-        .into_iter()
-        .map(|(n, o)| (n.to_string(), o))
-        .collect();
-        let size = CullUniform::min_size().get() as usize;
-        assert_eq!(struct_layout(&types, "Cull"), (ours, size));
-    }
-
-    /// An instance at `offset` (from the chunk corner) of scale 1.
-    fn at(offset: Vec3, appear: f32) -> GpuInstance {
-        GpuInstance {
-            offset: offset.to_array(),
-            scale: 1.0,
-            appear: (appear * 65535.0) as u16,
-            ..default()
-        }
-    }
-
-    #[test]
-    fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
-        // A view looking down +x from the origin: half-spaces x > 0 and |z| < x.
-        let planes = [
-            Vec4::new(1.0, 0.0, 0.0, 0.0),
-            Vec4::new(1.0, 0.0, 1.0, 0.0).normalize(),
-            Vec4::new(1.0, 0.0, -1.0, 0.0).normalize(),
-            Vec4::W,
-            Vec4::W,
-            Vec4::W,
-        ];
-        let uniform = CullUniform {
-            planes,
-            origin: Vec4::new(0.0, 0.0, 0.0, 0.5),
-            eye: Vec4::new(0.0, 0.0, 0.0, -1.0),
-            falloff: Vec4::new(10.0, 20.0, 1.0, 0.0),
-            fade: Vec4::new(0.1, 0.0, 0.0, 0.0),
-            thinning: Vec4::ZERO,
-            slots: UVec4::ZERO,
-        };
-        assert!(uniform.keeps(&at(Vec3::new(5.0, 0.0, 0.0), 0.5)));
-        // Behind the eye, or beside the view by more than its reach: culled.
-        assert!(!uniform.keeps(&at(Vec3::new(-1.0, 0.0, 0.0), 0.0)));
-        assert!(!uniform.keeps(&at(Vec3::new(3.0, 0.0, 4.0), 0.0)));
-        // Beside it by less than its reach: kept.
-        assert!(uniform.keeps(&at(Vec3::new(3.0, 0.0, 3.3), 0.0)));
-        // At 15 m the factor is 0.5: the instances of rank above it have not grown.
-        assert!(uniform.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.45)));
-        assert!(!uniform.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.55)));
-        // Without the fade every rank is drawn.
-        let no_fade = CullUniform {
-            falloff: Vec4::ZERO,
-            ..uniform
-        };
-        assert!(no_fade.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.95)));
-        // In a shadow view, beyond the class's shadow distance from the camera: culled.
-        let shadow = CullUniform {
-            eye: Vec4::new(0.0, 0.0, 0.0, 8.0),
-            ..no_fade
-        };
-        assert!(shadow.keeps(&at(Vec3::new(8.4, 0.0, 0.0), 0.0)));
-        assert!(!shadow.keeps(&at(Vec3::new(8.6, 0.0, 0.0), 0.0)));
-        // Thinned from 20 m: at 40 m a quarter is kept, the lowest ranks; nearer, all.
-        let thinned = CullUniform {
-            thinning: Vec4::new(20.0, 0.1, 1.0, 0.0),
-            ..no_fade
-        };
-        assert!(thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.2)));
-        assert!(!thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.3)));
-        assert!(thinned.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.99)));
-        // Down to the floor, however far.
-        assert!(thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.09)));
-        assert!(!thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.13)));
-        // A widened instance is kept by a view it reaches into only widened (a fraction of
-        // a quarter at 40 m: four times as wide).
-        let beside = Vec3::new(40.0, 0.0, 40.0 + 1.2 * std::f32::consts::SQRT_2);
-        assert!(thinned.keeps(&at(beside, 0.0)));
-        assert!(!no_fade.keeps(&at(beside, 0.0)));
-    }
-
-    #[test]
-    fn the_reach_holds_every_vertex_turned_tilted_and_swaying() {
-        // A blade 0.1 wide and 0.7 tall; instances up to 1.5 times its size.
-        let (mesh_lo, mesh_hi) = (Vec3::new(-0.05, 0.0, -0.01), Vec3::new(0.05, 0.7, 0.04));
-        let roots = (Vec3::new(0.0, -2.0, 0.0), Vec3::new(16.0, 3.0, 16.0));
-        let max_scale = 1.5;
-        // The chunk's bounds as `InstancedChunk::aabb` makes them.
-        let reach_xz = mesh_lo.abs().max(mesh_hi.abs());
-        let across = reach_xz.x.max(reach_xz.z) * std::f32::consts::SQRT_2;
-        let horizontal = (across + reach_xz.y) * max_scale;
-        let below = (mesh_lo.y.min(0.0) - across) * max_scale;
-        let local = Aabb::from_min_max(
-            roots.0 + Vec3::new(-horizontal, below, -horizontal),
-            roots.1 + Vec3::new(horizontal, mesh_hi.y * max_scale, horizontal),
-        );
-        let r = reach(&local, roots, max_scale, true);
-        let corners = (0..8).map(|i| {
-            let pick = |bit: u32, lo: f32, hi: f32| if i >> bit & 1 == 1 { hi } else { lo };
-            Vec3::new(
-                pick(0, mesh_lo.x, mesh_hi.x),
-                pick(1, mesh_lo.y, mesh_hi.y),
-                pick(2, mesh_lo.z, mesh_hi.z),
-            )
-        });
-        let corners: Vec<Vec3> = corners.collect();
-        for k in 0..64u16 {
-            // Tilted any way (up to 75 degrees), or upright and swaying by up to its height.
-            let tilted = k % 2 == 1;
-            let up = Vec3::new((k as f32 * 0.7).sin(), 1.0, (k as f32 * 1.3).cos()).normalize();
-            let g = GpuInstance {
-                yaw: k * 1021,
-                tilt: if tilted { GpuInstance::pack_up(up) } else { 0 },
-                ..default()
-            };
-            let sway = if tilted {
-                Vec3::ZERO
-            } else {
-                Vec3::X * mesh_hi.y
-            };
-            for &c in &corners {
-                let placed = g.rotation() * c + sway * (c.y / mesh_hi.y);
-                assert!(placed.length() <= r, "{placed} beyond {r}");
-            }
-        }
-        assert!(r < 2.0, "a reach of {r} culls nothing");
-        assert_eq!(reach(&local, roots, max_scale, false), f32::MAX);
+        clip_from_world,
+        occlusion,
     }
 }

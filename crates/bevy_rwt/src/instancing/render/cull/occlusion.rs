@@ -1,0 +1,258 @@
+//! Occlusion for culling per instance, in a camera with Bevy's `OcclusionCulling` and
+//! `DepthPrepass` (and so a `ViewDepthPyramid`).
+//!
+//! The early phase runs with the rest of culling, before the frame's passes: an instance
+//! last frame's pyramid hides, seen from last frame's view, is marked rather than kept. The
+//! early depth prepass draws what was kept; Bevy reduces it into this frame's pyramid; then
+//! [`cull_late`] tests the marked instances against it and keeps, into each draw's late
+//! range, those it does not hide. The late prepass draws the late ranges only (the early
+//! block of arguments is put aside, and counts nothing meanwhile); [`restore_early`] puts
+//! it back for the main pass, which draws both. What the early depth holds, the frame
+//! holds too, so an instance seen this frame is never dropped, however the view moved.
+
+use super::{ARGS_WORDS, InstanceCuller, workgroups};
+use bevy::core_pipeline::mip_generation::experimental::depth::ViewDepthPyramid;
+use bevy::core_pipeline::prepass::DepthPrepass;
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::render::render_resource::binding_types::texture_2d;
+use bevy::render::render_resource::*;
+use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
+use bevy::render::view::ExtractedView;
+use std::ops::Range;
+
+/// What culling reads of a view to occlude: its pyramid, and whether it has a depth prepass.
+pub(super) type PyramidQuery = (Option<&'static ViewDepthPyramid>, Has<DepthPrepass>);
+
+/// A view as [`Pyramids::prepare`] reads it: its entity, itself, whether it is a shadow
+/// view, and its [`PyramidQuery`].
+pub(super) type ViewPyramid<'a> = (
+    Entity,
+    &'a ExtractedView,
+    bool,
+    (Option<&'a ViewDepthPyramid>, bool),
+);
+
+/// How a view occludes this frame: its clip space from world space, and last frame's where
+/// its pyramid still holds last frame's depth.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Occluding {
+    pub current: Mat4,
+    pub previous: Option<Mat4>,
+}
+
+/// One occluding view's pyramid as culling binds it.
+struct Pyramid {
+    texture: TextureViewId,
+    /// The view's clip space from world space at the frame it was last culled.
+    clip_from_world: Mat4,
+    bind_group: BindGroup,
+}
+
+/// The pyramids views occlude with, and one that hides nothing for the other views.
+pub(super) struct Pyramids {
+    layout: BindGroupLayoutDescriptor,
+    none_texture: TextureView,
+    none: Option<BindGroup>,
+    by_view: HashMap<Entity, Pyramid>,
+}
+
+impl Pyramids {
+    pub fn new(device: &RenderDevice) -> Self {
+        let layout = BindGroupLayoutDescriptor::new(
+            "rwt_cull_pyramid",
+            &BindGroupLayoutEntries::single(
+                ShaderStages::COMPUTE,
+                texture_2d(TextureSampleType::Float { filterable: false }),
+            ),
+        );
+        // Zeroed: the farthest depth everywhere, which hides nothing.
+        let texture = device.create_texture(&TextureDescriptor {
+            label: Some("rwt_cull_no_pyramid"),
+            size: Extent3d::default(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: TextureDimension::D2,
+            format: TextureFormat::R32Float,
+            usage: TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        Self {
+            layout,
+            none_texture: texture.create_view(&TextureViewDescriptor::default()),
+            none: None,
+            by_view: HashMap::default(),
+        }
+    }
+
+    pub fn layout(&self) -> &BindGroupLayoutDescriptor {
+        &self.layout
+    }
+
+    /// The bind group `view` culls with this frame.
+    pub fn bind_group(&self, view: Entity) -> Option<&BindGroup> {
+        self.by_view
+            .get(&view)
+            .map(|p| &p.bind_group)
+            .or(self.none.as_ref())
+    }
+
+    /// Binds the pyramid of each camera view that occludes, and says how each occludes.
+    pub fn prepare<'a>(
+        &mut self,
+        views: impl IntoIterator<Item = ViewPyramid<'a>>,
+        device: &RenderDevice,
+        cache: &PipelineCache,
+    ) -> HashMap<Entity, Occluding> {
+        let layout = cache.get_bind_group_layout(&self.layout);
+        if self.none.is_none() {
+            let entries = BindGroupEntries::single(&self.none_texture);
+            self.none = Some(device.create_bind_group("rwt_cull_no_pyramid", &layout, &entries));
+        }
+        let mut occluding = HashMap::default();
+        let mut by_view = HashMap::default();
+        for (entity, view, shadow, (pyramid, depth_prepass)) in views {
+            let Some(pyramid) = pyramid.filter(|_| depth_prepass && !shadow) else {
+                continue;
+            };
+            let current = view.clip_from_world.unwrap_or_else(|| {
+                view.clip_from_view * view.world_from_view.to_matrix().inverse()
+            });
+            let texture = pyramid.all_mips.id();
+            let (previous, bind_group) = match self.by_view.remove(&entity) {
+                Some(p) if p.texture == texture => (Some(p.clip_from_world), p.bind_group),
+                _ => {
+                    let entries = BindGroupEntries::single(&pyramid.all_mips);
+                    let bind_group =
+                        device.create_bind_group("rwt_cull_pyramid", &layout, &entries);
+                    (None, bind_group)
+                }
+            };
+            occluding.insert(entity, Occluding { current, previous });
+            let clip_from_world = current;
+            by_view.insert(
+                entity,
+                Pyramid {
+                    texture,
+                    clip_from_world,
+                    bind_group,
+                },
+            );
+        }
+        self.by_view = by_view;
+        occluding
+    }
+}
+
+/// Where one dispatch's late phase lies: its uniform, its kept instances (bytes), its
+/// first word of marks.
+pub(super) struct LateOffsets {
+    pub uniform: u32,
+    pub kept: u64,
+    pub marks: u32,
+}
+
+/// One chunk's late dispatch.
+struct LateDispatch {
+    chunk: Entity,
+    uniform: u32,
+    kept: u64,
+    count: u32,
+}
+
+/// One view's late phase this frame: its draws (records of the early block) and dispatches.
+pub(super) struct LateWork {
+    draws: Range<u32>,
+    dispatches: Vec<LateDispatch>,
+}
+
+impl LateWork {
+    pub fn new(draw: u32) -> Self {
+        Self {
+            draws: draw..draw,
+            dispatches: Vec::new(),
+        }
+    }
+
+    pub fn push(&mut self, chunk: Entity, draw: u32, offsets: &LateOffsets, count: u32) {
+        self.draws.end = self.draws.end.max(draw + 1);
+        self.dispatches.push(LateDispatch {
+            chunk,
+            uniform: offsets.uniform,
+            kept: offsets.kept,
+            count,
+        });
+    }
+
+    /// The view's records of the early block, in bytes.
+    fn bytes(&self) -> Range<u64> {
+        let record = u64::from(ARGS_WORDS) * 4;
+        u64::from(self.draws.start) * record..u64::from(self.draws.end) * record
+    }
+}
+
+/// After the early depth prepass is reduced into the view's pyramid: culls the instances
+/// the early phase hid against it, puts the early block aside and zeroes its counts for the
+/// late prepass.
+pub(in crate::instancing) fn cull_late(
+    view: ViewQuery<Entity>,
+    culler: Option<Res<InstanceCuller>>,
+    cache: Res<PipelineCache>,
+    mut ctx: RenderContext,
+) {
+    let Some(culler) = culler else { return };
+    let Some(work) = culler.late.get(&view.entity()) else {
+        return;
+    };
+    let pipeline = culler.pipeline.and_then(|p| cache.get_compute_pipeline(p));
+    let (Some(pipeline), Some(args), Some(phases), Some(pyramid)) = (
+        pipeline,
+        &culler.args,
+        &culler.phases,
+        culler.pyramids.bind_group(view.entity()),
+    ) else {
+        return;
+    };
+    let encoder = ctx.command_encoder();
+    {
+        let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor {
+            label: Some("rwt_cull_late"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(1, pyramid, &[]);
+        for d in &work.dispatches {
+            let Some(chunk) = culler.chunks.get(&d.chunk) else {
+                continue;
+            };
+            pass.set_bind_group(0, &chunk.bind_group, &[d.uniform, d.kept as u32]);
+            let (x, y) = workgroups(d.count);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+    }
+    let bytes = work.bytes();
+    let block = u64::from(culler.draw_count * ARGS_WORDS * 4);
+    let size = bytes.end - bytes.start;
+    encoder.copy_buffer_to_buffer(args, bytes.start, phases, bytes.start, size);
+    encoder.copy_buffer_to_buffer(phases, block + bytes.start, args, bytes.start, size);
+}
+
+/// After the late prepass: puts the view's early block back for the main pass.
+pub(in crate::instancing) fn restore_early(
+    view: ViewQuery<Entity>,
+    culler: Option<Res<InstanceCuller>>,
+    mut ctx: RenderContext,
+) {
+    let Some(culler) = culler else { return };
+    let (Some(work), Some(args), Some(phases)) = (
+        culler.late.get(&view.entity()),
+        &culler.args,
+        &culler.phases,
+    ) else {
+        return;
+    };
+    let bytes = work.bytes();
+    let size = bytes.end - bytes.start;
+    ctx.command_encoder()
+        .copy_buffer_to_buffer(phases, bytes.start, args, bytes.start, size);
+}

@@ -1,0 +1,174 @@
+//! The culling shader's layout, its keep rules on the CPU, and the reach it tests.
+
+use super::super::reach;
+use super::super::shader_check::{bare_cache, struct_layout};
+use super::*;
+use bevy::asset::uuid::Uuid;
+use bevy::camera::primitives::Aabb;
+use bevy::render::render_resource::encase::UniformBuffer;
+use bevy::shader::Shader;
+
+#[test]
+fn the_cull_shader_validates_and_reads_the_uniform_as_rust_writes_it() {
+    let mut cache = bare_cache();
+    let id = AssetId::from(Uuid::from_u128(7));
+    cache.set_shader(
+        id,
+        Shader::from_wgsl(include_str!("cull.wgsl"), "cull.wgsl"),
+    );
+    let types = cache
+        .get(0, id, &[])
+        .expect("cull.wgsl composes and validates");
+    // Each member's first word marked, then found in encase's bytes.
+    let marked = CullUniform {
+        planes: [Vec4::new(1.0, 0.0, 0.0, 0.0); 6],
+        origin: Vec4::new(2.0, 0.0, 0.0, 0.0),
+        eye: Vec4::new(3.0, 0.0, 0.0, 0.0),
+        falloff: Vec4::new(4.0, 0.0, 0.0, 0.0),
+        fade: Vec4::new(5.0, 0.0, 0.0, 0.0),
+        thinning: Vec4::new(7.0, 0.0, 0.0, 0.0),
+        slots: UVec4::new(6, 0, 0, 0),
+        clip_from_world: Mat4::from_cols_array(&[8.0; 16]),
+        occlusion: UVec4::new(9, 0, 0, 0),
+    };
+    let mut bytes = UniformBuffer::new(Vec::<u8>::new());
+    bytes.write(&marked).expect("encase writes it");
+    let words: Vec<u32> = bytemuck::pod_collect_to_vec(bytes.as_ref());
+    let at = |word: u32| 4 * words.iter().position(|w| *w == word).expect("a marker");
+    let ours: Vec<(String, usize)> = [
+        ("planes", at(1.0f32.to_bits())),
+        ("origin", at(2.0f32.to_bits())),
+        ("eye", at(3.0f32.to_bits())),
+        ("falloff", at(4.0f32.to_bits())),
+        ("fade", at(5.0f32.to_bits())),
+        ("thinning", at(7.0f32.to_bits())),
+        ("slots", at(6)),
+        ("clip_from_world", at(8.0f32.to_bits())),
+        ("occlusion", at(9)),
+    ]
+    .into_iter()
+    .map(|(n, o)| (n.to_string(), o))
+    .collect();
+    let size = CullUniform::min_size().get() as usize;
+    assert_eq!(struct_layout(&types, "Cull"), (ours, size));
+}
+
+/// An instance at `offset` (from the chunk corner) of scale 1.
+fn at(offset: Vec3, appear: f32) -> GpuInstance {
+    GpuInstance {
+        offset: offset.to_array(),
+        scale: 1.0,
+        appear: (appear * 65535.0) as u16,
+        ..default()
+    }
+}
+
+#[test]
+fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
+    // A view looking down +x from the origin: half-spaces x > 0 and |z| < x.
+    let planes = [
+        Vec4::new(1.0, 0.0, 0.0, 0.0),
+        Vec4::new(1.0, 0.0, 1.0, 0.0).normalize(),
+        Vec4::new(1.0, 0.0, -1.0, 0.0).normalize(),
+        Vec4::W,
+        Vec4::W,
+        Vec4::W,
+    ];
+    let uniform = CullUniform {
+        planes,
+        origin: Vec4::new(0.0, 0.0, 0.0, 0.5),
+        eye: Vec4::new(0.0, 0.0, 0.0, -1.0),
+        falloff: Vec4::new(10.0, 20.0, 1.0, 0.0),
+        fade: Vec4::new(0.1, 0.0, 0.0, 0.0),
+        thinning: Vec4::ZERO,
+        slots: UVec4::ZERO,
+        clip_from_world: Mat4::IDENTITY,
+        occlusion: UVec4::ZERO,
+    };
+    assert!(uniform.keeps(&at(Vec3::new(5.0, 0.0, 0.0), 0.5)));
+    // Behind the eye, or beside the view by more than its reach: culled.
+    assert!(!uniform.keeps(&at(Vec3::new(-1.0, 0.0, 0.0), 0.0)));
+    assert!(!uniform.keeps(&at(Vec3::new(3.0, 0.0, 4.0), 0.0)));
+    // Beside it by less than its reach: kept.
+    assert!(uniform.keeps(&at(Vec3::new(3.0, 0.0, 3.3), 0.0)));
+    // At 15 m the factor is 0.5: the instances of rank above it have not grown.
+    assert!(uniform.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.45)));
+    assert!(!uniform.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.55)));
+    // Without the fade every rank is drawn.
+    let no_fade = CullUniform {
+        falloff: Vec4::ZERO,
+        ..uniform
+    };
+    assert!(no_fade.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.95)));
+    // In a shadow view, beyond the class's shadow distance from the camera: culled.
+    let shadow = CullUniform {
+        eye: Vec4::new(0.0, 0.0, 0.0, 8.0),
+        ..no_fade
+    };
+    assert!(shadow.keeps(&at(Vec3::new(8.4, 0.0, 0.0), 0.0)));
+    assert!(!shadow.keeps(&at(Vec3::new(8.6, 0.0, 0.0), 0.0)));
+    // Thinned from 20 m: at 40 m a quarter is kept, the lowest ranks; nearer, all.
+    let thinned = CullUniform {
+        thinning: Vec4::new(20.0, 0.1, 1.0, 0.0),
+        ..no_fade
+    };
+    assert!(thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.2)));
+    assert!(!thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.3)));
+    assert!(thinned.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.99)));
+    // Down to the floor, however far.
+    assert!(thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.09)));
+    assert!(!thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.13)));
+    // A widened instance is kept by a view it reaches into only widened (a fraction of
+    // a quarter at 40 m: four times as wide).
+    let beside = Vec3::new(40.0, 0.0, 40.0 + 1.2 * std::f32::consts::SQRT_2);
+    assert!(thinned.keeps(&at(beside, 0.0)));
+    assert!(!no_fade.keeps(&at(beside, 0.0)));
+}
+
+#[test]
+fn the_reach_holds_every_vertex_turned_tilted_and_swaying() {
+    // A blade 0.1 wide and 0.7 tall; instances up to 1.5 times its size.
+    let (mesh_lo, mesh_hi) = (Vec3::new(-0.05, 0.0, -0.01), Vec3::new(0.05, 0.7, 0.04));
+    let roots = (Vec3::new(0.0, -2.0, 0.0), Vec3::new(16.0, 3.0, 16.0));
+    let max_scale = 1.5;
+    // The chunk's bounds as `InstancedChunk::aabb` makes them.
+    let reach_xz = mesh_lo.abs().max(mesh_hi.abs());
+    let across = reach_xz.x.max(reach_xz.z) * std::f32::consts::SQRT_2;
+    let horizontal = (across + reach_xz.y) * max_scale;
+    let below = (mesh_lo.y.min(0.0) - across) * max_scale;
+    let local = Aabb::from_min_max(
+        roots.0 + Vec3::new(-horizontal, below, -horizontal),
+        roots.1 + Vec3::new(horizontal, mesh_hi.y * max_scale, horizontal),
+    );
+    let r = reach(&local, roots, max_scale, true);
+    let corners = (0..8).map(|i| {
+        let pick = |bit: u32, lo: f32, hi: f32| if i >> bit & 1 == 1 { hi } else { lo };
+        Vec3::new(
+            pick(0, mesh_lo.x, mesh_hi.x),
+            pick(1, mesh_lo.y, mesh_hi.y),
+            pick(2, mesh_lo.z, mesh_hi.z),
+        )
+    });
+    let corners: Vec<Vec3> = corners.collect();
+    for k in 0..64u16 {
+        // Tilted any way (up to 75 degrees), or upright and swaying by up to its height.
+        let tilted = k % 2 == 1;
+        let up = Vec3::new((k as f32 * 0.7).sin(), 1.0, (k as f32 * 1.3).cos()).normalize();
+        let g = GpuInstance {
+            yaw: k * 1021,
+            tilt: if tilted { GpuInstance::pack_up(up) } else { 0 },
+            ..default()
+        };
+        let sway = if tilted {
+            Vec3::ZERO
+        } else {
+            Vec3::X * mesh_hi.y
+        };
+        for &c in &corners {
+            let placed = g.rotation() * c + sway * (c.y / mesh_hi.y);
+            assert!(placed.length() <= r, "{placed} beyond {r}");
+        }
+    }
+    assert!(r < 2.0, "a reach of {r} culls nothing");
+    assert_eq!(reach(&local, roots, max_scale, false), f32::MAX);
+}

@@ -1,0 +1,230 @@
+//! Occlusion in culling per instance, checked in a real renderer (`scripts/smoke.sh` runs
+//! it under Xvfb and lavapipe): `cargo run --example gpu_occlusion`.
+//!
+//! A field of grass around a hill, no wind, and a camera with Bevy's `DepthPrepass` and
+//! `OcclusionCulling`. The camera waits low behind the hill, where the hill hides the field
+//! beyond it, then rises in one frame to look over it: that frame's early phase still tests
+//! against the depth seen from below, which hid the field, so everything it now shows,
+//! down to the blades whose tips peek over the crest, must be kept by the late phase.
+//!
+//! The rising frame is taken twice: with chunks drawn whole
+//! ([`InstanceCulling::PerChunk`], no occlusion), then culled per instance with occlusion,
+//! and [`CullingCheck`] reads back that frame's counts. It prints `rwt-occlusion: draws D
+//! occluding O instances N kept G (gpu) C (frustum) late L, pixel difference P, pixels
+//! differing X` and exits with an error unless the two frames match ([`MOST_DIFFERENCE`],
+//! [`MOST_PIXELS`]), occlusion dropped instances, the late phase kept some, and no draw
+//! kept more than the frustum alone keeps. Screenshots go to `RWT_OCCLUSION_DIR` (default
+//! `target/occlusion`).
+
+use bevy::app::AppExit;
+use bevy::core_pipeline::prepass::DepthPrepass;
+use bevy::light::CascadeShadowConfigBuilder;
+use bevy::prelude::*;
+use bevy::render::occlusion_culling::OcclusionCulling;
+use bevy_rwt::prelude::*;
+use bevy_rwt::testing::{CullingCheck, CullingReport};
+use rwt_examples::frame_check::{Captures, mean_difference, output_dir, pixels_differing};
+use rwt_examples::grass_field;
+use rwt_examples::prelude::*;
+
+/// Most mean difference between the two frames (0..255 a channel).
+const MOST_DIFFERENCE: f64 = 0.05;
+/// Most pixels that may differ by more than [`BY`] in some channel.
+const MOST_PIXELS: usize = 20;
+/// What a channel may differ by in a pixel that matches.
+const BY: u8 = 24;
+/// Frames each step waits once streaming has settled (pipelines compile on the CPU).
+const WAIT: u32 = 12;
+/// Most frames the check may take.
+const PATIENCE: u32 = 600;
+
+/// The camera's rest: low behind the hill, which hides the field beyond it.
+fn low() -> Transform {
+    Transform::from_xyz(-30.0, 1.2, 0.0).looking_at(Vec3::new(30.0, 1.2, 0.0), Vec3::Y)
+}
+
+/// The camera risen to look over the hill.
+fn high() -> Transform {
+    Transform::from_xyz(-30.0, 15.0, 0.0).looking_at(Vec3::new(20.0, 0.0, 0.0), Vec3::Y)
+}
+
+fn main() -> AppExit {
+    App::new()
+        .add_plugins(example_plugins("rwt gpu_occlusion"))
+        .add_plugins(RwtPlugins::default())
+        .insert_resource(RwtWind {
+            strength: 0.0,
+            ..default()
+        })
+        .insert_resource(InstanceCulling::PerChunk)
+        .init_resource::<CullingCheck>()
+        .init_resource::<Check>()
+        .init_resource::<Captures>()
+        .add_systems(Startup, setup)
+        .add_systems(Update, run_check)
+        .run()
+}
+
+fn setup(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let soil = materials.add(Color::srgb(0.2, 0.3, 0.1));
+    commands.spawn((
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(160.0, 160.0))),
+        MeshMaterial3d(soil.clone()),
+    ));
+    // A hill 6 m high and 28 m across; the field runs on under it.
+    commands.spawn((
+        Mesh3d(meshes.add(Sphere::new(20.0).mesh().uv(64, 32))),
+        MeshMaterial3d(soil),
+        Transform::from_xyz(0.0, -14.0, 0.0),
+    ));
+    commands.spawn((
+        Camera3d::default(),
+        DepthPrepass,
+        OcclusionCulling,
+        RwtViewer::all_around(),
+        low(),
+    ));
+    commands.spawn((
+        DirectionalLight {
+            shadow_maps_enabled: true,
+            ..default()
+        },
+        Transform::from_xyz(1.0, 2.0, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
+        // One cascade: a software driver draws every cascade on the CPU.
+        CascadeShadowConfigBuilder {
+            num_cascades: 1,
+            maximum_distance: 60.0,
+            ..default()
+        }
+        .build(),
+    ));
+    let blade = meshes.add(grass_field::blade());
+    let grass = ScatterClass::instanced(LayerDensity::Constant(8.0), blade, default());
+    commands.spawn(
+        ScatterLayer::new(vec![grass])
+            .with_tile_size(2.0)
+            .with_streaming(StreamingConfig {
+                chunk_size: 8.0,
+                load_distance: 64.0,
+                unload_distance: 72.0,
+                near_distance: 64.0,
+            }),
+    );
+}
+
+/// The check's progress: frames since streaming settled (or the camera came back down),
+/// the report.
+#[derive(Resource, Default)]
+struct Check {
+    settled_at: Option<u32>,
+    frame: u32,
+    report: Option<CullingReport>,
+}
+
+/// The culling setting and its check.
+#[derive(bevy::ecs::system::SystemParam)]
+struct Culling<'w> {
+    setting: ResMut<'w, InstanceCulling>,
+    check: Res<'w, CullingCheck>,
+}
+
+fn run_check(
+    mut check: ResMut<Check>,
+    mut captures: ResMut<Captures>,
+    stats: Res<RwtStats>,
+    mut culling: Culling,
+    mut camera: Single<&mut Transform, With<Camera3d>>,
+    mut commands: Commands,
+    mut exit: MessageWriter<AppExit>,
+) {
+    check.frame += 1;
+    if check.frame > PATIENCE {
+        eprintln!("rwt-occlusion: FAIL no result in {PATIENCE} frames");
+        exit.write(AppExit::error());
+        return;
+    }
+    let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && stats.live_instanced > 0;
+    let Some(since) = check.settled_at else {
+        if settled {
+            check.settled_at = Some(check.frame);
+        }
+        return;
+    };
+    if check.report.is_none() && captures.get("whole").is_some() {
+        check.report = culling.check.report();
+    }
+    if captures.pending() || check.frame < since + WAIT {
+        return;
+    }
+    let dir = output_dir("RWT_OCCLUSION_DIR", "target/occlusion");
+    match (captures.get("whole"), captures.get("occluded")) {
+        (None, _) => {
+            **camera = high();
+            captures.capture(&mut commands, "whole", dir);
+        }
+        (Some(_), None) if *culling.setting == InstanceCulling::PerChunk => {
+            // Back down behind the hill, culling per instance, until last frame's depth
+            // is the hill's again.
+            **camera = low();
+            *culling.setting = InstanceCulling::PerInstance;
+            check.settled_at = Some(check.frame);
+        }
+        (Some(_), None) => {
+            **camera = high();
+            culling.check.request();
+            captures.capture(&mut commands, "occluded", dir);
+        }
+        (Some(whole), Some(occluded)) => {
+            let Some(report) = check.report else { return };
+            let passed = conclude(&report, whole, occluded);
+            exit.write(if passed {
+                AppExit::Success
+            } else {
+                AppExit::error()
+            });
+        }
+    }
+}
+
+/// Prints the result line; whether every check passed.
+fn conclude(report: &CullingReport, whole: &image::RgbImage, occluded: &image::RgbImage) -> bool {
+    let difference = mean_difference(whole, occluded);
+    let differing = pixels_differing(whole, occluded, BY);
+    println!(
+        "rwt-occlusion: draws {} occluding {} instances {} kept {} (gpu) {} (frustum) late {}, pixel difference {difference:.3}, pixels differing {differing}",
+        report.draws,
+        report.occluding_draws,
+        report.instances,
+        report.gpu_kept,
+        report.cpu_kept,
+        report.late_kept
+    );
+    let failures = [
+        (report.occluding_draws == 0, "no draw occluded"),
+        (
+            report.mismatched > 0,
+            "a draw kept more than its frustum keeps, or counts where it does not occlude differ",
+        ),
+        (
+            report.gpu_kept >= report.cpu_kept,
+            "occlusion dropped no instance",
+        ),
+        (report.late_kept == 0, "the late phase kept nothing"),
+        (
+            difference >= MOST_DIFFERENCE || differing > MOST_PIXELS,
+            "the occluded frame differs from the whole one",
+        ),
+    ];
+    let mut passed = true;
+    for (failed, what) in failures {
+        if failed {
+            println!("rwt-occlusion: FAIL {what}");
+            passed = false;
+        }
+    }
+    passed
+}

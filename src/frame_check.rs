@@ -1,0 +1,80 @@
+//! Frames compared in a real renderer: screenshots captured by name into [`Captures`]
+//! (and saved as PNG), and their differences.
+
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use std::path::PathBuf;
+
+/// The frames captured so far, by name, and whether a capture is under way.
+#[derive(Resource, Default)]
+pub struct Captures {
+    frames: HashMap<&'static str, image::RgbImage>,
+    pending: bool,
+}
+
+impl Captures {
+    /// The frame captured as `name`.
+    pub fn get(&self, name: &str) -> Option<&image::RgbImage> {
+        self.frames.get(name)
+    }
+
+    /// Whether a capture is under way.
+    pub fn pending(&self) -> bool {
+        self.pending
+    }
+
+    /// Captures the next frame as `name` and saves it as `name.png` in `dir`.
+    pub fn capture(&mut self, commands: &mut Commands, name: &'static str, dir: PathBuf) {
+        self.pending = true;
+        commands.spawn(Screenshot::primary_window()).observe(
+            move |captured: On<ScreenshotCaptured>, mut captures: ResMut<Captures>| {
+                captures.pending = false;
+                let Ok(image) = captured.image.clone().try_into_dynamic() else {
+                    return;
+                };
+                let rgb = image.to_rgb8();
+                let file = dir.join(format!("{name}.png"));
+                if std::fs::create_dir_all(&dir).is_ok()
+                    && let Err(error) = rgb.save(&file)
+                {
+                    eprintln!("cannot save {}: {error}", file.display());
+                }
+                captures.frames.insert(name, rgb);
+            },
+        );
+    }
+}
+
+/// The folder named by the environment variable `var`, or `default`.
+pub fn output_dir(var: &str, default: &str) -> PathBuf {
+    std::env::var_os(var)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(default))
+}
+
+/// Mean absolute difference of two images' channels (255 when their sizes differ).
+pub fn mean_difference(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
+    if a.dimensions() != b.dimensions() {
+        return 255.0;
+    }
+    let total: u64 = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(x, y)| u64::from(x.abs_diff(*y)))
+        .sum();
+    total as f64 / a.as_raw().len().max(1) as f64
+}
+
+/// Pixels of which some channel differs by more than `by` (every pixel when the sizes
+/// differ).
+pub fn pixels_differing(a: &image::RgbImage, b: &image::RgbImage, by: u8) -> usize {
+    if a.dimensions() != b.dimensions() {
+        return a.pixels().len().max(b.pixels().len());
+    }
+    a.pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > by))
+        .count()
+}
