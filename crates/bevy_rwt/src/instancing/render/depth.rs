@@ -248,7 +248,7 @@ pub(in crate::instancing) fn queue_shadows(
                 };
                 Some((batch_set, bin, (entity, *main_entity)))
             });
-        queued.rebin(view.retained_view_entity, phase, items.collect::<Vec<_>>());
+        queued.rebin_phase(view.retained_view_entity, phase, items.collect::<Vec<_>>());
     }
     queued.end_frame();
 }

@@ -18,33 +18,49 @@
 #import bevy_pbr::view_transformations::position_world_to_clip
 
 struct Chunk {
-    // Chunk corner (xyz), mesh top (w).
-    origin: vec4<f32>,
+    // The chunk's corner, and the mesh's top (its height at scale 1).
+    origin: vec3<f32>,
+    mesh_top: f32,
     base_color: vec4<f32>,
     tip_color: vec4<f32>,
-    // Colour variation, roughness, wind response, fade band.
-    params: vec4<f32>,
-    // Fall-off near, far, enabled, floor.
-    falloff: vec4<f32>,
-    // Wind direction (x, z), strength, frequency.
-    wind: vec4<f32>,
-    // Wind speed.
-    wind_motion: vec4<f32>,
-    // Height fraction where the tip colour starts, bend response, alpha cut-off, 1 when
-    // textured.
-    shading: vec4<f32>,
-    // Far thinning: its distance, its floor, 1 when on.
-    thinning: vec4<f32>,
+    color_variation: f32,
+    roughness: f32,
+    wind_response: f32,
+    // The band of ranks an instance grows over.
+    fade_band: f32,
+    // The level of detail's fall-off: near, far, the factor's floor; 1 when on.
+    falloff_near: f32,
+    falloff_far: f32,
+    falloff_floor: f32,
+    falloff_on: u32,
+    // The wind: its direction (x, z), strength, frequency and speed.
+    wind_direction: vec2<f32>,
+    wind_strength: f32,
+    wind_frequency: f32,
+    wind_speed: f32,
+    // Height fraction where the tip colour starts.
+    tip_from: f32,
+    bend_response: f32,
+    alpha_cutoff: f32,
+    // 1 when the class has a texture.
+    textured: u32,
+    // Far thinning: its distance, its floor; 1 when on.
+    thinning_from: f32,
+    thinning_floor: f32,
+    thinning_on: u32,
 };
 
 @group(2) @binding(0) var<uniform> chunk: Chunk;
 
 struct Frame {
-    // Where the main camera is (xyz): shadow passes grow instances as that camera sees
-    // them, not as the light does.
-    viewer: vec4<f32>,
-    // The bend field's min corner (x, z), 1 / its side, 1 when any blade leans.
-    bend: vec4<f32>,
+    // Where the main camera is: shadow passes grow instances as that camera sees them, not
+    // as the light does.
+    viewer: vec3<f32>,
+    // 1 when any blade leans in the bend field.
+    bends: u32,
+    // The bend field's min corner (x, z), and 1 / its side.
+    bend_min: vec2<f32>,
+    bend_scale: f32,
 };
 
 @group(2) @binding(1) var<uniform> frame: Frame;
@@ -123,9 +139,9 @@ fn eye_xz() -> vec2<f32> {
 
 // Far thinning at `root`: the fraction of instances kept there (1 without thinning).
 fn kept_fraction(root: vec3<f32>) -> f32 {
-    let ratio = chunk.thinning.x / max(length(root.xz - eye_xz()), 1e-3);
-    let kept = clamp(ratio * ratio, chunk.thinning.y, 1.0);
-    return select(1.0, kept, chunk.thinning.z != 0.0);
+    let ratio = chunk.thinning_from / max(length(root.xz - eye_xz()), 1e-3);
+    let kept = clamp(ratio * ratio, chunk.thinning_floor, 1.0);
+    return select(1.0, kept, chunk.thinning_on != 0u);
 }
 
 // Growth of an instance: 0 until the level-of-detail factor at its place reaches the one at
@@ -134,21 +150,21 @@ fn kept_fraction(root: vec3<f32>) -> f32 {
 // them at a fraction of 1).
 fn growth(root: vec3<f32>, appear: f32, kept: f32) -> f32 {
     let distance = length(root.xz - eye_xz());
-    let span = max(chunk.falloff.y - chunk.falloff.x, 1e-3);
-    let factor = max(chunk.falloff.w, clamp(1.0 - (distance - chunk.falloff.x) / span, 0.0, 1.0));
-    let grown = clamp((factor - appear) / chunk.params.w, 0.0, 1.0);
-    let thinned = clamp((kept * (1.0 + chunk.params.w) - appear) / chunk.params.w, 0.0, 1.0);
-    return select(grown, 1.0, chunk.falloff.z == 0.0) * thinned;
+    let span = max(chunk.falloff_far - chunk.falloff_near, 1e-3);
+    let factor = max(chunk.falloff_floor, clamp(1.0 - (distance - chunk.falloff_near) / span, 0.0, 1.0));
+    let grown = clamp((factor - appear) / chunk.fade_band, 0.0, 1.0);
+    let thinned = clamp((kept * (1.0 + chunk.fade_band) - appear) / chunk.fade_band, 0.0, 1.0);
+    return select(grown, 1.0, chunk.falloff_on == 0u) * thinned;
 }
 
 // Sideways displacement of a point at height fraction `t` (0 root, 1 tip) of an instance
 // rooted at `root`: gusts travelling with the wind plus a small per-instance flutter.
 fn sway(root: vec3<f32>, t: f32, tint: f32, height: f32, time: f32) -> vec3<f32> {
-    let dir = normalize(chunk.wind.xy + vec2<f32>(1e-5, 0.0));
-    let drift = dir * chunk.wind_motion.x * time;
-    let gust = value_noise((root.xz - drift) * chunk.wind.w);
+    let dir = normalize(chunk.wind_direction + vec2<f32>(1e-5, 0.0));
+    let drift = dir * chunk.wind_speed * time;
+    let gust = value_noise((root.xz - drift) * chunk.wind_frequency);
     let flutter = 0.15 * sin(time * 2.3 + tint * 6.2831) * (0.5 + gust);
-    let amount = chunk.wind.z * chunk.params.z * (0.25 + gust + flutter) * height;
+    let amount = chunk.wind_strength * chunk.wind_response * (0.25 + gust + flutter) * height;
     let bend = t * t * amount;
     return vec3<f32>(dir.x * bend, -0.3 * abs(bend) * t, dir.y * bend);
 }
@@ -158,11 +174,11 @@ fn sway(root: vec3<f32>, t: f32, tint: f32, height: f32, time: f32) -> vec3<f32>
 // reads the field.
 fn lean_at(root: vec3<f32>) -> vec2<f32> {
 #ifdef RWT_BEND
-    let uv = (root.xz - frame.bend.xy) * frame.bend.z;
+    let uv = (root.xz - frame.bend_min) * frame.bend_scale;
     if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
         return vec2<f32>(0.0);
     }
-    let response = chunk.shading.y * frame.bend.w;
+    let response = chunk.bend_response * f32(frame.bends);
     let lean = textureSampleLevel(bend_field, bend_sampler, uv, 0.0).xy * response;
     let amount = length(lean);
     return select(lean, lean / amount, amount > 1.0);
@@ -206,7 +222,7 @@ fn tilt(v: vec3<f32>, up: vec3<f32>) -> vec3<f32> {
 }
 
 fn place(in: Vertex, time: f32) -> Placed {
-    let root = chunk.origin.xyz + in.offset_scale.xyz;
+    let root = chunk.origin + in.offset_scale.xyz;
     let yaw = in.yaw_appear_tint.x * 6.2831853;
     let tint = in.yaw_appear_tint.z;
     let kept = kept_fraction(root);
@@ -238,8 +254,8 @@ fn place(in: Vertex, time: f32) -> Placed {
         normal = fall(normal, dir, sin(angle), cos(angle));
     }
     var out: Placed;
-    out.t = clamp(in.position.y / chunk.origin.w, 0.0, 1.0);
-    let wind = sway(root, out.t, tint, chunk.origin.w * scale, time) * (1.0 - amount);
+    out.t = clamp(in.position.y / chunk.mesh_top, 0.0, 1.0);
+    let wind = sway(root, out.t, tint, chunk.mesh_top * scale, time) * (1.0 - amount);
     out.world = root + turned + wind;
     // Blades read as blades when their normals lean towards the sky.
     out.normal = normalize(mix(normal, vec3<f32>(0.0, 1.0, 0.0), 0.45));
@@ -250,8 +266,8 @@ fn place(in: Vertex, time: f32) -> Placed {
 fn vertex(in: Vertex) -> VertexOutput {
     let placed = place(in, globals.time);
     let tint = in.yaw_appear_tint.z;
-    let variation = (tint - 0.5) * chunk.params.x;
-    let tip_start = chunk.shading.x;
+    let variation = (tint - 0.5) * chunk.color_variation;
+    let tip_start = chunk.tip_from;
     let shade = mix(chunk.base_color, chunk.tip_color, clamp((placed.t - tip_start) / (1.0 - tip_start), 0.0, 1.0));
     var out: VertexOutput;
     out.world_position = vec4<f32>(placed.world, 1.0);
@@ -275,7 +291,7 @@ fn vertex(in: Vertex) -> VertexOutput {
 // The texture at the fragment, which is cut out where its alpha is below the cut-off.
 fn cut_out(uv: vec2<f32>) -> vec4<f32> {
     let texel = textureSample(base_texture, base_sampler, uv);
-    if texel.a < chunk.shading.z {
+    if texel.a < chunk.alpha_cutoff {
         discard;
     }
     return texel;
@@ -334,7 +350,7 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @locatio
 #endif
     var pbr_input = pbr_types::pbr_input_new();
     pbr_input.material.base_color = color;
-    pbr_input.material.perceptual_roughness = chunk.params.y;
+    pbr_input.material.perceptual_roughness = chunk.roughness;
     pbr_input.material.reflectance = vec3<f32>(0.2);
     pbr_input.material.flags = pbr_types::STANDARD_MATERIAL_FLAGS_FOG_ENABLED_BIT;
     pbr_input.frag_coord = in.clip_position;

@@ -18,6 +18,7 @@ mod main_pass;
 mod retained;
 #[cfg(test)]
 mod shader_check;
+mod uniforms;
 
 pub(super) use cull::{InstanceCuller, cull_instances, cull_late, init_culler, restore_early};
 #[cfg(feature = "testing")]
@@ -31,6 +32,7 @@ pub(super) use draw::DrawInstancedChunk;
 pub(super) use main_pass::{InstancedPipeline, init_main_pipeline, queue_main};
 use retained::BinnedChunk;
 pub(super) use retained::Queued;
+use uniforms::{ChunkUniform, FrameUniform, uniform_bytes};
 
 use super::bend::{BEND_FIELD_TEXELS, BendField};
 use super::{GpuInstance, InstanceBuffer, InstanceCulling, InstancedChunk, RwtFadeIn, RwtWind};
@@ -54,7 +56,6 @@ use bevy::render::sync_component::SyncComponent;
 use bevy::render::sync_world::MainEntity;
 use bevy::render::texture::{FallbackImage, GpuImage};
 use bevy::render::view::{ExtractedView, RenderVisibleEntities, RetainedViewEntity};
-use bytemuck::{Pod, Zeroable};
 use std::sync::Arc;
 
 /// Shader locations of the instance attributes (after every mesh attribute).
@@ -64,39 +65,6 @@ const INSTANCE_LOCATIONS: [u32; 2] = [8, 9];
 pub(super) fn embed_shader(app: &mut App) {
     bevy::asset::embedded_asset!(app, "instanced.wgsl");
     bevy::asset::embedded_asset!(app, "cull/cull.wgsl");
-}
-
-/// The per-chunk uniform, as the shader reads it.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-struct ChunkUniform {
-    /// Chunk corner (xyz) and the mesh's top (w).
-    origin: [f32; 4],
-    base_color: [f32; 4],
-    tip_color: [f32; 4],
-    /// Colour variation, roughness, wind response, fade band.
-    params: [f32; 4],
-    /// Fall-off near, far, 1 when the layer has one, and its floor.
-    falloff: [f32; 4],
-    /// Wind direction (x, z), strength, frequency.
-    wind: [f32; 4],
-    /// Wind speed.
-    wind_motion: [f32; 4],
-    /// Height fraction where the tip colour starts, bend response, alpha cut-off, 1 when
-    /// textured.
-    shading: [f32; 4],
-    /// Far thinning: its distance, its floor, 1 when on.
-    thinning: [f32; 4],
-}
-
-/// The per-frame uniform every chunk shares: where the main camera is (shadow passes grow
-/// instances as it sees them, not as the light does), and where the bend field lies.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-struct FrameUniform {
-    viewer: [f32; 4],
-    /// The bend field's min corner (x, z), 1 / its side, 1 when any blade leans.
-    bend: [f32; 4],
 }
 
 /// A chunk as the render world sees it (its extraction is part of [`InstancedChunk`]'s
@@ -117,12 +85,11 @@ pub struct ExtractedChunk {
 }
 
 impl ExtractedChunk {
-    /// What its class's pipelines compile in: a texture, and a bend response (the
-    /// uniform's `shading.y`) other than 0.
+    /// What its class's pipelines compile in: a texture, and a bend response other than 0.
     fn features(&self) -> ClassFeatures {
         ClassFeatures {
             textured: self.texture.is_some(),
-            bends: self.uniform.shading[1] != 0.0,
+            bends: self.uniform.bend_response != 0.0,
         }
     }
 }
@@ -156,10 +123,6 @@ impl ExtractComponent for InstancedChunk {
         (chunk, transform, aabb): QueryItem<'_, '_, Self::QueryData>,
     ) -> Option<Self::Out> {
         let origin = transform.translation();
-        let m = &chunk.material;
-        let (near, far, on, floor) = chunk
-            .falloff
-            .map_or((0.0, 1.0, 0.0, 0.0), |(n, f, floor)| (n, f, 1.0, floor));
         let local = aabb.copied().unwrap_or_else(|| {
             let (lo, hi) = chunk.buffer.bounds;
             Aabb::from_min_max(lo, hi)
@@ -168,34 +131,13 @@ impl ExtractComponent for InstancedChunk {
             reach: reach(&local, chunk.buffer.bounds, chunk.max_scale, aabb.is_some()),
             buffer: chunk.buffer.clone(),
             mesh: chunk.mesh.id(),
-            uniform: ChunkUniform {
-                origin: origin.extend(chunk.mesh_top).to_array(),
-                base_color: m.base_color.to_linear().to_f32_array(),
-                tip_color: m.tip_color.to_linear().to_f32_array(),
-                params: [
-                    m.color_variation,
-                    m.roughness,
-                    m.wind_response,
-                    m.fade_band.max(1e-3),
-                ],
-                falloff: [near, far, on, floor],
-                shading: [
-                    m.tip_from.clamp(0.0, 0.99),
-                    m.bend_response,
-                    m.alpha_cutoff,
-                    if m.texture.is_some() { 1.0 } else { 0.0 },
-                ],
-                thinning: m.thinning.map_or([0.0; 4], |t| {
-                    [t.from.max(0.0), t.floor.clamp(1e-3, 1.0), 1.0, 0.0]
-                }),
-                ..default()
-            },
+            uniform: ChunkUniform::new(origin, chunk.mesh_top, &chunk.material, chunk.falloff),
             bounds: Aabb {
                 center: local.center + origin.to_vec3a(),
                 half_extents: local.half_extents,
             },
-            shadows: m.shadows,
-            texture: m.texture.as_ref().map(Handle::id),
+            shadows: chunk.material.shadows,
+            texture: chunk.material.texture.as_ref().map(Handle::id),
         })
     }
 }
@@ -309,7 +251,7 @@ pub(super) fn init_bindings(
     );
     let frame = device.create_buffer_with_data(&BufferInitDescriptor {
         label: Some("rwt_instanced_frame"),
-        contents: bytemuck::bytes_of(&FrameUniform::default()),
+        contents: &uniform_bytes(&FrameUniform::default()),
         usage: BufferUsages::UNIFORM | BufferUsages::COPY_DST,
     });
     let bend = device.create_texture(&TextureDescriptor {
@@ -381,20 +323,13 @@ pub(super) fn prepare_frame(
         .min_by_key(|(_, camera)| camera.order)
         .map(|(view, _)| view.world_from_view.translation());
     let Some(bindings) = bindings else { return };
-    let bend = field.as_ref().map_or([0.0; 4], |f| {
-        let min = f.min();
-        [
-            min.x,
-            min.y,
-            1.0 / f.extent(),
-            if f.active() { 1.0 } else { 0.0 },
-        ]
-    });
     let uniform = FrameUniform {
-        viewer: viewer.0.unwrap_or_default().extend(1.0).to_array(),
-        bend,
+        viewer: viewer.0.unwrap_or_default(),
+        bends: field.as_ref().map_or(0, |f| u32::from(f.active())),
+        bend_min: field.as_ref().map_or(Vec2::ZERO, |f| f.min()),
+        bend_scale: field.as_ref().map_or(0.0, |f| 1.0 / f.extent()),
     };
-    queue.write_buffer(&bindings.frame, 0, bytemuck::bytes_of(&uniform));
+    queue.write_buffer(&bindings.frame, 0, &uniform_bytes(&uniform));
     if let Some(field) = field.filter(|f| f.is_changed()) {
         let texels: Vec<[i8; 2]> = field
             .texels()
@@ -465,21 +400,18 @@ pub(super) fn prepare_chunks(
     let fade = fade.map(|f| *f).unwrap_or_default();
     for (entity, chunk, gpu) in &mut chunks {
         let mut uniform = chunk.uniform;
-        uniform.wind = [
-            wind.direction.x,
-            wind.direction.y,
-            wind.strength,
-            wind.frequency,
-        ];
-        uniform.wind_motion = [wind.speed, 0.0, 0.0, 0.0];
+        uniform.wind_direction = wind.direction;
+        uniform.wind_strength = wind.strength;
+        uniform.wind_frequency = wind.frequency;
+        uniform.wind_speed = wind.speed;
         if !fade.0 {
-            uniform.falloff[2] = 0.0;
+            uniform.falloff_on = 0;
         }
         let texture = textures.of(chunk);
         match gpu {
             Some(mut gpu) if Arc::ptr_eq(&gpu.source, &chunk.buffer) => {
                 if gpu.uniform != uniform {
-                    queue.write_buffer(&gpu.uniform_buffer, 0, bytemuck::bytes_of(&uniform));
+                    queue.write_buffer(&gpu.uniform_buffer, 0, &uniform_bytes(&uniform));
                     gpu.uniform = uniform;
                 }
                 if gpu.texture_view != texture.texture_view.id() {
@@ -512,7 +444,7 @@ fn upload(
     });
     let uniform_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
         label: Some("rwt_instanced_chunk"),
-        contents: bytemuck::bytes_of(&uniform),
+        contents: &uniform_bytes(&uniform),
         usage: BufferUsages::UNIFORM | BufferUsages::COPY_DST,
     });
     GpuChunk {
@@ -616,7 +548,7 @@ fn rebin_cameras<P: BinnedPhaseItem, K: Copy>(
             .iter()
             .filter_map(|&(entity, main_entity)| item(key?, entity, main_entity))
             .collect();
-        queued.rebin(view.retained_view_entity, phase, items);
+        queued.rebin_phase(view.retained_view_entity, phase, items);
     }
     queued.end_frame();
 }

@@ -6,6 +6,10 @@
 use super::{ChunkUniform, FrameUniform};
 use bevy::asset::AssetId;
 use bevy::asset::uuid::Uuid;
+use bevy::math::{Vec2, Vec3, Vec4};
+use bevy::render::render_resource::ShaderType;
+use bevy::render::render_resource::encase::UniformBuffer;
+use bevy::render::render_resource::encase::internal::WriteInto;
 use bevy::render::render_resource::{DownlevelFlags, WgpuFeatures};
 use bevy::shader::{Shader, ShaderCache, ShaderCacheSource, ShaderDefVal};
 use std::path::{Path, PathBuf};
@@ -150,6 +154,112 @@ fn permutations() -> Vec<Vec<ShaderDefVal>> {
     all
 }
 
+/// The members (name, offset) and size of `value` as encase writes it into a uniform
+/// buffer: each member's first word holds its own marker (`markers`, in member order).
+pub(super) fn encase_layout<T: ShaderType + WriteInto>(
+    value: &T,
+    markers: &[(&str, u32)],
+) -> (Vec<(String, usize)>, usize) {
+    let mut bytes = UniformBuffer::new(Vec::<u8>::new());
+    bytes.write(value).expect("encase writes it");
+    let words: Vec<u32> = bytemuck::pod_collect_to_vec(bytes.as_ref());
+    let members = markers.iter().map(|&(name, marker)| {
+        let word = words.iter().position(|w| *w == marker);
+        (
+            name.to_string(),
+            4 * word.unwrap_or_else(|| panic!("no marker for {name}")),
+        )
+    });
+    (members.collect(), T::min_size().get() as usize)
+}
+
+/// `ChunkUniform`'s layout, each member marked by its own value.
+fn marked_chunk() -> (Vec<(String, usize)>, usize) {
+    let f = |k: u32| 100.0 + k as f32;
+    let marked = ChunkUniform {
+        origin: Vec3::splat(f(0)),
+        mesh_top: f(1),
+        base_color: Vec4::splat(f(2)),
+        tip_color: Vec4::splat(f(3)),
+        color_variation: f(4),
+        roughness: f(5),
+        wind_response: f(6),
+        fade_band: f(7),
+        falloff_near: f(8),
+        falloff_far: f(9),
+        falloff_floor: f(10),
+        falloff_on: 11,
+        wind_direction: Vec2::splat(f(12)),
+        wind_strength: f(13),
+        wind_frequency: f(14),
+        wind_speed: f(15),
+        tip_from: f(16),
+        bend_response: f(17),
+        alpha_cutoff: f(18),
+        textured: 19,
+        thinning_from: f(20),
+        thinning_floor: f(21),
+        thinning_on: 22,
+    };
+    let names = [
+        "origin",
+        "mesh_top",
+        "base_color",
+        "tip_color",
+        "color_variation",
+        "roughness",
+        "wind_response",
+        "fade_band",
+        "falloff_near",
+        "falloff_far",
+        "falloff_floor",
+        "falloff_on",
+        "wind_direction",
+        "wind_strength",
+        "wind_frequency",
+        "wind_speed",
+        "tip_from",
+        "bend_response",
+        "alpha_cutoff",
+        "textured",
+        "thinning_from",
+        "thinning_floor",
+        "thinning_on",
+    ];
+    let words = [11, 19, 22];
+    let markers: Vec<(&str, u32)> = (0u32..)
+        .zip(names)
+        .map(|(k, n)| {
+            (
+                n,
+                if words.contains(&k) {
+                    k
+                } else {
+                    f(k).to_bits()
+                },
+            )
+        })
+        .collect();
+    encase_layout(&marked, &markers)
+}
+
+/// `FrameUniform`'s layout, each member marked by its own value.
+fn marked_frame() -> (Vec<(String, usize)>, usize) {
+    let marked = FrameUniform {
+        viewer: Vec3::splat(1.0),
+        bends: 7,
+        bend_min: Vec2::splat(2.0),
+        bend_scale: 3.0,
+    };
+    let markers = [
+        ("viewer", 1.0f32.to_bits()),
+        ("bends", 7),
+        ("bend_min", 2.0f32.to_bits()),
+        ("bend_scale", 3.0f32.to_bits()),
+    ];
+    encase_layout(&marked, &markers)
+}
+
 /// The members (name, offset) and size of struct `name` in a module's types' `Debug` text.
 pub(super) fn struct_layout(types: &str, name: &str) -> (Vec<(String, usize)>, usize) {
     let start = types
@@ -196,29 +306,9 @@ fn every_permutation_composes_and_validates_with_the_uniform_layouts() {
         failed.join("\n")
     );
     assert_eq!(composed.len(), 8 * 17);
-    use std::mem::{offset_of, size_of};
-    let chunk = [
-        ("origin", offset_of!(ChunkUniform, origin)),
-        ("base_color", offset_of!(ChunkUniform, base_color)),
-        ("tip_color", offset_of!(ChunkUniform, tip_color)),
-        ("params", offset_of!(ChunkUniform, params)),
-        ("falloff", offset_of!(ChunkUniform, falloff)),
-        ("wind", offset_of!(ChunkUniform, wind)),
-        ("wind_motion", offset_of!(ChunkUniform, wind_motion)),
-        ("shading", offset_of!(ChunkUniform, shading)),
-        ("thinning", offset_of!(ChunkUniform, thinning)),
-    ];
-    let frame = [
-        ("viewer", offset_of!(FrameUniform, viewer)),
-        ("bend", offset_of!(FrameUniform, bend)),
-    ];
-    let expect = |fields: &[(&str, usize)]| -> Vec<(String, usize)> {
-        fields.iter().map(|(n, o)| (n.to_string(), *o)).collect()
-    };
+    let (chunk, frame) = (marked_chunk(), marked_frame());
     for types in &composed {
-        let ours = (expect(&chunk), size_of::<ChunkUniform>());
-        assert_eq!(struct_layout(types, "Chunk"), ours);
-        let ours = (expect(&frame), size_of::<FrameUniform>());
-        assert_eq!(struct_layout(types, "Frame"), ours);
+        assert_eq!(struct_layout(types, "Chunk"), chunk);
+        assert_eq!(struct_layout(types, "Frame"), frame);
     }
 }

@@ -504,7 +504,7 @@ impl CullInputs<'_, '_> {
                 continue;
             };
             for main in binned {
-                if let Some(&(entity, extracted, gpu)) = chunks.get(main) {
+                if let Some(&(entity, extracted, gpu)) = chunks.get(&main) {
                     pairs.push((*view, entity, extracted, gpu));
                 }
             }
@@ -749,11 +749,16 @@ fn uniform(d: &Dispatch, o: &Offsets) -> CullUniform {
     };
     CullUniform {
         planes: d.view.planes,
-        origin: Vec3::from_slice(&u.origin).extend(d.extracted.reach),
+        origin: u.origin.extend(d.extracted.reach),
         eye: d.view.eye.extend(shadow_distance),
-        falloff: Vec4::from_array(u.falloff),
-        fade: Vec4::new(u.params[3], 0.0, 0.0, 0.0),
-        thinning: Vec4::from_array(u.thinning),
+        falloff: Vec4::new(
+            u.falloff_near,
+            u.falloff_far,
+            u.falloff_on as f32,
+            u.falloff_floor,
+        ),
+        fade: Vec4::new(u.fade_band, 0.0, 0.0, 0.0),
+        thinning: Vec4::new(u.thinning_from, u.thinning_floor, u.thinning_on as f32, 0.0),
         slots: UVec4::new(d.gpu.count, o.draw * ARGS_WORDS + 1, x, 0),
         clip_from_world,
         occlusion,

@@ -1,0 +1,106 @@
+//! The uniforms `instanced.wgsl` reads, as `ShaderType`s: laid out by encase, as WGSL lays
+//! out its `Chunk` and `Frame` structs (the naga check compares the two).
+
+use crate::look::InstancedShading;
+use bevy::prelude::*;
+use bevy::render::render_resource::ShaderType;
+use bevy::render::render_resource::encase::UniformBuffer;
+use bevy::render::render_resource::encase::internal::WriteInto;
+
+/// One chunk's uniform: where it lies, and its class's look.
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub(super) struct ChunkUniform {
+    /// The chunk's corner.
+    pub origin: Vec3,
+    /// The mesh's top (its height at scale 1).
+    pub mesh_top: f32,
+    pub base_color: Vec4,
+    pub tip_color: Vec4,
+    pub color_variation: f32,
+    pub roughness: f32,
+    pub wind_response: f32,
+    /// The band of ranks an instance grows over (never 0).
+    pub fade_band: f32,
+    /// The level of detail's fall-off: near, far, the factor's floor; 1 when the layer has
+    /// one (and the fade is on).
+    pub falloff_near: f32,
+    pub falloff_far: f32,
+    pub falloff_floor: f32,
+    pub falloff_on: u32,
+    /// The wind (`RwtWind`): its direction (x, z), strength, frequency and speed.
+    pub wind_direction: Vec2,
+    pub wind_strength: f32,
+    pub wind_frequency: f32,
+    pub wind_speed: f32,
+    /// Height fraction where the tip colour starts.
+    pub tip_from: f32,
+    pub bend_response: f32,
+    pub alpha_cutoff: f32,
+    /// 1 when the class has a texture.
+    pub textured: u32,
+    /// Far thinning: its distance, its floor; 1 when on.
+    pub thinning_from: f32,
+    pub thinning_floor: f32,
+    pub thinning_on: u32,
+}
+
+impl ChunkUniform {
+    /// The uniform of a chunk at `origin` of a class drawn with `mesh_top`, `material` and
+    /// the fall-off `(near, far, floor)`; no wind yet (the render world adds it).
+    pub fn new(
+        origin: Vec3,
+        mesh_top: f32,
+        m: &InstancedShading,
+        falloff: Option<(f32, f32, f32)>,
+    ) -> Self {
+        let (falloff_near, falloff_far, falloff_floor) = falloff.unwrap_or((0.0, 1.0, 0.0));
+        let thinning = m
+            .thinning
+            .map(|t| (t.from.max(0.0), t.floor.clamp(1e-3, 1.0)));
+        Self {
+            origin,
+            mesh_top,
+            base_color: Vec4::from_array(m.base_color.to_linear().to_f32_array()),
+            tip_color: Vec4::from_array(m.tip_color.to_linear().to_f32_array()),
+            color_variation: m.color_variation,
+            roughness: m.roughness,
+            wind_response: m.wind_response,
+            fade_band: m.fade_band.max(1e-3),
+            falloff_near,
+            falloff_far,
+            falloff_floor,
+            falloff_on: u32::from(falloff.is_some()),
+            tip_from: m.tip_from.clamp(0.0, 0.99),
+            bend_response: m.bend_response,
+            alpha_cutoff: m.alpha_cutoff,
+            textured: u32::from(m.texture.is_some()),
+            thinning_from: thinning.map_or(0.0, |t| t.0),
+            thinning_floor: thinning.map_or(0.0, |t| t.1),
+            thinning_on: u32::from(thinning.is_some()),
+            ..default()
+        }
+    }
+}
+
+/// The uniform every chunk shares in a frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub(super) struct FrameUniform {
+    /// Where the main camera is: shadow passes grow instances as it sees them, not as the
+    /// light does.
+    pub viewer: Vec3,
+    /// 1 when any blade leans in the bend field.
+    pub bends: u32,
+    /// The bend field's min corner (x, z).
+    pub bend_min: Vec2,
+    /// 1 / the bend field's side.
+    pub bend_scale: f32,
+}
+
+/// `value`'s bytes as a uniform buffer holds them.
+pub(super) fn uniform_bytes<T: ShaderType + WriteInto>(value: &T) -> Vec<u8> {
+    let mut buffer = UniformBuffer::new(Vec::new());
+    buffer
+        .write(value)
+        .expect("a uniform of fixed size writes into a growable vector");
+    buffer.into_inner()
+}
