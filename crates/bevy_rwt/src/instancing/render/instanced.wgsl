@@ -16,6 +16,7 @@
 #import bevy_pbr::mesh_types::MESH_FLAGS_SHADOW_RECEIVER_BIT
 #endif
 #import bevy_pbr::view_transformations::position_world_to_clip
+#import rwt::fade::{Fade, kept_fraction, growth}
 
 struct Chunk {
     // The chunk's corner, and the mesh's top (its height at scale 1).
@@ -137,24 +138,19 @@ fn eye_xz() -> vec2<f32> {
 #endif
 }
 
-// Far thinning at `root`: the fraction of instances kept there (1 without thinning).
-fn kept_fraction(root: vec3<f32>) -> f32 {
-    let ratio = chunk.thinning_from / max(length(root.xz - eye_xz()), 1e-3);
-    let kept = clamp(ratio * ratio, chunk.thinning_floor, 1.0);
-    return select(1.0, kept, chunk.thinning_on != 0u);
-}
-
-// Growth of an instance: 0 until the level-of-detail factor at its place reaches the one at
-// which its point appears, then up to 1 over the fade band (always 1 without fall-off).
-// The far thinning keeps the instances of rank below its fraction the same way (all of
-// them at a fraction of 1).
-fn growth(root: vec3<f32>, appear: f32, kept: f32) -> f32 {
-    let distance = length(root.xz - eye_xz());
-    let span = max(chunk.falloff_far - chunk.falloff_near, 1e-3);
-    let factor = max(chunk.falloff_floor, clamp(1.0 - (distance - chunk.falloff_near) / span, 0.0, 1.0));
-    let grown = clamp((factor - appear) / chunk.fade_band, 0.0, 1.0);
-    let thinned = clamp((kept * (1.0 + chunk.fade_band) - appear) / chunk.fade_band, 0.0, 1.0);
-    return select(grown, 1.0, chunk.falloff_on == 0u) * thinned;
+// The chunk's level of detail, seen from `eye_xz()`.
+fn chunk_fade() -> Fade {
+    return Fade(
+        eye_xz(),
+        chunk.falloff_near,
+        chunk.falloff_far,
+        chunk.falloff_floor,
+        chunk.falloff_on != 0u,
+        chunk.fade_band,
+        chunk.thinning_from,
+        chunk.thinning_floor,
+        chunk.thinning_on != 0u,
+    );
 }
 
 // Sideways displacement of a point at height fraction `t` (0 root, 1 tip) of an instance
@@ -225,8 +221,9 @@ fn place(in: Vertex, time: f32) -> Placed {
     let root = chunk.origin + in.offset_scale.xyz;
     let yaw = in.yaw_appear_tint.x * 6.2831853;
     let tint = in.yaw_appear_tint.z;
-    let kept = kept_fraction(root);
-    let scale = in.offset_scale.w * growth(root, in.yaw_appear_tint.y, kept);
+    let fade = chunk_fade();
+    let kept = kept_fraction(fade, root);
+    let scale = in.offset_scale.w * growth(fade, root, in.yaw_appear_tint.y, kept);
     let c = cos(yaw);
     let s = sin(yaw);
     // A thinned field's instances are widened to cover as the whole field did (seen from

@@ -61,8 +61,10 @@ use std::sync::Arc;
 /// Shader locations of the instance attributes (after every mesh attribute).
 const INSTANCE_LOCATIONS: [u32; 2] = [8, 9];
 
-/// Adds the instanced shader to the app's embedded assets.
+/// Adds the instanced and culling shaders to the app's embedded assets, and the level of
+/// detail they share (`rwt::fade`) to its shader library.
 pub(super) fn embed_shader(app: &mut App) {
+    bevy::shader::load_shader_library!(app, "fade.wgsl");
     bevy::asset::embedded_asset!(app, "instanced.wgsl");
     bevy::asset::embedded_asset!(app, "cull/cull.wgsl");
 }

@@ -92,9 +92,17 @@ pub(super) fn bare_cache() -> ShaderCache<String, ()> {
     )
 }
 
-/// A [`bare_cache`] holding Bevy's library, set up as Bevy's plugins set it up.
-fn cache_with_library() -> ShaderCache<String, ()> {
+/// A cache holding the level of detail our shaders share (`rwt::fade`).
+pub(super) fn cache_with_fade() -> ShaderCache<String, ()> {
     let mut cache = bare_cache();
+    let fade = Shader::from_wgsl(include_str!("fade.wgsl"), "fade.wgsl");
+    cache.set_shader(AssetId::from(Uuid::from_u128(u128::MAX - 1)), fade);
+    cache
+}
+
+/// A [`cache_with_fade`] also holding Bevy's library, set up as Bevy's plugins set it up.
+fn cache_with_library() -> ShaderCache<String, ()> {
+    let mut cache = cache_with_fade();
     let mut found = Vec::new();
     for dir in library_sources() {
         modules(&dir, &mut found);

@@ -9,6 +9,8 @@
 // it and keeps those it does not hide, into the draw's second range. A blade seen this
 // frame is kept by one of the two: what the early depth holds, the frame holds too.
 
+#import rwt::fade::{Fade, kept_fraction, growth}
+
 struct Cull {
     // The view's half-spaces (normal, distance; inside where dot(n, p) + d > 0).
     planes: array<vec4<f32>, 6>,
@@ -48,23 +50,19 @@ struct Cull {
 // tilt).
 const WORDS: u32 = 6u;
 
-// `instanced.wgsl`'s fraction kept by far thinning.
-fn kept_fraction(root: vec3<f32>) -> f32 {
-    let ratio = cull.thinning.x / max(length(root.xz - cull.eye.xz), 1e-3);
-    let kept = clamp(ratio * ratio, cull.thinning.y, 1.0);
-    return select(1.0, kept, cull.thinning.z != 0.0);
-}
-
-// `instanced.wgsl`'s growth: 0 until the level-of-detail factor at the root reaches the one
-// at which the instance appears, then up to 1 over the fade band (1 without the fade); and
-// as far thinning keeps it.
-fn growth(root: vec3<f32>, appear: f32, kept: f32) -> f32 {
-    let distance = length(root.xz - cull.eye.xz);
-    let span = max(cull.falloff.y - cull.falloff.x, 1e-3);
-    let factor = max(cull.falloff.w, clamp(1.0 - (distance - cull.falloff.x) / span, 0.0, 1.0));
-    let grown = clamp((factor - appear) / cull.fade.x, 0.0, 1.0);
-    let thinned = clamp((kept * (1.0 + cull.fade.x) - appear) / cull.fade.x, 0.0, 1.0);
-    return select(grown, 1.0, cull.falloff.z == 0.0) * thinned;
+// The chunk's level of detail, seen from the view's eye.
+fn cull_fade() -> Fade {
+    return Fade(
+        cull.eye.xz,
+        cull.falloff.x,
+        cull.falloff.y,
+        cull.falloff.w,
+        cull.falloff.z != 0.0,
+        cull.fade.x,
+        cull.thinning.x,
+        cull.thinning.y,
+        cull.thinning.z != 0.0,
+    );
 }
 
 // Whether the instance may be seen: grown, within the shadow distance, and its sphere
@@ -165,8 +163,9 @@ fn cull_instances(
     let root = cull.origin.xyz + offset;
     // The appearance factor is the high half of the fifth word (the yaw is the low half).
     let appear = f32(instances[w + 4u] >> 16u) / 65535.0;
-    let kept = kept_fraction(root);
-    let scale = bitcast<f32>(instances[w + 3u]) * growth(root, appear, kept);
+    let fade = cull_fade();
+    let kept = kept_fraction(fade, root);
+    let scale = bitcast<f32>(instances[w + 3u]) * growth(fade, root, appear, kept);
     if !seen(root, scale, 1.0 / kept) {
         return;
     }

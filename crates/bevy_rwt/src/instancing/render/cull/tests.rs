@@ -1,7 +1,7 @@
 //! The culling shader's layout, its keep rules on the CPU, and the reach it tests.
 
 use super::super::reach;
-use super::super::shader_check::{bare_cache, encase_layout, struct_layout};
+use super::super::shader_check::{cache_with_fade, encase_layout, struct_layout};
 use super::*;
 use bevy::asset::uuid::Uuid;
 use bevy::camera::primitives::Aabb;
@@ -9,7 +9,7 @@ use bevy::shader::Shader;
 
 #[test]
 fn the_cull_shader_validates_and_reads_the_uniform_as_rust_writes_it() {
-    let mut cache = bare_cache();
+    let mut cache = cache_with_fade();
     let id = AssetId::from(Uuid::from_u128(7));
     cache.set_shader(
         id,
