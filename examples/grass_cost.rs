@@ -6,15 +6,20 @@
 //!
 //! A flat field holds about the given number of live blades (streamed by the plugin) around
 //! a camera 2 m above it, under a sun with cascaded shadow maps. The instanced path is
-//! timed in four settings in one run: the grass class's shadows off, on, on within 30 m of
-//! the camera, and off with the camera's depth, normal and motion-vector prepasses on (the
-//! entity path in the first only). In each, once streaming has settled and 10 frames have
+//! timed in seven settings in one run: culled as `InstanceCulling::Auto` chooses, the grass
+//! class's shadows off, on, and on within 30 m of the camera; shadows off, chunks drawn
+//! whole (the direct path, `PerChunk`), culled per instance on the GPU (`PerInstance`), and
+//! culled per instance with occlusion (the camera's depth prepass and `OcclusionCulling`);
+//! and `Auto` with the camera's depth, normal and motion-vector prepasses on. The entity
+//! path is timed in the first only. In each, once streaming has settled and 10 frames have
 //! warmed up, 30 frames are timed and one line is printed:
 //!
-//! `grass-cost: path=P live=N shadows=S prepass=Q main_ms=X/Y render_world_ms=X/Y frame_ms=X/Y`
-//! (median/p95), then the frame-time ratios to the first setting, measured in the same run:
+//! `grass-cost: path=P shadows=S prepass=Q cull=C live=N main_ms=X/Y render_world_ms=X/Y frame_ms=X/Y`
+//! (median/p95), then the frame-time ratios measured in the same run, to the first setting
+//! and to the direct path:
 //!
 //! `grass-cost: frame_ms ratio shadows_on=R shadows_within_30m=R prepass_on=R`
+//! `grass-cost: frame_ms ratio gpu_cull=R occlusion=R`
 //!
 //! `main_ms` is the main world's schedules (the plugin, transforms, visibility);
 //! `render_world_ms` is extraction, preparation and queueing in the render world, from the
@@ -24,6 +29,7 @@
 
 use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass, NormalPrepass};
 use bevy::prelude::*;
+use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy_rwt::prelude::*;
@@ -36,13 +42,48 @@ use std::time::Instant;
 const TIMED: usize = 30;
 /// Frames run before, to warm up.
 const WARM_UP: usize = 10;
-/// The settings timed: the grass class's shadows, and whether the camera has prepasses.
-const SETTINGS: [(InstancedShadows, bool); 4] = [
-    (InstancedShadows::Off, false),
-    (InstancedShadows::On, false),
-    (InstancedShadows::Within(30.0), false),
-    (InstancedShadows::Off, true),
-];
+/// The camera's prepasses in a setting.
+#[derive(Clone, Copy, PartialEq)]
+enum Prepass {
+    None,
+    /// Depth, normals and motion vectors.
+    All,
+    /// Depth, and occlusion culling.
+    Occlusion,
+}
+
+/// One setting timed: the grass class's shadows, the camera's prepasses, the culling.
+#[derive(Clone, Copy)]
+struct Setting {
+    shadows: InstancedShadows,
+    prepass: Prepass,
+    culling: InstanceCulling,
+}
+
+const fn at(shadows: InstancedShadows, prepass: Prepass, culling: InstanceCulling) -> Setting {
+    Setting {
+        shadows,
+        prepass,
+        culling,
+    }
+}
+
+/// The settings timed, in order.
+const SETTINGS: [Setting; 7] = {
+    use InstanceCulling::*;
+    use InstancedShadows::*;
+    [
+        at(Off, Prepass::None, Auto),
+        at(On, Prepass::None, Auto),
+        at(Within(30.0), Prepass::None, Auto),
+        at(Off, Prepass::None, PerChunk),
+        at(Off, Prepass::None, PerInstance),
+        at(Off, Prepass::Occlusion, PerInstance),
+        // Last: Bevy 0.19 keeps a view's background motion-vector pipeline once its motion
+        // vector prepass is removed, and fails the next frame with a depth prepass.
+        at(Off, Prepass::All, Auto),
+    ]
+};
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -137,7 +178,7 @@ fn setup(
         ScatterClass::new(density, blade, material)
     } else {
         let material = InstancedShading {
-            shadows: SETTINGS[0].0,
+            shadows: SETTINGS[0].shadows,
             ..default()
         };
         ScatterClass::instanced(density, blade, material)
@@ -201,20 +242,9 @@ fn settle(
         (v[v.len() / 2], v[v.len() * 95 / 100])
     };
     let shown = |(median, p95): (f64, f64)| format!("{median:.2}/{p95:.2}");
-    let path = if field.entities {
-        "entities"
-    } else {
-        "instanced"
-    };
-    let (shadows, prepass) = SETTINGS[field.setting];
-    let shadows = match shadows {
-        InstancedShadows::Off => "off".to_string(),
-        InstancedShadows::On => "on".to_string(),
-        InstancedShadows::Within(d) => format!("within_{d}m"),
-    };
-    let prepass = if prepass { "on" } else { "off" };
     println!(
-        "grass-cost: path={path} live={live} shadows={shadows} prepass={prepass} main_ms={} render_world_ms={} frame_ms={}",
+        "grass-cost: {} live={live} main_ms={} render_world_ms={} frame_ms={}",
+        describe(field.entities, SETTINGS[field.setting]),
         shown(column(0)),
         shown(column(1)),
         shown(column(2))
@@ -225,39 +255,77 @@ fn settle(
     *settled_frames = 0;
     field.setting += 1;
     if field.entities || field.setting == SETTINGS.len() {
-        if let [base, on, within, prepass] = field.frame_ms[..] {
-            println!(
-                "grass-cost: frame_ms ratio shadows_on={:.2} shadows_within_30m={:.2} prepass_on={:.2}",
-                on / base,
-                within / base,
-                prepass / base
-            );
-        }
+        print_ratios(&field.frame_ms);
         exit.write(AppExit::Success);
         return;
     }
     apply(SETTINGS[field.setting], &layers, &cameras, &mut commands);
 }
 
-/// Gives the grass class the setting's shadows (a replaced layer streams anew) and the
-/// camera its prepasses or none.
+/// A setting as the result line names it.
+fn describe(entities: bool, setting: Setting) -> String {
+    let path = if entities { "entities" } else { "instanced" };
+    let shadows = match setting.shadows {
+        InstancedShadows::Off => "off".to_string(),
+        InstancedShadows::On => "on".to_string(),
+        InstancedShadows::Within(d) => format!("within_{d}m"),
+    };
+    let prepass = match setting.prepass {
+        Prepass::None => "off",
+        Prepass::All => "on",
+        Prepass::Occlusion => "depth",
+    };
+    let cull = match (setting.culling, setting.prepass) {
+        (InstanceCulling::Auto, _) => "auto",
+        (InstanceCulling::PerChunk, _) => "whole",
+        (InstanceCulling::PerInstance, Prepass::Occlusion) => "occlusion",
+        (InstanceCulling::PerInstance, _) => "gpu",
+    };
+    format!("path={path} shadows={shadows} prepass={prepass} cull={cull}")
+}
+
+/// The frame-time ratios, once every setting was timed.
+fn print_ratios(frame_ms: &[f64]) {
+    if let [base, on, within, whole, gpu, occlusion, prepass] = frame_ms[..] {
+        println!(
+            "grass-cost: frame_ms ratio shadows_on={:.2} shadows_within_30m={:.2} prepass_on={:.2}",
+            on / base,
+            within / base,
+            prepass / base
+        );
+        println!(
+            "grass-cost: frame_ms ratio gpu_cull={:.2} occlusion={:.2}",
+            gpu / whole,
+            occlusion / whole
+        );
+    }
+}
+
+/// Gives the grass class the setting's shadows (a replaced layer streams anew), the camera
+/// its prepasses, and the culling its setting.
 fn apply(
-    (shadows, prepass): (InstancedShadows, bool),
+    setting: Setting,
     layers: &Query<(Entity, &ScatterLayer)>,
     cameras: &Query<Entity, With<Camera3d>>,
     commands: &mut Commands,
 ) {
     for (entity, layer) in layers {
         let mut layer = layer.clone();
-        set_instanced_shadows(&mut layer, shadows);
+        set_instanced_shadows(&mut layer, setting.shadows);
         commands.entity(entity).insert(layer);
     }
     for camera in cameras {
         let mut camera = commands.entity(camera);
-        if prepass {
-            camera.insert((DepthPrepass, NormalPrepass, MotionVectorPrepass));
-        } else {
-            camera.remove::<(DepthPrepass, NormalPrepass, MotionVectorPrepass)>();
+        camera.remove::<(DepthPrepass, NormalPrepass, MotionVectorPrepass, OcclusionCulling)>();
+        match setting.prepass {
+            Prepass::None => {}
+            Prepass::All => {
+                camera.insert((DepthPrepass, NormalPrepass, MotionVectorPrepass));
+            }
+            Prepass::Occlusion => {
+                camera.insert((DepthPrepass, OcclusionCulling));
+            }
         }
     }
+    commands.insert_resource(setting.culling);
 }
