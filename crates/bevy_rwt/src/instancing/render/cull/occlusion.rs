@@ -191,6 +191,29 @@ impl LateWork {
     }
 }
 
+/// What one view's late phase needs this frame: its work, its pipeline and pyramid, the
+/// arguments and the buffer the early block is put aside in. `cull_late` and
+/// `restore_early` both ask for it, so the block is restored exactly when it was put aside.
+struct LateFrame<'a> {
+    work: &'a LateWork,
+    pipeline: &'a ComputePipeline,
+    pyramid: &'a BindGroup,
+    args: &'a Buffer,
+    phases: &'a Buffer,
+}
+
+impl InstanceCuller {
+    fn late_frame<'a>(&'a self, view: Entity, cache: &'a PipelineCache) -> Option<LateFrame<'a>> {
+        Some(LateFrame {
+            work: self.late.get(&view)?,
+            pipeline: cache.get_compute_pipeline(self.pipeline?)?,
+            pyramid: self.pyramids.bind_group(view)?,
+            args: self.args.as_ref()?,
+            phases: self.phases.as_ref()?,
+        })
+    }
+}
+
 /// After the early depth prepass is reduced into the view's pyramid: culls the instances
 /// the early phase hid against it, puts the early block aside and zeroes its counts for the
 /// late prepass.
@@ -201,16 +224,7 @@ pub(in crate::instancing) fn cull_late(
     mut ctx: RenderContext,
 ) {
     let Some(culler) = culler else { return };
-    let Some(work) = culler.late.get(&view.entity()) else {
-        return;
-    };
-    let pipeline = culler.pipeline.and_then(|p| cache.get_compute_pipeline(p));
-    let (Some(pipeline), Some(args), Some(phases), Some(pyramid)) = (
-        pipeline,
-        &culler.args,
-        &culler.phases,
-        culler.pyramids.bind_group(view.entity()),
-    ) else {
+    let Some(late) = culler.late_frame(view.entity(), &cache) else {
         return;
     };
     let encoder = ctx.command_encoder();
@@ -219,9 +233,9 @@ pub(in crate::instancing) fn cull_late(
             label: Some("rwt_cull_late"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(1, pyramid, &[]);
-        for d in &work.dispatches {
+        pass.set_pipeline(late.pipeline);
+        pass.set_bind_group(1, late.pyramid, &[]);
+        for d in &late.work.dispatches {
             let Some(chunk) = culler.chunks.get(&d.chunk) else {
                 continue;
             };
@@ -230,29 +244,37 @@ pub(in crate::instancing) fn cull_late(
             pass.dispatch_workgroups(x, y, 1);
         }
     }
-    let bytes = work.bytes();
+    let bytes = late.work.bytes();
     let block = u64::from(culler.draw_count * ARGS_WORDS * 4);
     let size = bytes.end - bytes.start;
-    encoder.copy_buffer_to_buffer(args, bytes.start, phases, bytes.start, size);
-    encoder.copy_buffer_to_buffer(phases, block + bytes.start, args, bytes.start, size);
+    encoder.copy_buffer_to_buffer(late.args, bytes.start, late.phases, bytes.start, size);
+    encoder.copy_buffer_to_buffer(
+        late.phases,
+        block + bytes.start,
+        late.args,
+        bytes.start,
+        size,
+    );
 }
 
 /// After the late prepass: puts the view's early block back for the main pass.
 pub(in crate::instancing) fn restore_early(
     view: ViewQuery<Entity>,
     culler: Option<Res<InstanceCuller>>,
+    cache: Res<PipelineCache>,
     mut ctx: RenderContext,
 ) {
     let Some(culler) = culler else { return };
-    let (Some(work), Some(args), Some(phases)) = (
-        culler.late.get(&view.entity()),
-        &culler.args,
-        &culler.phases,
-    ) else {
+    let Some(late) = culler.late_frame(view.entity(), &cache) else {
         return;
     };
-    let bytes = work.bytes();
+    let bytes = late.work.bytes();
     let size = bytes.end - bytes.start;
-    ctx.command_encoder()
-        .copy_buffer_to_buffer(phases, bytes.start, args, bytes.start, size);
+    ctx.command_encoder().copy_buffer_to_buffer(
+        late.phases,
+        bytes.start,
+        late.args,
+        bytes.start,
+        size,
+    );
 }
