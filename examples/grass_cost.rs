@@ -316,7 +316,12 @@ fn apply(
     }
     for camera in cameras {
         let mut camera = commands.entity(camera);
-        camera.remove::<(DepthPrepass, NormalPrepass, MotionVectorPrepass, OcclusionCulling)>();
+        camera.remove::<(
+            DepthPrepass,
+            NormalPrepass,
+            MotionVectorPrepass,
+            OcclusionCulling,
+        )>();
         match setting.prepass {
             Prepass::None => {}
             Prepass::All => {

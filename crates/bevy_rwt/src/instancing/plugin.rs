@@ -54,73 +54,78 @@ impl Plugin for RwtInstancingPlugin {
                         .before(RwtSystems::Stats),
                 ),
             );
-        if app.get_sub_app(RenderApp).is_none() {
-            return;
+        if app.get_sub_app(RenderApp).is_some() {
+            build_render(app);
         }
-        render::embed_shader(app);
-        app.add_plugins((
-            ExtractComponentPlugin::<InstancedChunk>::default(),
-            ExtractResourcePlugin::<RwtWind>::default(),
-            ExtractResourcePlugin::<RwtFadeIn>::default(),
-            ExtractResourcePlugin::<InstanceCulling>::default(),
-            ExtractResourcePlugin::<BendField>::default(),
-        ));
-        #[cfg(feature = "testing")]
-        app.sub_app_mut(RenderApp)
-            .init_resource::<render::FrameCheck>()
-            .add_systems(ExtractSchedule, render::extract_culling_check)
-            .add_systems(
-                Render,
-                render::check_culling
-                    .after(RenderSystems::Render)
-                    .before(RenderSystems::Cleanup),
-            );
-        let render_app = app.sub_app_mut(RenderApp);
-        render_app
-            .add_render_command::<Opaque3d, render::DrawInstancedChunk>()
-            .add_render_command::<Opaque3dPrepass, render::DrawInstancedDepth>()
-            .add_render_command::<Shadow, render::DrawInstancedDepth>()
-            .init_resource::<SpecializedMeshPipelines<render::InstancedPipeline>>()
-            .init_resource::<SpecializedMeshPipelines<render::InstancedDepthPipeline>>()
-            .init_resource::<render::ReportedMeshes>()
-            .init_resource::<render::MainViewer>()
-            .init_resource::<render::Queued<Opaque3d>>()
-            .init_resource::<render::Queued<Opaque3dPrepass>>()
-            .init_resource::<render::Queued<Shadow>>()
-            .add_systems(
-                RenderStartup,
-                (
-                    render::init_bindings,
-                    render::init_main_pipeline.after(MeshPipelineSystems),
-                    render::init_depth_pipeline.after(init_prepass_pipeline),
-                    render::init_culler,
-                )
-                    .chain(),
-            )
-            .add_systems(
-                Render,
-                (
-                    (render::prepare_frame, render::prepare_chunks)
-                        .in_set(RenderSystems::PrepareResources),
-                    (
-                        render::queue_main,
-                        render::queue_prepass,
-                        render::queue_shadows,
-                    )
-                        .in_set(RenderSystems::QueueMeshes),
-                    render::cull_instances.in_set(RenderSystems::PrepareBindGroups),
-                ),
-            )
-            .add_systems(
-                Core3d,
-                (
-                    render::cull_late
-                        .after(early_downsample_depth)
-                        .before(late_prepass),
-                    render::restore_early
-                        .after(late_prepass)
-                        .before(Core3dSystems::MainPass),
-                ),
-            );
     }
+}
+
+/// The render world's part: extraction, pipelines, queueing, culling (and its check, with
+/// feature `testing`), draws.
+fn build_render(app: &mut App) {
+    render::embed_shader(app);
+    app.add_plugins((
+        ExtractComponentPlugin::<InstancedChunk>::default(),
+        ExtractResourcePlugin::<RwtWind>::default(),
+        ExtractResourcePlugin::<RwtFadeIn>::default(),
+        ExtractResourcePlugin::<InstanceCulling>::default(),
+        ExtractResourcePlugin::<BendField>::default(),
+    ));
+    #[cfg(feature = "testing")]
+    app.sub_app_mut(RenderApp)
+        .init_resource::<render::FrameCheck>()
+        .add_systems(ExtractSchedule, render::extract_culling_check)
+        .add_systems(
+            Render,
+            render::check_culling
+                .after(RenderSystems::Render)
+                .before(RenderSystems::Cleanup),
+        );
+    let render_app = app.sub_app_mut(RenderApp);
+    render_app
+        .add_render_command::<Opaque3d, render::DrawInstancedChunk>()
+        .add_render_command::<Opaque3dPrepass, render::DrawInstancedDepth>()
+        .add_render_command::<Shadow, render::DrawInstancedDepth>()
+        .init_resource::<SpecializedMeshPipelines<render::InstancedPipeline>>()
+        .init_resource::<SpecializedMeshPipelines<render::InstancedDepthPipeline>>()
+        .init_resource::<render::ReportedMeshes>()
+        .init_resource::<render::MainViewer>()
+        .init_resource::<render::Queued<Opaque3d>>()
+        .init_resource::<render::Queued<Opaque3dPrepass>>()
+        .init_resource::<render::Queued<Shadow>>()
+        .add_systems(
+            RenderStartup,
+            (
+                render::init_bindings,
+                render::init_main_pipeline.after(MeshPipelineSystems),
+                render::init_depth_pipeline.after(init_prepass_pipeline),
+                render::init_culler,
+            )
+                .chain(),
+        )
+        .add_systems(
+            Render,
+            (
+                (render::prepare_frame, render::prepare_chunks)
+                    .in_set(RenderSystems::PrepareResources),
+                (
+                    render::queue_main,
+                    render::queue_prepass,
+                    render::queue_shadows,
+                )
+                    .in_set(RenderSystems::QueueMeshes),
+                render::cull_instances.in_set(RenderSystems::PrepareBindGroups),
+            ),
+        )
+        .add_systems(
+            Core3d,
+            (
+                render::cull_late
+                    .after(early_downsample_depth)
+                    .before(late_prepass),
+                render::restore_early
+                    .after(late_prepass)
+                    .before(Core3dSystems::MainPass),
+            ),
+        );
 }
