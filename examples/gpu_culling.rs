@@ -16,13 +16,13 @@
 //! `target/culling`).
 
 use bevy::app::AppExit;
-use bevy::light::CascadeShadowConfigBuilder;
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
-use rwt_examples::frame_check::{Captures, mean_difference, output_dir};
+use rwt_examples::frame_check::{
+    Captures, culling_check_app, mean_difference, output_dir, passed, spawn_shadow_sun,
+};
 use rwt_examples::grass_field;
-use rwt_examples::prelude::*;
 
 /// Most mean difference between the two frames (0..255 a channel).
 const MOST_DIFFERENCE: f64 = 1.0;
@@ -32,17 +32,8 @@ const WAIT: u32 = 12;
 const PATIENCE: u32 = 600;
 
 fn main() -> AppExit {
-    App::new()
-        .add_plugins(example_plugins("rwt gpu_culling"))
-        .add_plugins(RwtPlugins::default())
-        .insert_resource(RwtWind {
-            strength: 0.0,
-            ..default()
-        })
-        .insert_resource(InstanceCulling::PerChunk)
-        .init_resource::<CullingCheck>()
+    culling_check_app("rwt gpu_culling")
         .init_resource::<Check>()
-        .init_resource::<Captures>()
         .add_systems(Startup, setup)
         .add_systems(Update, run_check)
         .run()
@@ -62,20 +53,7 @@ fn setup(
         RwtViewer::all_around(),
         Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
     ));
-    commands.spawn((
-        DirectionalLight {
-            shadow_maps_enabled: true,
-            ..default()
-        },
-        Transform::from_xyz(1.0, 2.0, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
-        // One cascade: a software driver draws every cascade on the CPU.
-        CascadeShadowConfigBuilder {
-            num_cascades: 1,
-            maximum_distance: 60.0,
-            ..default()
-        }
-        .build(),
-    ));
+    spawn_shadow_sun(&mut commands);
     let material = InstancedShading {
         thinning: Some(InstancedThinning::from(10.0)),
         ..default()
@@ -173,12 +151,5 @@ fn conclude(report: &CullingReport, whole: &image::RgbImage, culled: &image::Rgb
             "the culled frame differs from the whole one",
         ),
     ];
-    let mut passed = true;
-    for (failed, what) in failures {
-        if failed {
-            println!("rwt-culling: FAIL {what}");
-            passed = false;
-        }
-    }
-    passed
+    passed("rwt-culling", &failures)
 }

@@ -1,9 +1,13 @@
 //! Frames compared in a real renderer: screenshots captured by name into [`Captures`]
-//! (and saved as PNG), and their differences.
+//! (and saved as PNG), their differences, and what the examples that check culling against
+//! the frame drawn whole share.
 
+use bevy::light::CascadeShadowConfigBuilder;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy_rwt::prelude::*;
+use bevy_rwt::testing::CullingCheck;
 use std::path::PathBuf;
 
 /// The frames captured so far, by name, and whether a capture is under way.
@@ -77,4 +81,47 @@ pub fn pixels_differing(a: &image::RgbImage, b: &image::RgbImage, by: u8) -> usi
         .zip(b.pixels())
         .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > by))
         .count()
+}
+
+/// The app of an example that checks culling against the frame drawn whole: Bevy's and
+/// rwt's plugins, no wind (so that two frames can match), chunks drawn whole to begin with,
+/// a [`CullingCheck`] and the [`Captures`].
+pub fn culling_check_app(title: &str) -> App {
+    let mut app = App::new();
+    app.add_plugins(crate::example_plugins(title))
+        .add_plugins(RwtPlugins::default())
+        .insert_resource(RwtWind {
+            strength: 0.0,
+            ..default()
+        })
+        .insert_resource(InstanceCulling::PerChunk)
+        .init_resource::<CullingCheck>()
+        .init_resource::<Captures>();
+    app
+}
+
+/// A sun casting shadows into one cascade (a software driver draws every cascade on the
+/// CPU).
+pub fn spawn_shadow_sun(commands: &mut Commands) {
+    commands.spawn((
+        DirectionalLight {
+            shadow_maps_enabled: true,
+            ..default()
+        },
+        Transform::from_xyz(1.0, 2.0, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
+        CascadeShadowConfigBuilder {
+            num_cascades: 1,
+            maximum_distance: 60.0,
+            ..default()
+        }
+        .build(),
+    ));
+}
+
+/// Prints `PREFIX: FAIL what` for each failed check; whether none failed.
+pub fn passed(prefix: &str, checks: &[(bool, &str)]) -> bool {
+    for (_, what) in checks.iter().filter(|(failed, _)| *failed) {
+        println!("{prefix}: FAIL {what}");
+    }
+    checks.iter().all(|(failed, _)| !failed)
 }
