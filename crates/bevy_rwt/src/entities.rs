@@ -7,10 +7,11 @@
 use crate::ground::GroundRule;
 use crate::layers::{ScatterEntity, ScatterLayer};
 use crate::look::ClassLook;
+use bevy::camera::visibility::VisibilityRange;
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 use rwt_core::query::{Point, PointId};
-use rwt_core::streaming::{ChunkCoord, diff_instances};
+use rwt_core::streaming::{ChunkCoord, Viewer, diff_instances};
 use std::collections::VecDeque;
 
 /// A chunk's entity instances.
@@ -22,6 +23,43 @@ struct EntityChunk {
     queued: Vec<Point>,
     /// Whether the chunk is in the spawn order.
     in_order: bool,
+    /// The points of classes drawn far as impostors, spawned only while the chunk is near.
+    impostors: Vec<Point>,
+    /// Whether the chunk is near enough for its impostor classes' entities.
+    near: bool,
+}
+
+/// Which classes of a layer are drawn far as impostors, and within what ground distance of
+/// a viewer a chunk spawns their entities: where a camera may see the meshes, up to the end
+/// of their crossfade with the impostors.
+pub(crate) struct ImpostorReach {
+    classes: Vec<bool>,
+    reach: f64,
+}
+
+impl ImpostorReach {
+    /// A chunk near once stays so until this factor past the reach.
+    const HYSTERESIS: f64 = 1.1;
+
+    /// The reach of `layer`'s impostor classes (`None` when it has none).
+    pub fn of(layer: &ScatterLayer) -> Option<Self> {
+        let bands = layer.classes.iter().map(|c| c.impostor.map(|i| i.band().1));
+        let reach = bands.clone().flatten().fold(f32::NAN, f32::max);
+        (!reach.is_nan()).then(|| Self {
+            classes: bands.map(|b| b.is_some()).collect(),
+            reach: reach as f64,
+        })
+    }
+
+    /// Whether entities of `class` are held back in far chunks.
+    fn holds(&self, class: u16) -> bool {
+        self.classes.get(class as usize).copied().unwrap_or(false)
+    }
+
+    /// Whether a chunk `distance` from the nearest viewer is near, given whether it was.
+    fn near(&self, distance: f64, was: bool) -> bool {
+        distance <= self.reach * if was { Self::HYSTERESIS } else { 1.0 }
+    }
 }
 
 /// A layer's entity instances: what each chunk shows and is about to show, the order in
@@ -46,8 +84,23 @@ pub(crate) struct Spawner<'a> {
 impl EntityQueue {
     /// Shows `points` in `chunk`: vanished or re-classed instances go to the despawn queue,
     /// new points wait for the spawn budget; the others stay as they are.
-    pub fn show(&mut self, chunk: ChunkCoord, points: Vec<Point>) {
+    pub fn show(
+        &mut self,
+        chunk: ChunkCoord,
+        mut points: Vec<Point>,
+        reach: Option<&ImpostorReach>,
+    ) {
         let c = self.chunks.entry(chunk).or_default();
+        if let Some(reach) = reach {
+            c.impostors = points
+                .iter()
+                .filter(|p| reach.holds(p.class))
+                .copied()
+                .collect();
+            if !c.near {
+                points.retain(|p| !reach.holds(p.class));
+            }
+        }
         // Compare with what the chunk shows or is about to show.
         let spawned = c.spawned.iter().map(|(id, (_, class))| (*id, *class));
         let queued = c.queued.iter().map(|p| (p.id, p.class));
@@ -65,6 +118,37 @@ impl EntityQueue {
         if !c.queued.is_empty() && !c.in_order {
             c.in_order = true;
             self.spawn_order.push_back(chunk);
+        }
+    }
+
+    /// Spawns the impostor classes' entities of chunks that came within `reach` of a
+    /// viewer, and despawns those of chunks that left it.
+    pub fn follow_viewers(&mut self, reach: &ImpostorReach, size: f64, viewers: &[Viewer]) {
+        for (chunk, c) in self.chunks.iter_mut() {
+            let near = reach.near(chunk.viewer_distance(size, viewers), c.near);
+            if near == c.near {
+                continue;
+            }
+            c.near = near;
+            if near {
+                let shown = |p: &&Point| !c.spawned.contains_key(&p.id);
+                let points: Vec<Point> = c.impostors.iter().filter(shown).copied().collect();
+                c.queued.extend(points);
+                if !c.queued.is_empty() && !c.in_order {
+                    c.in_order = true;
+                    self.spawn_order.push_back(*chunk);
+                }
+            } else {
+                c.queued.retain(|p| !reach.holds(p.class));
+                let despawn = &mut self.despawn;
+                c.spawned.retain(|_, (e, class)| {
+                    let held = reach.holds(*class);
+                    if held {
+                        despawn.push_back(*e);
+                    }
+                    !held
+                });
+            }
         }
     }
 
@@ -104,6 +188,7 @@ impl EntityQueue {
         let Some(c) = self.chunks.get_mut(&chunk) else {
             return false;
         };
+        c.impostors.retain(|p| p.id != *id);
         if let Some((e, _)) = c.spawned.remove(id) {
             commands.entity(e).try_despawn();
             return true;
@@ -126,8 +211,14 @@ impl EntityQueue {
         if !self.remove_now(commands, chunk, &p.id) {
             return false;
         }
-        let e = spawn_instance(commands, spawner, p);
         let c = self.chunks.entry(chunk).or_default();
+        if ImpostorReach::of(spawner.layer).is_some_and(|r| r.holds(p.class)) {
+            c.impostors.push(*p);
+            if !c.near {
+                return true;
+            }
+        }
+        let e = spawn_instance(commands, spawner, p);
         c.spawned.insert(p.id, (e, p.class));
         true
     }
@@ -200,17 +291,36 @@ fn spawn_instance(commands: &mut Commands, spawner: &Spawner, p: &Point) -> Enti
     };
     // One bundle for the common case: an insert after the spawn would move every instance
     // to a second archetype.
-    match (&class.look, &class.lod) {
-        (ClassLook::Mesh { mesh, material }, None) => commands
-            .spawn((
+    // Drawn as an impostor from its band on: the mesh fades out over it (a far level of
+    // detail that would start later is never seen).
+    let band = class.impostor.map(|i| i.band());
+    let lod = class
+        .lod
+        .as_ref()
+        .filter(|l| class.impostor.is_none_or(|i| l.distance < i.distance));
+    match (&class.look, lod) {
+        (ClassLook::Mesh { mesh, material }, None) => {
+            let look = (
                 instance,
                 Mesh3d(mesh.clone()),
                 MeshMaterial3d(material.clone()),
                 transform,
-            ))
-            .id(),
+            );
+            match band {
+                Some((start, end)) => commands.spawn((
+                    look,
+                    VisibilityRange {
+                        start_margin: 0.0..0.0,
+                        end_margin: start..end,
+                        use_aabb: false,
+                    },
+                )),
+                None => commands.spawn(look),
+            }
+            .id()
+        }
         (ClassLook::Mesh { mesh, material }, Some(lod)) => {
-            let (near, far) = lod.ranges();
+            let (near, far) = lod.ranges(band);
             commands
                 .spawn((
                     instance,

@@ -150,6 +150,7 @@ mod entities;
 pub mod footprints;
 pub mod gizmos;
 pub mod ground;
+pub mod impostor;
 pub mod instancing;
 pub mod layers;
 pub mod look;
@@ -175,7 +176,7 @@ pub use layers::{
     ScatterEntity, ScatterLayer, ScatterLayerStatus,
 };
 pub use look::{
-    ClassLook, Footing, GroundPlane, InstanceInserter, InstancedLook, InstancedShading,
+    ClassLook, Footing, GroundPlane, Impostor, InstanceInserter, InstancedLook, InstancedShading,
     InstancedShadows, InstancedThinning, MeshLod, Pose, Stance,
 };
 pub use rwt_core;
@@ -200,7 +201,7 @@ pub mod prelude {
     pub use crate::save::{LoadWorld, NamedMap, RwtSavePlugin, SaveWorld, WorldLoaded, WorldSaved};
     pub use crate::{
         AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundMap,
-        GroundPlane, HeightSource, InstanceCulling, InstancedChunk, InstancedShading,
+        GroundPlane, HeightSource, Impostor, InstanceCulling, InstancedChunk, InstancedShading,
         InstancedShadows, InstancedThinning, LayerDensity, RwtDiagnosticsPlugin, RwtFadeIn,
         RwtInstancingPlugin, RwtLayersPlugin, RwtPlugins, RwtSettings, RwtStats,
         RwtStreamingPlugin, RwtSystems, RwtViewer, RwtViewersPlugin, RwtWind, ScatterClass,

@@ -197,6 +197,21 @@ pub struct InstancedChunk {
     /// see them: bulk data, counted by [`InstancedChunk::len`].
     #[reflect(ignore)]
     pub buffer: Arc<InstanceBuffer>,
+    /// Drawn as impostors: cards showing the atlas (the material's texture) from the
+    /// nearest view, from the start of the band on.
+    pub impostor: Option<ImpostorDraw>,
+}
+
+/// How a chunk of impostors is drawn: where the atlas's views lie, and the crossfade band
+/// (distance from the camera to an instance's root) over which the cards fade in,
+/// dithered as Bevy's visibility ranges fade the meshes out.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
+pub struct ImpostorDraw {
+    /// Where the atlas's views lie.
+    pub frames: crate::impostor::ImpostorFrames,
+    /// The crossfade band (start, end).
+    pub band: (f32, f32),
 }
 
 impl InstancedChunk {

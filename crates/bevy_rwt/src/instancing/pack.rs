@@ -33,6 +33,8 @@ struct PackedLook {
     stance: Stance,
     /// Promoted classes keep their instances' identities.
     keep_ids: bool,
+    /// An entity class packed for its impostors: its points are also spawned.
+    keep_points: bool,
 }
 
 /// A chunk's instances of one class, ready for the GPU.
@@ -47,12 +49,20 @@ impl InstancedClasses {
         let classes = layer
             .classes
             .iter()
-            .map(|c| match c.look {
-                ClassLook::Instanced(_) => Some(PackedLook {
+            .map(|c| match (&c.look, &c.impostor) {
+                (ClassLook::Instanced(_), _) => Some(PackedLook {
                     scale: c.scale,
                     variation: c.scale_variation,
                     stance: c.stance,
                     keep_ids: keep_ids || c.promotion.is_some(),
+                    keep_points: false,
+                }),
+                (ClassLook::Mesh { .. }, Some(_)) => Some(PackedLook {
+                    scale: c.scale,
+                    variation: c.scale_variation,
+                    stance: c.stance,
+                    keep_ids,
+                    keep_points: true,
                 }),
                 _ => None,
             })
@@ -77,13 +87,22 @@ impl InstancedClasses {
         self.classes.iter().any(Option::is_some)
     }
 
-    /// Whether points of `class` are packed rather than spawned.
+    /// Whether points of `class` are packed (rather than spawned, or besides being spawned
+    /// for a class drawn far as impostors).
     pub fn is_instanced(&self, class: u16) -> bool {
         matches!(self.classes.get(class as usize), Some(Some(_)))
     }
 
-    /// Moves the points of instanced classes out of `points` into one buffer per class
-    /// (every instanced class gets one, empty or not, so that emptied chunks are cleared).
+    /// Whether points of `class` stay for the entity look once packed.
+    fn keeps_points(&self, class: u16) -> bool {
+        self.classes
+            .get(class as usize)
+            .is_some_and(|c| c.is_some_and(|c| c.keep_points))
+    }
+
+    /// Moves the points of instanced classes out of `points` into one buffer per class, and
+    /// copies those of entity classes with impostors into one (every packed class gets one,
+    /// empty or not, so that emptied chunks are cleared).
     /// `densities` are the class densities the chunk was queried with, at level-of-detail
     /// `factor`; `corner` is the chunk's corner, which positions are relative to.
     pub fn pack(
@@ -103,8 +122,9 @@ impl InstancedClasses {
             if !self.is_instanced(p.class) {
                 return true;
             }
+            let keep = self.keeps_points(p.class);
             if !self.drawable {
-                return false;
+                return keep;
             }
             let (hit, area) = ground
                 .stand_in(p, stands)
@@ -117,7 +137,7 @@ impl InstancedClasses {
             if self.classes[p.class as usize].is_some_and(|c| c.keep_ids) {
                 buffer.ids.push(p.id);
             }
-            false
+            keep
         });
         buffers
             .into_iter()

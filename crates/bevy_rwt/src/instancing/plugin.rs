@@ -37,6 +37,7 @@ impl Plugin for RwtInstancingPlugin {
             .init_resource::<InstanceCulling>()
             .init_resource::<InstancedMeshes>()
             .init_resource::<BendField>()
+            .init_resource::<crate::impostor::ImpostorAtlases>()
             .register_type::<Bender>()
             .register_type::<BendField>()
             .register_type::<RwtWind>()
@@ -48,6 +49,7 @@ impl Plugin for RwtInstancingPlugin {
                 (
                     mesh::refit_changed_meshes.before(RwtSystems::Apply),
                     bend::update_bend_field,
+                    crate::impostor::bake_impostors.before(RwtSystems::Apply),
                     (far::choose_chunk_meshes, mesh::report_class_errors)
                         .chain()
                         .after(RwtSystems::Apply)

@@ -4,9 +4,12 @@
 //! Instances of a promoted class near a viewer are held by entities instead
 //! ([`super::promote`]); the chunk's buffer draws the others.
 
-use super::{InstanceBuffer, InstancedChunk, InstancedMeshes, PackedClass, pack};
+use super::{ImpostorDraw, InstanceBuffer, InstancedChunk, InstancedMeshes, PackedClass, pack};
+use crate::impostor::{ImpostorAtlas, ImpostorAtlases};
+use crate::layers::ScatterClass;
 use crate::layers::ScatterLayer;
 use crate::look::ClassLook;
+use crate::look::{InstancedShading, InstancedShadows};
 use bevy::camera::primitives::Aabb;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -44,6 +47,8 @@ pub(crate) struct InstancedQueue {
     /// Entities of unloaded chunks (chunk entities, promoted instances): despawned at once,
     /// whatever the budget.
     retired: Vec<Entity>,
+    /// [`ImpostorAtlases::generation`] when impostor chunks were last drawn.
+    impostors_seen: u64,
 }
 
 impl ClassBuffer {
@@ -159,6 +164,8 @@ pub(crate) struct Upload<'a> {
     checked: &'a mut InstancedMeshes,
     /// Whether no chunk was handed over yet this frame (one always is).
     first: bool,
+    /// The impostor atlases baked so far.
+    impostors: Option<&'a ImpostorAtlases>,
 }
 
 /// A layer's chunk: where buffers of its classes go.
@@ -175,12 +182,42 @@ impl<'a> Upload<'a> {
         budget: usize,
         meshes: Option<&'a Assets<Mesh>>,
         checked: &'a mut InstancedMeshes,
+        impostors: Option<&'a ImpostorAtlases>,
     ) -> Self {
         Self {
             budget,
             meshes,
             checked,
             first: true,
+            impostors,
+        }
+    }
+
+    /// Draws again the impostor classes of every chunk when atlases were baked since the
+    /// queue last looked (chunks handed over before their class's atlas drew nothing).
+    pub fn refresh_impostors(
+        &mut self,
+        commands: &mut Commands,
+        entity: Entity,
+        layer: &ScatterLayer,
+        queue: &mut InstancedQueue,
+    ) {
+        let generation = self.impostors.map_or(0, ImpostorAtlases::generation);
+        if std::mem::replace(&mut queue.impostors_seen, generation) == generation {
+            return;
+        }
+        for (chunk, c) in queue.chunks.iter_mut() {
+            let target = Target {
+                entity,
+                layer,
+                chunk: *chunk,
+            };
+            for (class, buffer) in c.classes.iter_mut() {
+                let impostor = layer.classes.get(*class as usize).and_then(|c| c.impostor);
+                if impostor.is_some() {
+                    self.redraw(commands, target, *class, buffer);
+                }
+            }
         }
     }
 
@@ -300,7 +337,11 @@ impl<'a> Upload<'a> {
         let layer = target.layer;
         let c = layer.classes.get(class as usize)?;
         let ClassLook::Instanced(look) = &c.look else {
-            return None;
+            return self.impostors?.of(c).map(|atlas| {
+                let component = impostor_chunk(target, class, c, atlas, buffer);
+                let aabb = component.aabb(self.checked.bounds(&atlas.card, self.meshes));
+                (component, aabb)
+            });
         };
         let mesh_bounds = self.checked.bounds(&look.mesh, self.meshes);
         let component = InstancedChunk {
@@ -312,12 +353,57 @@ impl<'a> Upload<'a> {
             material: look.material.clone(),
             mesh_top: mesh_bounds.1.y.max(1e-3),
             max_scale: c.scale * (1.0 + c.scale_variation.abs()),
-            falloff: layer
-                .falloff
-                .map(|f| (f.near as f32, f.far as f32, f.floor as f32)),
+            falloff: layer_falloff(layer),
             buffer,
+            impostor: None,
         };
         let aabb = component.aabb(self.checked.class_bounds(&component.meshes, self.meshes));
         Some((component, aabb))
+    }
+}
+
+/// The layer's level-of-detail fall-off as chunk components carry it.
+fn layer_falloff(layer: &ScatterLayer) -> Option<(f32, f32, f32)> {
+    layer
+        .falloff
+        .map(|f| (f.near as f32, f.far as f32, f.floor as f32))
+}
+
+/// The chunk drawing the class's instances in `buffer` as impostors of `atlas`: lit cards,
+/// still in the wind, casting no shadow.
+fn impostor_chunk(
+    target: Target,
+    class: u16,
+    c: &ScatterClass,
+    atlas: &ImpostorAtlas,
+    buffer: Arc<InstanceBuffer>,
+) -> InstancedChunk {
+    let frames = atlas.frames;
+    let material = InstancedShading {
+        base_color: Color::WHITE,
+        tip_color: Color::WHITE,
+        color_variation: 0.0,
+        roughness: atlas.roughness,
+        wind_response: 0.0,
+        tip_from: 0.0,
+        shadows: InstancedShadows::Off,
+        texture: Some(atlas.image.clone()),
+        bend_response: 0.0,
+        thinning: None,
+        ..default()
+    };
+    let band = c.impostor.map_or((0.0, 0.0), |i| i.band());
+    InstancedChunk {
+        layer: target.entity,
+        chunk: target.chunk,
+        class,
+        mesh: atlas.card.clone(),
+        meshes: (atlas.card.clone(), None),
+        material,
+        mesh_top: (frames.center.y + frames.half.y).max(1e-3),
+        max_scale: c.scale * (1.0 + c.scale_variation.abs()),
+        falloff: layer_falloff(target.layer),
+        buffer,
+        impostor: Some(ImpostorDraw { frames, band }),
     }
 }

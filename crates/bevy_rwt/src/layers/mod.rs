@@ -21,8 +21,8 @@ use crate::ground::{
     SurfacePolicy,
 };
 use crate::look::{
-    ClassLook, GroundPlane, InstanceInserter, InstancedFar, InstancedLook, InstancedShading,
-    MeshLod, Pose, Stance,
+    ClassLook, GroundPlane, Impostor, InstanceInserter, InstancedFar, InstancedLook,
+    InstancedShading, MeshLod, Pose, Stance,
 };
 use bevy::prelude::*;
 use rwt_core::clumps::Clumps;
@@ -130,6 +130,8 @@ pub struct ScatterClass {
     pub promotion: Option<Promotion>,
     /// How its instances stand on their surface: upright, along its normal, or between.
     pub stance: Stance,
+    /// Far instances drawn as impostors (for [`ClassLook::Mesh`] classes).
+    pub impostor: Option<Impostor>,
 }
 
 /// Near instances of an instanced class become entities: within `distance` (on the ground)
@@ -240,7 +242,15 @@ impl ScatterClass {
             pick_bounds: None,
             promotion: None,
             stance: Stance::UPRIGHT,
+            impostor: None,
         }
+    }
+
+    /// Draws the instances of this mesh class from `impostor.distance` on as impostors
+    /// baked from its look (see [`Impostor`]).
+    pub fn with_impostor(mut self, impostor: Impostor) -> Self {
+        self.impostor = Some(impostor);
+        self
     }
 
     /// Stands instances between upright (`align` 0) and along the surface normal (1), sunk

@@ -6,11 +6,13 @@
 
 mod blade;
 mod check;
+mod impostor;
 mod instanced;
 
 pub use blade::blade_mesh;
 pub use check::{InstancedClassError, check_instanced_mesh};
 pub(crate) use check::{check_texture, check_topology};
+pub use impostor::Impostor;
 pub use instanced::{
     DEFAULT_ALPHA_CUTOFF, InstancedFar, InstancedLook, InstancedShading, InstancedShadows,
     InstancedThinning,
@@ -83,8 +85,9 @@ pub struct MeshLod {
 }
 
 impl MeshLod {
-    /// The visibility ranges of the near and the far look.
-    pub fn ranges(&self) -> (VisibilityRange, VisibilityRange) {
+    /// The visibility ranges of the near and the far look; the far look fades out over
+    /// `until` (an impostor's crossfade band) when given.
+    pub fn ranges(&self, until: Option<(f32, f32)>) -> (VisibilityRange, VisibilityRange) {
         let half = (0.5 * self.crossfade).clamp(0.0, 0.99 * self.distance.max(0.0));
         let switch = (self.distance - half).max(0.0)..self.distance + half;
         let near = VisibilityRange {
@@ -94,14 +97,14 @@ impl MeshLod {
         };
         let far = VisibilityRange {
             start_margin: switch,
-            end_margin: Self::NEVER..Self::NEVER,
+            end_margin: until.map_or(Self::NEVER..Self::NEVER, |(a, b)| a..b),
             use_aabb: false,
         };
         (near, far)
     }
 
     /// A distance no camera reaches (the far look never fades out).
-    const NEVER: f32 = 1.0e9;
+    pub(crate) const NEVER: f32 = 1.0e9;
 }
 
 /// How a point's instance is turned and sized: hashed from its identity, so every look of

@@ -3,7 +3,7 @@
 
 use super::{ChunkContent, ChunkLoaded, LayerState};
 use crate::edits::EditSet;
-use crate::entities::Spawner;
+use crate::entities::{ImpostorReach, Spawner};
 use crate::layers::ScatterLayer;
 use bevy::prelude::*;
 use bevy::tasks::futures::check_ready;
@@ -17,6 +17,7 @@ pub(super) fn collect_results(
 ) {
     for (entity, layer, mut state) in &mut layers {
         let classes = layer.classes.len();
+        let reach = ImpostorReach::of(layer);
         let state = &mut *state;
         let mut finished = Vec::new();
         for (chunk, c) in state.states.iter_mut() {
@@ -73,7 +74,7 @@ pub(super) fn collect_results(
                     .entities
                     .replace_kept(&mut commands, &spawner, chunk, &points);
             }
-            state.entities.show(chunk, points);
+            state.entities.show(chunk, points, reach.as_ref());
             loaded.write(ChunkLoaded {
                 layer: entity,
                 chunk,

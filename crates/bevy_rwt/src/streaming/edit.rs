@@ -127,8 +127,10 @@ fn apply_edit(
         }
         _ => false,
     };
-    // Otherwise the point is instanced, restored, or not shown: its chunk is generated again.
-    if !shown {
+    // Otherwise the point is instanced, restored, or not shown: its chunk is generated
+    // again; so is a chunk drawing impostors, whose buffers show its points too.
+    let impostors = layer.classes.iter().any(|c| c.impostor.is_some());
+    if !shown || impostors {
         state.mark_chunk_stale(chunk);
     }
     Ok(())

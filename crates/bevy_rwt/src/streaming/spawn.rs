@@ -2,7 +2,8 @@
 //! order).
 
 use super::LayerState;
-use crate::entities::Spawner;
+use crate::entities::{ImpostorReach, Spawner};
+use crate::impostor::ImpostorAtlases;
 use crate::instancing::{InstancedMeshes, Upload};
 use crate::layers::ScatterLayer;
 use crate::settings::RwtSettings;
@@ -18,13 +19,24 @@ pub(super) fn apply_budget(
     meshes: Option<Res<Assets<Mesh>>>,
     mut checked: ResMut<InstancedMeshes>,
     viewers: Res<Viewers>,
+    impostors: Option<Res<ImpostorAtlases>>,
 ) {
     let mut spawn_budget = settings.spawn_budget;
     let mut despawn_budget = settings.despawn_budget;
-    let mut upload = Upload::new(settings.upload_budget, meshes.as_deref(), &mut checked);
+    let mut upload = Upload::new(
+        settings.upload_budget,
+        meshes.as_deref(),
+        &mut checked,
+        impostors.as_deref(),
+    );
     for (entity, layer, mut state) in &mut layers {
         let state = &mut *state;
         state.instanced.despawn_retired(&mut commands);
+        if let Some(reach) = ImpostorReach::of(layer) {
+            let viewers = viewers.on(layer.plane);
+            let size = layer.streaming.chunk_size;
+            state.entities.follow_viewers(&reach, size, viewers);
+        }
         state
             .entities
             .despawn_queued(&mut commands, &mut despawn_budget);
@@ -39,6 +51,7 @@ pub(super) fn apply_budget(
                 .spawn_queued(&mut commands, &spawner, &mut spawn_budget);
         }
         upload.chunks(&mut commands, entity, layer, &mut state.instanced);
+        upload.refresh_impostors(&mut commands, entity, layer, &mut state.instanced);
         let viewers = viewers.on(layer.plane);
         upload.promote(&mut commands, entity, layer, &mut state.instanced, viewers);
     }

@@ -10,6 +10,7 @@ mod edits;
 mod footprints;
 mod gizmos;
 mod ground;
+mod impostors;
 mod instanced;
 mod keep_out;
 mod layer_files;

@@ -49,6 +49,16 @@ struct Chunk {
     thinning_from: f32,
     thinning_floor: f32,
     thinning_on: u32,
+    // Impostors: the crossfade band (distance from the eye to a root) they fade in over.
+    visible_from: f32,
+    visible_to: f32,
+    // Half the width and height one baked view covers, at scale 1.
+    impostor_half: vec2<f32>,
+    // Where the views look (the mesh's bounds' centre), and how many there are around.
+    impostor_center: vec3<f32>,
+    impostor_views: u32,
+    // Elevations baked.
+    impostor_rows: u32,
 };
 
 @group(2) @binding(0) var<uniform> chunk: Chunk;
@@ -102,6 +112,10 @@ struct VertexOutput {
 #endif
 #ifdef RWT_TEXTURE
     @location(5) uv: vec2<f32>,
+#endif
+#ifdef RWT_IMPOSTOR
+    // The instance's turn (cosine, sine) and its crossfade's dither level (-16..0).
+    @location(6) @interpolate(flat) impostor: vec4<f32>,
 #endif
 };
 
@@ -259,8 +273,96 @@ fn place(in: Vertex, time: f32) -> Placed {
     return out;
 }
 
+#ifdef RWT_IMPOSTOR
+// Where distances are measured from, as Bevy's visibility ranges measure them: the view's
+// camera, or the main camera in shadow passes.
+fn lod_eye() -> vec3<f32> {
+#ifdef RWT_SHADOW_PASS
+    return frame.viewer;
+#else
+    return view.world_position;
+#endif
+}
+
+// The dither level of an impostor `d` from the eye: -16 (not drawn) before the crossfade
+// band, rising to 0 (whole) at its end. Bevy's visibility range fades the mesh out over
+// the same band with the level 16 more, so every pixel shows one of the two.
+fn fade_in_level(d: f32) -> f32 {
+    let span = max(chunk.visible_to - chunk.visible_from, 1e-3);
+    return -16.0 + clamp(round((d - chunk.visible_from) / span * 16.0), 0.0, 16.0);
+}
+
+// An impostor's card: centred on the baked views' centre (turned with the instance), facing
+// the eye, pulled towards it by half its width (so that the ground around the root does
+// not cut it) and shrunk to keep its size on screen. It shows the view nearest to the
+// direction of the eye in the instance's frame. A card not drawn collapses to its root.
+fn card(in: Vertex) -> VertexOutput {
+    let root = chunk.origin + in.offset_scale.xyz;
+    let yaw = in.yaw_appear_tint.x * 6.2831853;
+    let c = cos(yaw);
+    let s = sin(yaw);
+    let fade = chunk_fade();
+    let scale = in.offset_scale.w * growth(fade, root, in.yaw_appear_tint.y, kept_fraction(fade, root));
+    let eye = lod_eye();
+    let level = fade_in_level(distance(eye, root));
+    let m = chunk.impostor_center * scale;
+    let center = root + vec3<f32>(c * m.x + s * m.z, m.y, -s * m.x + c * m.z);
+    let dist = max(distance(eye, center), 1e-3);
+    let dir = (eye - center) / dist;
+    let local = vec3<f32>(c * dir.x - s * dir.z, dir.y, s * dir.x + c * dir.z);
+    let views = f32(chunk.impostor_views);
+    let rows = f32(chunk.impostor_rows);
+    let turn = atan2(local.x, local.z) / 6.2831853 * views;
+    let i = (round(turn) % views + views) % views;
+    let j = clamp(round(asin(clamp(local.y, 0.0, 1.0)) / 1.5707963 * rows), 0.0, rows - 1.0);
+    var right = cross(vec3<f32>(0.0, 1.0, 0.0), dir);
+    right = select(vec3<f32>(1.0, 0.0, 0.0), normalize(right), dot(right, right) > 1e-8);
+    let up = cross(dir, right);
+    let pull = min(chunk.impostor_half.x * scale, 0.5 * dist);
+    let size = scale * (dist - pull) / dist * select(0.0, 1.0, level > -16.0 && scale > 0.0);
+    let across = in.position.x * size;
+    let high = (in.position.y - chunk.impostor_center.y) * size;
+    let world = center + dir * pull + right * across + up * high;
+    var out: VertexOutput;
+    out.world_position = vec4<f32>(world, 1.0);
+    out.clip_position = position_world_to_clip(world);
+    out.world_normal = dir;
+    out.color = vec4<f32>(1.0);
+#ifdef MOTION_VECTOR_PREPASS
+    out.previous_world_position = out.world_position;
+#endif
+    out.uv = vec2<f32>((i + in.uv.x) / (2.0 * views), (j + in.uv.y) / rows);
+    out.impostor = vec4<f32>(c, s, level, 0.0);
+#ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
+    out.unclipped_depth = out.clip_position.z;
+    out.clip_position.z = min(out.clip_position.z, 1.0);
+#endif
+    return out;
+}
+
+// Bevy's ordered dither: discards the fragment at `frag_coord` of a look fading in at
+// `level` (-16: gone, 0: whole), as `visibility_range_dither` does.
+fn dither_in(frag_coord: vec4<f32>, level: f32) {
+    let coords = vec2<u32>(floor(frag_coord.xy)) % 4u;
+    let map = vec4<u32>(0x0a020800u, 0x060e040cu, 0x09010b03u, 0x050d070fu);
+    let threshold = f32((map[coords.y] >> (coords.x * 8u)) & 0xffu);
+    if level <= -16.0 || 1.0 + level + threshold <= 0.0 {
+        discard;
+    }
+}
+
+// The atlas's normal where the albedo is read at `uv`, in the world (the instance turned).
+fn impostor_normal(uv: vec2<f32>, turn: vec4<f32>) -> vec3<f32> {
+    let n = textureSample(base_texture, base_sampler, uv + vec2<f32>(0.5, 0.0)).xyz * 2.0 - 1.0;
+    return normalize(vec3<f32>(turn.x * n.x + turn.y * n.z, n.y, -turn.y * n.x + turn.x * n.z));
+}
+#endif
+
 @vertex
 fn vertex(in: Vertex) -> VertexOutput {
+#ifdef RWT_IMPOSTOR
+    return card(in);
+#else
     let placed = place(in, globals.time);
     let tint = in.yaw_appear_tint.z;
     let variation = (tint - 0.5) * chunk.color_variation;
@@ -282,6 +384,7 @@ fn vertex(in: Vertex) -> VertexOutput {
     out.clip_position.z = min(out.clip_position.z, 1.0);
 #endif
     return out;
+#endif
 }
 
 #ifdef RWT_TEXTURE
@@ -311,12 +414,19 @@ struct FragmentOutput {
 
 @fragment
 fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> FragmentOutput {
+#ifdef RWT_IMPOSTOR
+    let n = impostor_normal(in.uv, in.impostor);
+    _ = cut_out(in.uv);
+    dither_in(in.clip_position, in.impostor.z);
+#else
 #ifdef RWT_TEXTURE
     _ = cut_out(in.uv);
 #endif
+    let n = facing_normal(in.world_normal, is_front);
+#endif
     var out: FragmentOutput;
 #ifdef NORMAL_PREPASS
-    out.normal = vec4<f32>(facing_normal(in.world_normal, is_front) * 0.5 + vec3<f32>(0.5), 1.0);
+    out.normal = vec4<f32>(n * 0.5 + vec3<f32>(0.5), 1.0);
 #endif
 #ifdef MOTION_VECTOR_PREPASS
     let now_t = view.unjittered_clip_from_world * in.world_position;
@@ -334,16 +444,26 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> Fragment
 @fragment
 fn fragment(in: VertexOutput) {
     _ = cut_out(in.uv);
+#ifdef RWT_IMPOSTOR
+    dither_in(in.clip_position, in.impostor.z);
+#endif
 }
 #endif
 #endif
 #else
 @fragment
 fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
+#ifdef RWT_IMPOSTOR
+    let n = impostor_normal(in.uv, in.impostor);
+#else
     let n = facing_normal(in.world_normal, is_front);
+#endif
     var color = in.color;
 #ifdef RWT_TEXTURE
     color = vec4<f32>(color.rgb * cut_out(in.uv).rgb, 1.0);
+#endif
+#ifdef RWT_IMPOSTOR
+    dither_in(in.clip_position, in.impostor.z);
 #endif
     var pbr_input = pbr_types::pbr_input_new();
     pbr_input.material.base_color = color;

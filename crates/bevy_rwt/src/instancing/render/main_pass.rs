@@ -89,6 +89,9 @@ pub(super) fn mesh_attributes(
         attributes.push(Mesh::ATTRIBUTE_UV_0.at_shader_location(2));
         defs.push("RWT_TEXTURE".into());
     }
+    if features.impostor {
+        defs.push("RWT_IMPOSTOR".into());
+    }
     attributes
 }
 

@@ -92,6 +92,7 @@ impl ExtractedChunk {
         ClassFeatures {
             textured: self.texture.is_some(),
             bends: self.uniform.bend_response != 0.0,
+            impostor: self.uniform.impostor_views != 0 && self.texture.is_some(),
         }
     }
 }
@@ -106,6 +107,8 @@ pub(in crate::instancing) struct ClassFeatures {
     textured: bool,
     /// The class leans away from benders (`RWT_BEND`).
     bends: bool,
+    /// The chunk draws impostors, cards showing its texture's atlas (`RWT_IMPOSTOR`).
+    impostor: bool,
 }
 
 impl SyncComponent for InstancedChunk {
@@ -133,7 +136,8 @@ impl ExtractComponent for InstancedChunk {
             reach: reach(&local, chunk.buffer.bounds, chunk.max_scale, aabb.is_some()),
             buffer: chunk.buffer.clone(),
             mesh: chunk.mesh.id(),
-            uniform: ChunkUniform::new(origin, chunk.mesh_top, &chunk.material, chunk.falloff),
+            uniform: ChunkUniform::new(origin, chunk.mesh_top, &chunk.material, chunk.falloff)
+                .with_impostor(chunk.impostor.as_ref()),
             bounds: Aabb {
                 center: local.center + origin.to_vec3a(),
                 half_extents: local.half_extents,

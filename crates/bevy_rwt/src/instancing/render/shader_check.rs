@@ -128,7 +128,7 @@ fn cache_with_library() -> ShaderCache<String, ()> {
 /// every class feature and pass option the pipelines combine.
 fn permutations() -> Vec<Vec<ShaderDefVal>> {
     let global = ShaderDefVal::UInt("AVAILABLE_STORAGE_BUFFER_BINDINGS".into(), 8);
-    let features = ["RWT_NORMALS", "RWT_BEND", "RWT_TEXTURE"];
+    let features = ["RWT_NORMALS", "RWT_BEND", "RWT_TEXTURE", "RWT_IMPOSTOR"];
     let passes = [
         "NORMAL_PREPASS",
         "MOTION_VECTOR_PREPASS",
@@ -140,7 +140,9 @@ fn permutations() -> Vec<Vec<ShaderDefVal>> {
         on.map(|(_, n)| ShaderDefVal::from(*n)).collect()
     };
     let mut all = Vec::new();
-    for f in 0..1 << features.len() {
+    // Impostors are always textured (their atlas).
+    let impostor_untextured = |f: usize| f & 0b1100 == 0b1000;
+    for f in (0..1 << features.len()).filter(|f| !impostor_untextured(*f)) {
         let mut main = vec![
             global.clone(),
             ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 3),
@@ -208,6 +210,12 @@ fn marked_chunk() -> (Vec<(String, usize)>, usize) {
         thinning_from: f(20),
         thinning_floor: f(21),
         thinning_on: 22,
+        visible_from: f(23),
+        visible_to: f(24),
+        impostor_half: Vec2::splat(f(25)),
+        impostor_center: Vec3::splat(f(26)),
+        impostor_views: 27,
+        impostor_rows: 28,
     };
     let names = [
         "origin",
@@ -233,8 +241,14 @@ fn marked_chunk() -> (Vec<(String, usize)>, usize) {
         "thinning_from",
         "thinning_floor",
         "thinning_on",
+        "visible_from",
+        "visible_to",
+        "impostor_half",
+        "impostor_center",
+        "impostor_views",
+        "impostor_rows",
     ];
-    let words = [11, 19, 22];
+    let words = [11, 19, 22, 27, 28];
     let markers: Vec<(&str, u32)> = (0u32..)
         .zip(names)
         .map(|(k, n)| {
@@ -313,7 +327,7 @@ fn every_permutation_composes_and_validates_with_the_uniform_layouts() {
         failed.len(),
         failed.join("\n")
     );
-    assert_eq!(composed.len(), 8 * 17);
+    assert_eq!(composed.len(), 12 * 17);
     let (chunk, frame) = (marked_chunk(), marked_frame());
     for types in &composed {
         assert_eq!(struct_layout(types, "Chunk"), chunk);

@@ -1,6 +1,7 @@
 //! The uniforms `instanced.wgsl` reads, as `ShaderType`s: laid out by encase, as WGSL lays
 //! out its `Chunk` and `Frame` structs (the naga check compares the two).
 
+use crate::instancing::ImpostorDraw;
 use crate::look::InstancedShading;
 use bevy::prelude::*;
 use bevy::render::render_resource::ShaderType;
@@ -42,6 +43,16 @@ pub(super) struct ChunkUniform {
     pub thinning_from: f32,
     pub thinning_floor: f32,
     pub thinning_on: u32,
+    /// Impostors: the crossfade band (distance from the eye to a root) they fade in over;
+    /// both 0 for other classes.
+    pub visible_from: f32,
+    pub visible_to: f32,
+    /// Impostors: half the width and height of a baked view, at scale 1.
+    pub impostor_half: Vec2,
+    /// Impostors: where the views look, and how many there are around and up.
+    pub impostor_center: Vec3,
+    pub impostor_views: u32,
+    pub impostor_rows: u32,
 }
 
 impl ChunkUniform {
@@ -78,6 +89,20 @@ impl ChunkUniform {
             thinning_floor: thinning.map_or(0.0, |t| t.1),
             thinning_on: u32::from(thinning.is_some()),
             ..default()
+        }
+    }
+
+    /// The uniform drawing impostors as `draw` says.
+    pub fn with_impostor(self, draw: Option<&ImpostorDraw>) -> Self {
+        let Some(d) = draw else { return self };
+        Self {
+            visible_from: d.band.0,
+            visible_to: d.band.1,
+            impostor_half: d.frames.half,
+            impostor_center: d.frames.center,
+            impostor_views: d.frames.views,
+            impostor_rows: d.frames.rows,
+            ..self
         }
     }
 }

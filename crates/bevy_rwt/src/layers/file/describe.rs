@@ -117,6 +117,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             pick_bounds,
             promotion,
             stance,
+            impostor,
         } = c;
         let (mesh, material, lod) = self.look(look, lod.as_ref())?;
         let promotion = match promotion {
@@ -139,6 +140,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             stance: *stance,
             pick_bounds: *pick_bounds,
             promotion,
+            impostor: *impostor,
         })
     }
 

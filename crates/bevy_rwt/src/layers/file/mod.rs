@@ -372,6 +372,10 @@ pub struct ClassDescription {
     /// `(distance: 12.0, insert: "tree collider")`.
     #[serde(default)]
     pub promotion: Option<PromotionDescription>,
+    /// Far instances drawn as impostors (see [`crate::Impostor`]), e.g.
+    /// `(distance: 400.0)`.
+    #[serde(default)]
+    pub impostor: Option<crate::Impostor>,
 }
 
 /// A promotion in a layer file: its distance, and what promoted instances get by the name
@@ -727,6 +731,7 @@ impl ClassDescription {
                     stance: self.stance,
                     pick_bounds: self.pick_bounds,
                     promotion: self.promotion(handles.names)?,
+                    impostor: self.impostor,
                     ..class.with_instanced_far(far, lod.distance)
                 });
             }
@@ -745,6 +750,7 @@ impl ClassDescription {
             stance: self.stance,
             pick_bounds: self.pick_bounds,
             promotion: self.promotion(handles.names)?,
+            impostor: self.impostor,
             ..class
         })
     }

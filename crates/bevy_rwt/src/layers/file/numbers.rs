@@ -179,6 +179,18 @@ fn class(n: &mut Numbers, at: &str, c: &ClassDescription) {
             Rule::NonNegative,
         );
     }
+    if let Some(i) = &c.impostor {
+        n.add(
+            format!("{at}: impostor distance"),
+            i.distance,
+            Rule::NonNegative,
+        );
+        n.add(
+            format!("{at}: impostor crossfade"),
+            i.crossfade,
+            Rule::NonNegative,
+        );
+    }
     if let Some((lo, hi)) = c.pick_bounds {
         for (axis, v) in lo.to_array().into_iter().chain(hi.to_array()).enumerate() {
             n.add(format!("{at}: pick_bounds {axis}"), v, Rule::Finite);

@@ -22,7 +22,8 @@ struct Cull {
     eye: vec4<f32>,
     // Fall-off near, far, 1 when the fade is on, and its floor.
     falloff: vec4<f32>,
-    // Fade band (x).
+    // Fade band (x); distance from the eye within which instances are not drawn (y: the
+    // start of an impostor's crossfade; 0 for other classes).
     fade: vec4<f32>,
     // Far thinning: its distance, its floor, 1 when on.
     thinning: vec4<f32>,
@@ -72,7 +73,11 @@ fn seen(root: vec3<f32>, scale: f32, widen: f32) -> bool {
         return false;
     }
     let radius = cull.origin.w * scale * widen;
-    if cull.eye.w >= 0.0 && distance(root, cull.eye.xyz) - radius > cull.eye.w {
+    let from_eye = distance(root, cull.eye.xyz);
+    if cull.eye.w >= 0.0 && from_eye - radius > cull.eye.w {
+        return false;
+    }
+    if from_eye < cull.fade.y {
         return false;
     }
     for (var k = 0u; k < 6u; k++) {

@@ -64,7 +64,8 @@ pub(super) struct CullUniform {
     eye: Vec4,
     /// Fall-off near, far, 1 when the fade is on, floor.
     falloff: Vec4,
-    /// Fade band (x).
+    /// Fade band (x); distance from the eye within which instances are not drawn (y: the
+    /// start of an impostor's crossfade; 0 for other classes).
     fade: Vec4,
     /// Far thinning: its distance, its floor, 1 when on.
     thinning: Vec4,
@@ -89,7 +90,11 @@ impl CullUniform {
             return false;
         }
         let radius = self.origin.w * scale / kept;
-        if self.eye.w >= 0.0 && root.distance(self.eye.truncate()) - radius > self.eye.w {
+        let distance = root.distance(self.eye.truncate());
+        if self.eye.w >= 0.0 && distance - radius > self.eye.w {
+            return false;
+        }
+        if distance < self.fade.y {
             return false;
         }
         self.planes
@@ -757,7 +762,7 @@ fn uniform(d: &Dispatch, o: &Offsets) -> CullUniform {
             u.falloff_on as f32,
             u.falloff_floor,
         ),
-        fade: Vec4::new(u.fade_band, 0.0, 0.0, 0.0),
+        fade: Vec4::new(u.fade_band, u.visible_from, 0.0, 0.0),
         thinning: Vec4::new(u.thinning_from, u.thinning_floor, u.thinning_on as f32, 0.0),
         slots: UVec4::new(d.gpu.count, o.draw * ARGS_WORDS + 1, x, 0),
         clip_from_world,

@@ -109,6 +109,13 @@ fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
     assert!(thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.2)));
     assert!(!thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.3)));
     assert!(thinned.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.99)));
+    // Impostors fading in from 12 m: nearer ones are the meshes' to draw.
+    let impostors = CullUniform {
+        fade: Vec4::new(0.1, 12.0, 0.0, 0.0),
+        ..no_fade
+    };
+    assert!(!impostors.keeps(&at(Vec3::new(11.9, 0.0, 0.0), 0.0)));
+    assert!(impostors.keeps(&at(Vec3::new(12.1, 0.0, 0.0), 0.0)));
     // Down to the floor, however far.
     assert!(thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.09)));
     assert!(!thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.13)));
