@@ -13,7 +13,9 @@
 # drawn with the prepasses, TAA and SSAO, gpu_culling, which fails unless the frame culled
 # per instance on the GPU is the frame drawn whole and its indirect counts are the CPU's, and
 # gpu_occlusion, which fails unless a camera rising over a hill, occluding, draws the frame
-# drawn whole (the blades peeking over the crest included) and occlusion dropped instances.
+# drawn whole (the blades peeking over the crest included) and occlusion dropped instances,
+# and impostor_match, which fails unless trees drawn as impostors cover the pixels their
+# meshes cover (silhouette IoU >= 0.8), coloured alike, culled per instance as the CPU does.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -25,10 +27,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion)
+examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -94,6 +96,11 @@ for run in "${runs[@]}"; do
         # Occlusion: the frame of a camera rising over a hill matches the whole chunks',
         # its late phase kept what the early phase's stale depth hid.
         self_checked RWT_OCCLUSION_DIR=$out/occlusion rwt-occlusion 'draws'
+        continue
+    fi
+    if [ "$ex" = impostor_match ]; then
+        # Impostors: trees as cards cover their meshes' pixels, coloured alike.
+        self_checked RWT_IMPOSTOR_DIR=$out/impostor rwt-impostor 'trees'
         continue
     fi
     # CI's open_world flies its path in 100 frames instead of 150 (the same checks: the
