@@ -6,12 +6,14 @@
 //!
 //! A flat field holds about the given number of live blades (streamed by the plugin) around
 //! a camera 2 m above it, under a sun with cascaded shadow maps. The instanced path is
-//! timed in seven settings in one run: culled as `InstanceCulling::Auto` chooses, the grass
+//! timed in nine settings in one run: culled as `InstanceCulling::Auto` chooses, the grass
 //! class's shadows off, on, and on within 30 m of the camera; shadows off, chunks drawn
 //! whole (the direct path, `PerChunk`), culled per instance on the GPU (`PerInstance`), and
 //! culled per instance with occlusion (the camera's depth prepass and `OcclusionCulling`);
-//! and `Auto` with the camera's depth, normal and motion-vector prepasses on. The entity
-//! path is timed in the first only. In each, once streaming has settled and 10 frames have
+//! `Auto` with open_world's forests around the field to 2.6 km, far trees as meshes with a
+//! fifth of them kept from 1.4 km on (as drawing each tree as a mesh affords), then every
+//! tree with impostors from 350 m; and `Auto` with the camera's depth, normal and
+//! motion-vector prepasses on. The entity path is timed in the first only. In each, once streaming has settled and 10 frames have
 //! warmed up, 30 frames are timed and one line is printed:
 //!
 //! `grass-cost: path=P shadows=S prepass=Q cull=C live=N main_ms=X/Y render_world_ms=X/Y frame_ms=X/Y`
@@ -19,7 +21,9 @@
 //! and to the direct path:
 //!
 //! `grass-cost: frame_ms ratio shadows_on=R shadows_within_30m=R prepass_on=R`
-//! `grass-cost: frame_ms ratio gpu_cull=R occlusion=R`
+//! `grass-cost: frame_ms ratio gpu_cull=R1 occlusion=R2 impostors=R3`
+//!
+//! (`impostors`: the full forest with impostors over the thinned forest of meshes.)
 //!
 //! `main_ms` is the main world's schedules (the plugin, transforms, visibility);
 //! `render_world_ms` is extraction, preparation and queueing in the render world, from the
@@ -33,6 +37,7 @@ use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy_rwt::prelude::*;
+use rwt_examples::forest::{FarTrees, tree_layer};
 use rwt_examples::grass_field::{self, field_layer, nominal_density, set_instanced_shadows};
 use rwt_examples::prelude::*;
 use std::sync::{Arc, Mutex};
@@ -52,12 +57,14 @@ enum Prepass {
     Occlusion,
 }
 
-/// One setting timed: the grass class's shadows, the camera's prepasses, the culling.
+/// One setting timed: the grass class's shadows, the camera's prepasses, the culling, and
+/// the forests around the field, if any.
 #[derive(Clone, Copy)]
 struct Setting {
     shadows: InstancedShadows,
     prepass: Prepass,
     culling: InstanceCulling,
+    forest: Option<FarTrees>,
 }
 
 const fn at(shadows: InstancedShadows, prepass: Prepass, culling: InstanceCulling) -> Setting {
@@ -65,11 +72,19 @@ const fn at(shadows: InstancedShadows, prepass: Prepass, culling: InstanceCullin
         shadows,
         prepass,
         culling,
+        forest: None,
+    }
+}
+
+const fn with_forest(far: FarTrees) -> Setting {
+    Setting {
+        forest: Some(far),
+        ..at(InstancedShadows::Off, Prepass::None, InstanceCulling::Auto)
     }
 }
 
 /// The settings timed, in order.
-const SETTINGS: [Setting; 7] = {
+const SETTINGS: [Setting; 9] = {
     use InstanceCulling::*;
     use InstancedShadows::*;
     [
@@ -79,6 +94,8 @@ const SETTINGS: [Setting; 7] = {
         at(Off, Prepass::None, PerChunk),
         at(Off, Prepass::None, PerInstance),
         at(Off, Prepass::Occlusion, PerInstance),
+        with_forest(FarTrees::Thinned),
+        with_forest(FarTrees::Impostors),
         // Last: Bevy 0.19 keeps a view's background motion-vector pipeline once its motion
         // vector prepass is removed, and fails the next frame with a depth prepass.
         at(Off, Prepass::All, Auto),
@@ -128,6 +145,14 @@ fn main() {
         );
     app.run();
 }
+
+/// The forests' layer.
+#[derive(Component)]
+struct Forest;
+
+/// The trees' material.
+#[derive(Resource)]
+struct ForestMaterial(Handle<StandardMaterial>);
 
 /// What to draw, the setting being timed and the median frame times of those timed.
 #[derive(Resource)]
@@ -184,6 +209,11 @@ fn setup(
         ScatterClass::instanced(density, blade, material)
     };
     commands.spawn(field_layer(grass));
+    commands.insert_resource(ForestMaterial(materials.add(StandardMaterial {
+        perceptual_roughness: 0.9,
+        reflectance: 0.2,
+        ..default()
+    })));
 }
 
 fn start_frame(clock: Res<Clock>) {
@@ -222,9 +252,10 @@ fn settle(
     mut field: ResMut<Field>,
     mut settled_frames: Local<usize>,
     mut exit: MessageWriter<AppExit>,
-    layers: Query<(Entity, &ScatterLayer)>,
+    layers: Query<(Entity, &ScatterLayer, Has<Forest>)>,
     cameras: Query<Entity, With<Camera3d>>,
     mut commands: Commands,
+    (mut meshes, forest_material): (ResMut<Assets<Mesh>>, Res<ForestMaterial>),
 ) {
     let live = stats.live_entities + stats.live_instanced;
     if *settled_frames == 0 && (stats.pending_tasks > 0 || stats.queued_spawns > 0 || live == 0) {
@@ -259,7 +290,15 @@ fn settle(
         exit.write(AppExit::Success);
         return;
     }
-    apply(SETTINGS[field.setting], &layers, &cameras, &mut commands);
+    let setting = SETTINGS[field.setting];
+    apply(
+        setting,
+        &layers,
+        &cameras,
+        &mut commands,
+        &mut meshes,
+        &forest_material,
+    );
 }
 
 /// A setting as the result line names it.
@@ -275,18 +314,34 @@ fn describe(entities: bool, setting: Setting) -> String {
         Prepass::All => "on",
         Prepass::Occlusion => "depth",
     };
+    let forest = match setting.forest {
+        None => "",
+        Some(FarTrees::Thinned) => " forest=thinned_meshes",
+        Some(FarTrees::Impostors) => " forest=impostors",
+    };
     let cull = match (setting.culling, setting.prepass) {
         (InstanceCulling::Auto, _) => "auto",
         (InstanceCulling::PerChunk, _) => "whole",
         (InstanceCulling::PerInstance, Prepass::Occlusion) => "occlusion",
         (InstanceCulling::PerInstance, _) => "gpu",
     };
-    format!("path={path} shadows={shadows} prepass={prepass} cull={cull}")
+    format!("path={path} shadows={shadows} prepass={prepass} cull={cull}{forest}")
 }
 
 /// The frame-time ratios, once every setting was timed.
 fn print_ratios(frame_ms: &[f64]) {
-    if let [base, on, within, whole, gpu, occlusion, prepass] = frame_ms[..] {
+    if let [
+        base,
+        on,
+        within,
+        whole,
+        gpu,
+        occlusion,
+        thinned,
+        impostors,
+        prepass,
+    ] = frame_ms[..]
+    {
         println!(
             "grass-cost: frame_ms ratio shadows_on={:.2} shadows_within_30m={:.2} prepass_on={:.2}",
             on / base,
@@ -294,25 +349,37 @@ fn print_ratios(frame_ms: &[f64]) {
             prepass / base
         );
         println!(
-            "grass-cost: frame_ms ratio gpu_cull={:.2} occlusion={:.2}",
+            "grass-cost: frame_ms ratio gpu_cull={:.2} occlusion={:.2} impostors={:.2}",
             gpu / whole,
-            occlusion / whole
+            occlusion / whole,
+            impostors / thinned
         );
     }
 }
 
-/// Gives the grass class the setting's shadows (a replaced layer streams anew), the camera
-/// its prepasses, and the culling its setting.
+/// Gives the grass class the setting's shadows (a replaced layer streams anew), the field
+/// its forests, the camera its prepasses, and the culling its setting.
 fn apply(
     setting: Setting,
-    layers: &Query<(Entity, &ScatterLayer)>,
+    layers: &Query<(Entity, &ScatterLayer, Has<Forest>)>,
     cameras: &Query<Entity, With<Camera3d>>,
     commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    forest_material: &ForestMaterial,
 ) {
-    for (entity, layer) in layers {
+    for (entity, layer, forest) in layers {
+        if forest {
+            commands.entity(entity).despawn();
+            continue;
+        }
         let mut layer = layer.clone();
         set_instanced_shadows(&mut layer, setting.shadows);
         commands.entity(entity).insert(layer);
+    }
+    if let Some(far) = setting.forest {
+        let flat = HeightSource::Constant(0.0);
+        let forest = tree_layer(&flat, meshes, &forest_material.0, far);
+        commands.spawn((Forest, forest));
     }
     for camera in cameras {
         let mut camera = commands.entity(camera);

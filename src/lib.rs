@@ -11,6 +11,7 @@
 pub mod brush_status;
 pub mod fly_camera;
 pub mod foliage;
+pub mod forest;
 pub mod frame_check;
 pub mod grass_field;
 pub mod hud;

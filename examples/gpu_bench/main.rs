@@ -2,7 +2,8 @@
 //!
 //! `scripts/gpu_bench.sh` runs it (built on any machine, run on one with a GPU), or
 //! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
-//! [--thin 25] [--shots DIR] [--detail]`; `--shots` saves one frame of each case there as
+//! [--thin 25] [--forest thinned|impostors] [--shots DIR] [--detail]`; `--shots` saves one
+//! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
 //! ([`detail`]).
 //!
@@ -22,6 +23,11 @@
 //! each frame: the time is that of the slower of the main world and render world plus GPU.
 //! `cull=off` culls whole chunks on the CPU and draws every blade of those kept; `cull=on`
 //! also culls each blade on the GPU and draws indirectly.
+//!
+//! `--forest` adds open_world's forests around the field to 2.6 km ([`FarTrees`]: `thinned`,
+//! every tree a mesh entity and a fifth of them kept from 1.4 km on; `impostors`, every tree,
+//! impostors from 350 m) and prints `gpu-bench: forest=F tree_entities=E impostors=I` after
+//! each case line.
 
 use bevy::app::ScheduleRunnerPlugin;
 use bevy::camera::RenderTarget;
@@ -35,6 +41,7 @@ use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
 use bevy_rwt::prelude::*;
+use rwt_examples::forest::{FarTrees, tree_layer};
 use rwt_examples::grass_field::{self, field_layer, set_instanced_shadows};
 use std::time::{Duration, Instant};
 
@@ -60,7 +67,7 @@ fn main() {
         Err(message) => {
             eprintln!("gpu_bench: {message}");
             eprintln!(
-                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] (M: millions)"
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--forest thinned|impostors] (M: millions)"
             );
             std::process::exit(2);
         }
@@ -120,6 +127,8 @@ struct Options {
     detail: bool,
     /// Distance from which the grass thins out (metres; 0: it does not).
     thin: f32,
+    /// Forests around the field, and how far trees are drawn.
+    forest: Option<FarTrees>,
 }
 
 impl Options {
@@ -131,6 +140,7 @@ impl Options {
             shots: None,
             detail: false,
             thin: THIN_FROM,
+            forest: None,
         };
         while let Some(flag) = args.next() {
             if flag == "--detail" {
@@ -171,6 +181,13 @@ impl Options {
                         .ok()
                         .filter(|m: &f32| (0.0..=1e4).contains(m))
                         .ok_or_else(bad)?;
+                }
+                "--forest" => {
+                    options.forest = Some(match value.as_str() {
+                        "thinned" => FarTrees::Thinned,
+                        "impostors" => FarTrees::Impostors,
+                        _ => return Err(bad()),
+                    });
                 }
                 _ => return Err(format!("unknown option {flag:?}")),
             }
@@ -299,8 +316,25 @@ fn setup(
     };
     let blade = meshes.add(grass_field::blade());
     let grass = ScatterClass::instanced(LayerDensity::Constant(density), blade, material);
-    commands.spawn(field_layer(grass));
+    commands.spawn((Grass, field_layer(grass)));
+    if let Some(far) = bench.options.forest {
+        let material = materials.add(StandardMaterial {
+            perceptual_roughness: 0.9,
+            reflectance: 0.2,
+            ..default()
+        });
+        let flat = HeightSource::Constant(0.0);
+        commands.spawn((Forest, tree_layer(&flat, &mut meshes, &material, far)));
+    }
 }
+
+/// The grass's layer, whose blades the cases count.
+#[derive(Component)]
+struct Grass;
+
+/// The forests' layer (`--forest`).
+#[derive(Component)]
+struct Forest;
 
 /// Times the frame that just ended, while a case is timed.
 fn tick(mut bench: ResMut<Bench>) {
@@ -313,10 +347,13 @@ fn tick(mut bench: ResMut<Bench>) {
 
 /// Moves the bench on: streaming settles, the frame warms up, a case is timed and printed,
 /// the next case streams in; after the last, the app exits.
+#[allow(clippy::too_many_arguments)]
 fn step(
     mut bench: ResMut<Bench>,
     stats: Res<RwtStats>,
-    mut layers: Query<&mut ScatterLayer>,
+    mut layers: Query<&mut ScatterLayer, With<Grass>>,
+    grass: Single<&ScatterLayerStatus, With<Grass>>,
+    forest: Option<Single<&ScatterLayerStatus, With<Forest>>>,
     mut culling: ResMut<InstanceCulling>,
     report: Report,
     mut commands: Commands,
@@ -324,24 +361,25 @@ fn step(
 ) {
     let now = Instant::now();
     let frames = bench.options.frames;
+    let live = grass.live_instanced;
     match bench.phase {
         Phase::Streaming {
             since,
             stable,
-            live,
+            live: streamed,
         } => {
             let settled_now = stats.pending_tasks == 0
                 && stats.queued_spawns == 0
-                && stats.live_instanced > 0
-                && stats.live_instanced == live;
+                && grass.live_instanced > 0
+                && grass.live_instanced == streamed;
             let stable = if settled_now { stable + 1 } else { 0 };
             bench.phase = Phase::Streaming {
                 since,
                 stable,
-                live: stats.live_instanced,
+                live: grass.live_instanced,
             };
             if stable >= SETTLED_FRAMES {
-                settled(&mut bench, stats.live_instanced, &mut layers);
+                settled(&mut bench, grass.live_instanced, &mut layers);
             } else if since.elapsed() > LONGEST_STREAMING {
                 eprintln!("gpu_bench: streaming did not settle in {LONGEST_STREAMING:?}");
                 exit.write(AppExit::error());
@@ -371,7 +409,17 @@ fn step(
             if bench.frame_ms.len() >= frames
                 || (since.elapsed() >= LONGEST_TIMING && bench.frame_ms.len() >= 10) =>
         {
-            print_case(&bench, stats.live_instanced, &report);
+            print_case(&bench, live, &report);
+            if let (Some(far), Some(forest)) = (bench.options.forest, &forest) {
+                let far = match far {
+                    FarTrees::Thinned => "thinned",
+                    FarTrees::Impostors => "impostors",
+                };
+                println!(
+                    "gpu-bench: forest={far} tree_entities={} impostors={}",
+                    forest.live_entities, forest.live_instanced
+                );
+            }
             let (this, next) = bench.case.map_or((0, 0), |i| (i, i + 1));
             let Some(&case) = bench.cases.get(next) else {
                 exit.write(AppExit::Success);
@@ -398,7 +446,7 @@ fn step(
 }
 
 /// Streaming has settled with `live` blades: measure the area (the first time), or warm up.
-fn settled(bench: &mut Bench, live: usize, layers: &mut Query<&mut ScatterLayer>) {
+fn settled(bench: &mut Bench, live: usize, layers: &mut Query<&mut ScatterLayer, With<Grass>>) {
     if bench.area.is_none() {
         bench.area = Some(live as f64 / CALIBRATION_DENSITY);
         bench.case = Some(0);
@@ -412,7 +460,7 @@ fn settled(bench: &mut Bench, live: usize, layers: &mut Query<&mut ScatterLayer>
 }
 
 /// Gives the layer the density and shadows of the bench's case (it streams anew).
-fn restream(bench: &mut Bench, layers: &mut Query<&mut ScatterLayer>) {
+fn restream(bench: &mut Bench, layers: &mut Query<&mut ScatterLayer, With<Grass>>) {
     let (density, shadows) = bench.density_and_shadows();
     for mut layer in layers {
         set_instanced_shadows(&mut layer, shadows);

@@ -3,11 +3,11 @@
 //! grass and flowers under it. Both persist (edits, and a footprint on an entity) and the
 //! brush's F5 saves the edits with the painted maps.
 
-use crate::layers::{STUMP, TREE_SPECIES};
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
 use rwt_examples::foliage;
+use rwt_examples::forest::{STUMP, TREE_SPECIES};
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::Terrain;
 

@@ -9,6 +9,7 @@ use glam::DVec2;
 use noise::{NoiseFn, Perlin};
 use rwt_core::density::{Density, NoiseDensity, NoiseParams};
 use rwt_examples::foliage;
+use rwt_examples::forest::{FarTrees, ForestCover, tree_layer};
 use rwt_examples::terrain::{Terrain, WATER};
 use std::sync::Arc;
 
@@ -44,7 +45,9 @@ pub fn setup_layers(
     let ground = terrain.source();
     names.insert_height("terrain", &ground);
     names.insert_material("white", white.clone());
-    let trees = trees(&ground, &mut meshes, &white);
+    let trees = tree_layer(&ground, &mut meshes, &white, FarTrees::Impostors)
+        .with_height_range(WATER + 1.5, 112.0)
+        .with_max_slope(0.6);
     commands.spawn((Name::new("trees"), trees));
     let rocks = rocks(&ground, &mut meshes, &white);
     commands.spawn((Name::new("rocks"), rocks));
@@ -92,48 +95,6 @@ fn painted_map(images: &mut Assets<Image>, seed: u32, scale: f64, feature: f64) 
     LayerDensity::Image(map)
 }
 
-/// The tree layer's classes: the three species, then their stump.
-pub const TREE_SPECIES: [u16; 3] = [0, 1, 2];
-pub const STUMP: u16 = 3;
-
-/// The forests' noise seeds and bases, one per species.
-const FORESTS: [(u32, f64); 3] = [(11, -0.1), (12, -0.2), (13, -0.35)];
-
-/// The density of one species' forest (trees per square metre).
-fn forest(seed: u32, base: f64) -> NoiseDensity {
-    NoiseDensity::new(NoiseParams {
-        seed,
-        frequency: 1.0 / 650.0,
-        octaves: 4,
-        base,
-        amplitude: 1.9,
-        scale: 0.01,
-    })
-}
-
-/// The three forests together: trees per square metre of all species.
-pub struct ForestCover([NoiseDensity; 3]);
-
-impl ForestCover {
-    pub fn new() -> Self {
-        Self(FORESTS.map(|(seed, base)| forest(seed, base)))
-    }
-}
-
-impl Density for ForestCover {
-    fn density(&self, p: DVec2) -> f64 {
-        self.0.iter().map(|f| f.density(p)).sum()
-    }
-
-    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
-        self.0.iter().map(|f| f.max_over(min, max)).sum()
-    }
-
-    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
-        self.0.iter().map(|f| f.min_over(min, max)).sum()
-    }
-}
-
 /// Ferns per square metre under a full canopy.
 const FERNS: f64 = 0.3;
 /// The forest cover (trees per square metre) from which ferns grow at full density; they
@@ -156,57 +117,6 @@ impl Density for FernDensity {
     fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
         FERNS * (self.0.min_over(min, max) / FERN_COVER).min(1.0)
     }
-}
-
-/// Forests of three species from fractal noise; near and far meshes crossfade at 180 m.
-/// The fall-off keeps a fifth of the forest out to 2.6 km, so distant hills stay wooded.
-fn trees(
-    ground: &HeightSource,
-    meshes: &mut Assets<Mesh>,
-    material: &Handle<StandardMaterial>,
-) -> ScatterLayer {
-    let [a, b, c] = FORESTS.map(|(seed, base)| LayerDensity::Noise(forest(seed, base)));
-    let species = [
-        (foliage::conifer(), a),
-        (foliage::broadleaf(), b),
-        (foliage::birch(), c),
-    ];
-    let mut classes: Vec<ScatterClass> = species
-        .into_iter()
-        .map(|(tree, density)| {
-            let near = meshes.add(tree.near);
-            let far = meshes.add(tree.far);
-            let mut class = ScatterClass::new(density, near, material.clone()).with_lod(
-                far,
-                material.clone(),
-                180.0,
-            );
-            class.scale_variation = 0.3;
-            class
-        })
-        .collect();
-    // Nowhere until a tree is chopped (an edit gives its point this class); the same scale
-    // rule as the trees, so a stump is as thick as its tree was.
-    let mut stump = ScatterClass::new(
-        LayerDensity::Constant(0.0),
-        meshes.add(foliage::stump()),
-        material.clone(),
-    );
-    stump.scale_variation = 0.3;
-    classes.push(stump);
-    ScatterLayer::new(classes)
-        .with_seed(1)
-        .with_tile_size(128.0)
-        .with_streaming(StreamingConfig {
-            chunk_size: 256.0,
-            load_distance: 2600.0,
-            unload_distance: 2800.0,
-            near_distance: 200.0,
-        })
-        .with_falloff_floor(350.0, 1400.0, 0.2)
-        .with_height(ground.clone())
-        .with_height_range(WATER + 1.5, 112.0)
-        .with_max_slope(0.6)
 }
 
 /// Boulders, more of them on slopes' noise-chosen patches.

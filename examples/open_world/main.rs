@@ -2,7 +2,7 @@
 //! direction: nothing is precomputed) with dense wind-blown grass and painted flower
 //! meadows drawn from per-chunk instance buffers, ferns with textured fronds on the forest
 //! floor, bushes, rocks and three tree species as entities (near and far meshes
-//! crossfading), forests thinning to a sparse remainder that reaches the horizon, and a
+//! crossfading), forests at full density to the horizon (impostors from 350 m), and a
 //! density brush that paints the flower and bush maps live.
 //!
 //! `cargo run --release --example open_world`

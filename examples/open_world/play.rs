@@ -8,12 +8,12 @@
 //! `rwt-smoke: walked into a trunk: closest D m from its axis, collision at R m`.
 
 use crate::gameplay::{Cabins, spawn_cabin, tree_layer, trees_only};
-use crate::layers::STUMP;
 use crate::walk::{RADIUS as WALKER_RADIUS, TRUNK_RADIUS, Walker, spawn_walker};
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
 use glam::DVec2;
+use rwt_examples::forest::STUMP;
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::Terrain;
 use std::collections::{HashMap, HashSet};

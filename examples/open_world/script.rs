@@ -6,12 +6,12 @@
 //! the cabin's clearing from above); then the brush saves the painted world (maps, layer
 //! files and edits) to `RWT_PAINT_DIR`.
 
-use crate::layers::ForestCover;
 use crate::play::{Play, play};
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushCommand, BrushSystems, DensityBrush, PaintDab};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::density::Density;
+use rwt_examples::forest::ForestCover;
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::{Terrain, WATER};
 

@@ -3,11 +3,11 @@
 //! mouse as the fly camera does. Trunks and rocks get static colliders as `bevy_rwt`
 //! spawns them (an observer on `ScatterEntity`): the plugin knows nothing of physics.
 
-use crate::layers::{STUMP, TREE_SPECIES};
 use avian3d::prelude::*;
 use bevy::prelude::*;
 use bevy::transform::TransformSystems;
 use bevy_rwt::prelude::*;
+use rwt_examples::forest::{STUMP, TREE_SPECIES};
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::{Terrain, WATER};
 

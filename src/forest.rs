@@ -1,0 +1,130 @@
+//! open_world's forests: three tree species from fractal noise, and their stump, in one
+//! layer that streams to 2.6 km. Shared by open_world and the cost benchmark, which times
+//! far trees drawn both ways ([`FarTrees`]).
+
+use crate::foliage;
+use bevy::prelude::*;
+use bevy_rwt::prelude::*;
+use bevy_rwt::rwt_core::density::{Density, NoiseDensity, NoiseParams};
+use glam::DVec2;
+
+/// The tree layer's classes: the three species, then their stump.
+pub const TREE_SPECIES: [u16; 3] = [0, 1, 2];
+/// The stump's class in the tree layer.
+pub const STUMP: u16 = 3;
+
+/// The forests' noise seeds and bases, one per species.
+const FORESTS: [(u32, f64); 3] = [(11, -0.1), (12, -0.2), (13, -0.35)];
+
+/// Where near and far meshes crossfade (metres).
+const LOD_DISTANCE: f32 = 180.0;
+/// Where impostors take over (metres).
+pub const IMPOSTOR_DISTANCE: f32 = 350.0;
+
+/// The density of one species' forest (trees per square metre).
+fn forest(seed: u32, base: f64) -> NoiseDensity {
+    NoiseDensity::new(NoiseParams {
+        seed,
+        frequency: 1.0 / 650.0,
+        octaves: 4,
+        base,
+        amplitude: 1.9,
+        scale: 0.01,
+    })
+}
+
+/// The three forests together: trees per square metre of all species.
+pub struct ForestCover([NoiseDensity; 3]);
+
+impl ForestCover {
+    /// The three species' densities.
+    pub fn new() -> Self {
+        Self(FORESTS.map(|(seed, base)| forest(seed, base)))
+    }
+}
+
+impl Default for ForestCover {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Density for ForestCover {
+    fn density(&self, p: DVec2) -> f64 {
+        self.0.iter().map(|f| f.density(p)).sum()
+    }
+
+    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
+        self.0.iter().map(|f| f.max_over(min, max)).sum()
+    }
+
+    fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
+        self.0.iter().map(|f| f.min_over(min, max)).sum()
+    }
+}
+
+/// How far trees are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FarTrees {
+    /// Every tree an entity (near and far meshes), a fifth of the forest kept from 1.4 km
+    /// on: what drawing every far tree as a mesh could afford.
+    Thinned,
+    /// Every tree to the horizon; from [`IMPOSTOR_DISTANCE`] on, impostors.
+    Impostors,
+}
+
+/// The forests on `ground`: near and far meshes crossfade at 180 m; far trees as `far`
+/// says. Standing wherever the ground lets them (the caller sets heights and slopes).
+pub fn tree_layer(
+    ground: &HeightSource,
+    meshes: &mut Assets<Mesh>,
+    material: &Handle<StandardMaterial>,
+    far: FarTrees,
+) -> ScatterLayer {
+    let [a, b, c] = FORESTS.map(|(seed, base)| LayerDensity::Noise(forest(seed, base)));
+    let species = [
+        (foliage::conifer(), a),
+        (foliage::broadleaf(), b),
+        (foliage::birch(), c),
+    ];
+    let mut classes: Vec<ScatterClass> = species
+        .into_iter()
+        .map(|(tree, density)| {
+            let near = meshes.add(tree.near);
+            let far_mesh = meshes.add(tree.far);
+            let mut class = ScatterClass::new(density, near, material.clone()).with_lod(
+                far_mesh,
+                material.clone(),
+                LOD_DISTANCE,
+            );
+            if far == FarTrees::Impostors {
+                class = class.with_impostor(Impostor::at(IMPOSTOR_DISTANCE));
+            }
+            class.scale_variation = 0.3;
+            class
+        })
+        .collect();
+    // Nowhere until a tree is chopped (an edit gives its point this class); the same scale
+    // rule as the trees, so a stump is as thick as its tree was.
+    let mut stump = ScatterClass::new(
+        LayerDensity::Constant(0.0),
+        meshes.add(foliage::stump()),
+        material.clone(),
+    );
+    stump.scale_variation = 0.3;
+    classes.push(stump);
+    let layer = ScatterLayer::new(classes)
+        .with_seed(1)
+        .with_tile_size(128.0)
+        .with_streaming(StreamingConfig {
+            chunk_size: 256.0,
+            load_distance: 2600.0,
+            unload_distance: 2800.0,
+            near_distance: 200.0,
+        })
+        .with_height(ground.clone());
+    match far {
+        FarTrees::Thinned => layer.with_falloff_floor(350.0, 1400.0, 0.2),
+        FarTrees::Impostors => layer,
+    }
+}
