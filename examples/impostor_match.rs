@@ -1,13 +1,14 @@
 //! Impostors checked in a real renderer (`scripts/smoke.sh` runs it under Xvfb and
 //! lavapipe): `cargo run --example impostor_match`.
 //!
-//! open_world's three tree species stand in a strip 180 to 220 m ahead of a long-lens
-//! camera, against the sky (no ground, so that every pixel that is not sky is a tree).
+//! open_world's three tree species (entities) and an instanced broadleaf stand in a strip
+//! 180 to 220 m ahead of a long-lens camera, against the sky (no ground, so that every
+//! pixel that is not sky is a tree).
 //! The same trees are taken twice: as meshes (their far level of detail, from which the
 //! impostors are baked), then with the impostors' crossfade moved near, so that every tree
 //! is a card, culled per instance ([`CullingCheck`] reads that frame's counts back). It
 //! prints `rwt-impostor: trees T, mesh pixels M, impostor pixels I, silhouette IoU U, colour
-//! difference C` and exits with an error unless the silhouettes' intersection over union
+//! difference C` (`T`: the tree entities of the first frame) and exits with an error unless the silhouettes' intersection over union
 //! is at least [`LEAST_IOU`], the mean colour difference where both show a tree is under
 //! [`MOST_COLOUR`], and culling kept the CPU's instances. Screenshots go to
 //! `RWT_IMPOSTOR_DIR` (default `target/impostor`).
@@ -98,17 +99,32 @@ fn setup(
         ..default()
     });
     let density = LayerDensity::Custom(Arc::new(Strip));
-    let classes = [foliage::conifer(), foliage::broadleaf(), foliage::birch()]
-        .into_iter()
-        .map(|tree| {
-            let (near, far) = (meshes.add(tree.near), meshes.add(tree.far));
-            let mut class = ScatterClass::new(density.clone(), near, white.clone())
-                .with_lod(far, white.clone(), 100.0)
-                .with_impostor(Impostor::at(1000.0));
-            class.scale_variation = 0.3;
-            class
-        })
-        .collect();
+    let mut classes: Vec<ScatterClass> =
+        [foliage::conifer(), foliage::broadleaf(), foliage::birch()]
+            .into_iter()
+            .map(|tree| {
+                let (near, far) = (meshes.add(tree.near), meshes.add(tree.far));
+                let mut class = ScatterClass::new(density.clone(), near, white.clone())
+                    .with_lod(far, white.clone(), 100.0)
+                    .with_impostor(Impostor::at(1000.0));
+                class.scale_variation = 0.3;
+                class
+            })
+            .collect();
+    // An instanced tree: its meshes fade out where its impostors fade in.
+    let shading = InstancedShading {
+        base_color: Color::srgb(0.25, 0.16, 0.08),
+        tip_color: Color::srgb(0.2, 0.45, 0.12),
+        tip_from: 0.35,
+        color_variation: 0.15,
+        wind_response: 0.0,
+        shadows: InstancedShadows::Off,
+        ..default()
+    };
+    let canopy = meshes.add(foliage::broadleaf().far);
+    classes.push(
+        ScatterClass::instanced(density, canopy, shading).with_impostor(Impostor::at(1000.0)),
+    );
     commands.spawn(
         ScatterLayer::new(classes)
             .with_tile_size(64.0)

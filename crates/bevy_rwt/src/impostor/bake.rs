@@ -4,12 +4,10 @@
 //! the mesh's frame on the right half, with a mip chain whose cut-out coverage stays that of
 //! the full-size views. Deterministic: the same mesh and material bake the same bytes.
 
+use super::atlas::{Level, Texel, atlas_image};
 use crate::look::Impostor;
-use bevy::asset::RenderAssetUsages;
-use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler, ImageSamplerDescriptor};
 use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
 use bevy::prelude::*;
-use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 
 /// Supersampling of the raster along each axis (coverage in steps of a quarter).
 const SUPERSAMPLE: u32 = 2;
@@ -86,12 +84,55 @@ pub fn card_axes(direction: Vec3) -> (Vec3, Vec3) {
 pub struct BakeSource<'a> {
     /// The mesh (positions; normals, colours and UVs where it has them).
     pub mesh: &'a Mesh,
-    /// The material's base colour (linear).
-    pub base_color: LinearRgba,
+    /// The material's base colour (linear), or an instanced class's colours from root to
+    /// tip.
+    pub color: BakeColor,
+    /// Whether the mesh's vertex colours tint it (a `StandardMaterial` reads them; the
+    /// instanced shading does not).
+    pub vertex_colors: bool,
+    /// How far normals lean towards the sky (0..1; the instanced shading leans its blades'
+    /// by 0.45 so that they read as blades).
+    pub lean: f32,
     /// The material's base-colour texture, where it has one that loaded.
     pub texture: Option<&'a Image>,
     /// Alpha below which the material is cut out (`None`: opaque).
     pub alpha_cutoff: Option<f32>,
+}
+
+/// The colour a bake gives the mesh before its texture.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BakeColor {
+    /// One colour (linear).
+    Plain(LinearRgba),
+    /// As the instanced shading blends it: the base colour below `tip_from` of the height
+    /// (from 0 up to the mesh's top), the tip colour blending in above it.
+    Gradient {
+        /// At the root.
+        base: LinearRgba,
+        /// At the top.
+        tip: LinearRgba,
+        /// Height fraction where the tip colour starts.
+        tip_from: f32,
+    },
+}
+
+impl BakeColor {
+    /// The colour at height `y` of a mesh whose top is `top`.
+    fn at(&self, y: f32, top: f32) -> Vec4 {
+        match *self {
+            BakeColor::Plain(c) => Vec4::from(c.to_f32_array()),
+            BakeColor::Gradient {
+                base,
+                tip,
+                tip_from,
+            } => {
+                let t = (y / top.max(1e-3)).clamp(0.0, 1.0);
+                let from = tip_from.clamp(0.0, 0.99);
+                let k = ((t - from) / (1.0 - from)).clamp(0.0, 1.0);
+                Vec4::from(base.to_f32_array()).lerp(Vec4::from(tip.to_f32_array()), k)
+            }
+        }
+    }
 }
 
 /// A baked atlas and where its views lie.
@@ -136,7 +177,7 @@ pub fn bake(source: &BakeSource, settings: &Impostor) -> Result<BakedImpostor, B
     let mut level = Level::new(size);
     for j in 0..rows {
         for i in 0..views {
-            let raster = Raster::view(&frames, i, j, source, (&vertices, &triangles));
+            let raster = Raster::view(&frames, (i, j, hi.y), source, (&vertices, &triangles));
             raster.store(&mut level, (i * texels, j * texels), (views * texels, 0));
         }
     }
@@ -223,14 +264,6 @@ fn read_mesh(mesh: &Mesh) -> Result<(Vec<BakeVertex>, Vec<[usize; 3]>), BakeErro
     Ok((vertices, triangles))
 }
 
-/// One texel of the atlas before encoding: linear albedo, coverage, normal.
-#[derive(Clone, Copy, Default)]
-struct Texel {
-    albedo: Vec3,
-    coverage: f32,
-    normal: Vec3,
-}
-
 /// One view rasterized at the supersampled size.
 struct Raster {
     side: u32,
@@ -242,8 +275,7 @@ impl Raster {
     /// View `i` of row `j`: the mesh's triangles, nearest first by depth.
     fn view(
         frames: &ImpostorFrames,
-        i: u32,
-        j: u32,
+        (i, j, top): (u32, u32, f32),
         source: &BakeSource,
         (vertices, triangles): (&[BakeVertex], &[[usize; 3]]),
     ) -> Self {
@@ -269,7 +301,7 @@ impl Raster {
         for t in triangles {
             let corners = t.map(|k| projected[k]);
             let attributes = t.map(|k| vertices[k]);
-            raster.triangle(corners, attributes, source, direction);
+            raster.triangle(corners, attributes, source, (direction, top));
         }
         raster
     }
@@ -280,7 +312,7 @@ impl Raster {
         [a, b, c]: [Vec3; 3],
         attributes: [BakeVertex; 3],
         source: &BakeSource,
-        direction: Vec3,
+        (direction, top): (Vec3, f32),
     ) {
         let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
         if area.abs() < 1e-12 {
@@ -307,7 +339,11 @@ impl Raster {
                 let mix = |f: fn(&BakeVertex) -> Vec4| {
                     w.x * f(&attributes[0]) + w.y * f(&attributes[1]) + w.z * f(&attributes[2])
                 };
-                let mut color = mix(|v| v.color) * Vec4::from(source.base_color.to_f32_array());
+                let y = mix(|v| v.position.extend(0.0)).y;
+                let mut color = source.color.at(y, top);
+                if source.vertex_colors {
+                    color *= mix(|v| v.color);
+                }
                 if let Some(texture) = source.texture {
                     color *= sample(texture, mix(|v| v.uv.extend(0.0).extend(0.0)).xy());
                 }
@@ -315,6 +351,7 @@ impl Raster {
                     continue;
                 }
                 let normal = mix(|v| v.normal.extend(0.0)).truncate().normalize_or(flat);
+                let normal = normal.lerp(Vec3::Y, source.lean).normalize_or(normal);
                 // Seen from the side the view looks from (leaves are seen from both).
                 let normal = if normal.dot(direction) < 0.0 {
                     -normal
@@ -377,186 +414,10 @@ fn sample(image: &Image, uv: Vec2) -> Vec4 {
         .map_or(Vec4::ONE, |c| Vec4::from(c.to_linear().to_f32_array()))
 }
 
-/// One mip level of the whole atlas: albedo texels on the left, normals on the right (each
-/// with the coverage of its view's texel).
-struct Level {
-    size: UVec2,
-    texels: Vec<Texel>,
-}
-
-impl Level {
-    fn new(size: UVec2) -> Self {
-        Self {
-            size,
-            texels: vec![Texel::default(); (size.x * size.y) as usize],
-        }
-    }
-
-    fn set(&mut self, x: u32, y: u32, texel: Texel) {
-        self.texels[(y * self.size.x + x) as usize] = texel;
-    }
-
-    /// A normal texel: the normal stored as the albedo's place holds colour.
-    fn set_normal(&mut self, x: u32, y: u32, texel: Texel) {
-        self.set(
-            x,
-            y,
-            Texel {
-                albedo: texel.normal * 0.5 + Vec3::splat(0.5),
-                ..texel
-            },
-        );
-    }
-
-    /// Spreads colour into uncovered texels next to covered ones, `steps` times, so that
-    /// filtering at an outline blends with the outline's colour, not black.
-    fn dilate(&mut self, steps: u32) {
-        let (w, h) = (self.size.x as i64, self.size.y as i64);
-        let mut filled: Vec<bool> = self.texels.iter().map(|t| t.coverage > 0.0).collect();
-        for _ in 0..steps {
-            let mut next = self.texels.clone();
-            let mut now = filled.clone();
-            for y in 0..h {
-                for x in 0..w {
-                    let k = (y * w + x) as usize;
-                    if filled[k] {
-                        continue;
-                    }
-                    let (mut sum, mut count) = (Vec3::ZERO, 0.0);
-                    for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1)] {
-                        let (nx, ny) = (x + dx, y + dy);
-                        if nx >= 0 && ny >= 0 && nx < w && ny < h && filled[(ny * w + nx) as usize]
-                        {
-                            sum += self.texels[(ny * w + nx) as usize].albedo;
-                            count += 1.0;
-                        }
-                    }
-                    if count > 0.0 {
-                        next[k].albedo = sum / count;
-                        now[k] = true;
-                    }
-                }
-            }
-            self.texels = next;
-            filled = now;
-        }
-    }
-
-    /// The next level down: 2x2 boxes, colour weighted by coverage (uncovered texels keep
-    /// their dilated colour).
-    fn half(&self) -> Self {
-        let size = (self.size / 2).max(UVec2::ONE);
-        let mut out = Self::new(size);
-        for y in 0..size.y {
-            for x in 0..size.x {
-                let mut sum = Texel::default();
-                let mut plain = Vec3::ZERO;
-                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    let (sx, sy) = (
-                        (2 * x + dx).min(self.size.x - 1),
-                        (2 * y + dy).min(self.size.y - 1),
-                    );
-                    let t = self.texels[(sy * self.size.x + sx) as usize];
-                    sum.albedo += t.albedo * t.coverage;
-                    sum.coverage += t.coverage;
-                    plain += t.albedo;
-                }
-                out.set(
-                    x,
-                    y,
-                    Texel {
-                        albedo: if sum.coverage > 0.0 {
-                            sum.albedo / sum.coverage
-                        } else {
-                            plain / 4.0
-                        },
-                        coverage: sum.coverage / 4.0,
-                        normal: Vec3::ZERO,
-                    },
-                );
-            }
-        }
-        out
-    }
-
-    /// The share of texels whose coverage, times `gain`, reaches `cutoff`.
-    fn kept(&self, cutoff: f32, gain: f32) -> f32 {
-        let kept = self
-            .texels
-            .iter()
-            .filter(|t| (t.coverage * gain).min(1.0) >= cutoff)
-            .count();
-        kept as f32 / self.texels.len() as f32
-    }
-
-    /// The gain on coverage that keeps the share `target` of texels at the cut-off (alpha
-    /// averaged down a mip chain thins a cut-out; this keeps it as dense).
-    fn gain_for(&self, cutoff: f32, target: f32) -> f32 {
-        let (mut lo, mut hi) = (1.0f32, 16.0f32);
-        if self.kept(cutoff, lo) >= target {
-            return lo;
-        }
-        for _ in 0..24 {
-            let mid = 0.5 * (lo + hi);
-            if self.kept(cutoff, mid) < target {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        hi
-    }
-
-    /// The level as sRGB bytes, coverage times `gain` in alpha.
-    fn encode(&self, gain: f32, out: &mut Vec<u8>) {
-        for t in &self.texels {
-            let c = Srgba::from(LinearRgba::rgb(t.albedo.x, t.albedo.y, t.albedo.z))
-                .to_u8_array_no_alpha();
-            out.extend_from_slice(&c);
-            out.push(((t.coverage * gain).clamp(0.0, 1.0) * 255.0).round() as u8);
-        }
-    }
-}
-
-/// The atlas image: every level down to 4 texels a view, sampled linearly and clamped.
-fn atlas_image(frames: &ImpostorFrames, base: Level, cutoff: f32) -> Image {
-    let levels = frames.texels.trailing_zeros().saturating_sub(1).max(1);
-    let target = base.kept(cutoff, 1.0);
-    let mut data = Vec::new();
-    base.encode(1.0, &mut data);
-    let mut level = base;
-    for _ in 1..levels {
-        level = level.half();
-        let gain = level.gain_for(cutoff, target);
-        level.encode(gain, &mut data);
-    }
-    let size = frames.size();
-    let mut image = Image::new_uninit(
-        Extent3d {
-            width: size.x,
-            height: size.y,
-            depth_or_array_layers: 1,
-        },
-        TextureDimension::D2,
-        TextureFormat::Rgba8UnormSrgb,
-        RenderAssetUsages::RENDER_WORLD | RenderAssetUsages::MAIN_WORLD,
-    );
-    image.data = Some(data);
-    image.texture_descriptor.mip_level_count = levels;
-    image.sampler = ImageSampler::Descriptor(ImageSamplerDescriptor {
-        address_mode_u: ImageAddressMode::ClampToEdge,
-        address_mode_v: ImageAddressMode::ClampToEdge,
-        mag_filter: ImageFilterMode::Linear,
-        min_filter: ImageFilterMode::Linear,
-        mipmap_filter: ImageFilterMode::Linear,
-        ..default()
-    });
-    image
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bevy::asset::RenderAssetUsages;
 
     fn settings(views: u32, rows: u32, texels: u32) -> Impostor {
         Impostor {
@@ -570,7 +431,9 @@ mod tests {
     fn source(mesh: &Mesh) -> BakeSource<'_> {
         BakeSource {
             mesh,
-            base_color: LinearRgba::rgb(0.5, 0.25, 1.0),
+            color: BakeColor::Plain(LinearRgba::rgb(0.5, 0.25, 1.0)),
+            vertex_colors: true,
+            lean: 0.0,
             texture: None,
             alpha_cutoff: None,
         }
@@ -672,6 +535,36 @@ mod tests {
         );
         // Outside the box: nothing covered.
         assert_eq!(texel(&baked, (0, 0), (1, 1), false)[3], 0);
+    }
+
+    #[test]
+    fn an_instanced_class_bakes_its_root_to_tip_colours_and_leaned_normals() {
+        let mut mesh = tall_box();
+        let count = mesh.count_vertices();
+        // The instanced shading reads no vertex colour.
+        mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, vec![[0.0, 0.0, 0.0, 1.0]; count]);
+        let mut s = source(&mesh);
+        s.color = BakeColor::Gradient {
+            base: LinearRgba::RED,
+            tip: LinearRgba::BLUE,
+            tip_from: 0.0,
+        };
+        s.vertex_colors = false;
+        s.lean = 0.45;
+        let baked = bake(&s, &settings(4, 1, 64)).unwrap();
+        let f = baked.frames;
+        // Rows of the front view a tenth and nine tenths up the box (4 m tall).
+        let row = |h: f32| ((0.5 - (h - f.center.y) / f.half.y * 0.5) * 64.0) as u32;
+        let low = texel(&baked, (0, 0), (32, row(0.4)), false);
+        let high = texel(&baked, (0, 0), (32, row(3.6)), false);
+        assert!(low[0] > 200 && low[2] < 130, "{low:?}");
+        assert!(high[2] > 200 && high[0] < 130, "{high:?}");
+        // The front face's normal (+z) leaned towards the sky.
+        let normal = texel(&baked, (0, 0), (32, 32), true);
+        let n = LinearRgba::from(Srgba::rgb_u8(normal[0], normal[1], normal[2])).to_vec3() * 2.0
+            - Vec3::ONE;
+        let leaned = Vec3::Z.lerp(Vec3::Y, 0.45).normalize();
+        assert!((n - leaned).length() < 0.03, "{n}");
     }
 
     #[test]

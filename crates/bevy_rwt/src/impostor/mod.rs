@@ -3,18 +3,20 @@
 //!
 //! Each class with an impostor has its atlas baked once, on the async compute pool, from the
 //! look it shows at the impostor's distance (its far level of detail when that starts
-//! nearer): [`bake`] rasterizes the mesh with its material from every view on the CPU.
+//! nearer): [`bake`] rasterizes the mesh with its material (or an instanced class's
+//! shading) from every view on the CPU.
 //! [`ImpostorAtlases`] holds the atlases by what they were baked from; the instanced look
 //! then draws each chunk's instances of the class as cards (one instanced draw per chunk,
 //! culled per instance like any instanced class), and entity instances are only spawned
 //! near enough to crossfade with them.
 
+mod atlas;
 pub mod bake;
 
 pub use bake::{BakeError, BakedImpostor, ImpostorFrames};
 
 use crate::layers::{ScatterClass, ScatterLayer};
-use crate::look::{ClassLook, Impostor};
+use crate::look::{ClassLook, Impostor, InstancedShading};
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::platform::collections::HashMap;
@@ -22,12 +24,56 @@ use bevy::prelude::*;
 use bevy::tasks::futures::check_ready;
 use bevy::tasks::{AsyncComputeTaskPool, Task};
 
-/// What an atlas is baked from: a mesh, a material, the views.
+/// What an atlas is baked from: a mesh, its material or shading, the views.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ImpostorKey {
     mesh: AssetId<Mesh>,
-    material: AssetId<StandardMaterial>,
+    look: LookKey,
     views: (u32, u32, u32),
+}
+
+/// A class's material, or its instanced shading (by what the bake reads of it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum LookKey {
+    Material(AssetId<StandardMaterial>),
+    Shading {
+        colors: [u32; 8],
+        tip_from: u32,
+        alpha_cutoff: u32,
+        texture: Option<AssetId<Image>>,
+    },
+}
+
+/// What a class's impostor is baked from besides its mesh.
+enum BakedLook<'a> {
+    Material(&'a Handle<StandardMaterial>),
+    Shading(&'a InstancedShading),
+}
+
+impl BakedLook<'_> {
+    fn key(&self) -> LookKey {
+        match self {
+            BakedLook::Material(m) => LookKey::Material(m.id()),
+            BakedLook::Shading(s) => {
+                let (base, tip) = (s.base_color.to_linear(), s.tip_color.to_linear());
+                let mut colors = [0; 8];
+                for (k, c) in base
+                    .to_f32_array()
+                    .into_iter()
+                    .chain(tip.to_f32_array())
+                    .enumerate()
+                {
+                    colors[k] = c.to_bits();
+                }
+                LookKey::Shading {
+                    colors,
+                    tip_from: s.tip_from.to_bits(),
+                    alpha_cutoff: s.alpha_cutoff.to_bits(),
+                    texture: s.texture.as_ref().map(Handle::id),
+                }
+            }
+        }
+    }
 }
 
 /// A baked atlas, ready to draw: the image, the card every instance draws, and where the
@@ -76,25 +122,30 @@ impl ImpostorAtlases {
 
 /// The mesh and material a class's impostor shows: its far level of detail's when that
 /// starts before the impostor, its own otherwise (`None` for classes without an impostor,
-/// or whose look is not a mesh).
-fn baked_look(
-    class: &ScatterClass,
-) -> Option<(&Handle<Mesh>, &Handle<StandardMaterial>, &Impostor)> {
+/// or whose look is a game's own).
+fn baked_look(class: &ScatterClass) -> Option<(&Handle<Mesh>, BakedLook<'_>, &Impostor)> {
     let impostor = class.impostor.as_ref()?;
-    let ClassLook::Mesh { mesh, material } = &class.look else {
-        return None;
-    };
-    Some(match &class.lod {
-        Some(lod) if lod.distance < impostor.distance => (&lod.mesh, &lod.material, impostor),
-        _ => (mesh, material, impostor),
+    Some(match (&class.look, &class.lod) {
+        (ClassLook::Mesh { .. }, Some(lod)) if lod.distance < impostor.distance => {
+            (&lod.mesh, BakedLook::Material(&lod.material), impostor)
+        }
+        (ClassLook::Mesh { mesh, material }, _) => (mesh, BakedLook::Material(material), impostor),
+        (ClassLook::Instanced(look), _) => {
+            let mesh = match &look.far {
+                Some(far) if far.distance < impostor.distance => &far.mesh,
+                _ => &look.mesh,
+            };
+            (mesh, BakedLook::Shading(&look.material), impostor)
+        }
+        (ClassLook::Custom(_), _) => return None,
     })
 }
 
 fn key_of(class: &ScatterClass) -> Option<ImpostorKey> {
-    let (mesh, material, impostor) = baked_look(class)?;
+    let (mesh, look, impostor) = baked_look(class)?;
     Some(ImpostorKey {
         mesh: mesh.id(),
-        material: material.id(),
+        look: look.key(),
         views: impostor.clamped(),
     })
 }
@@ -112,25 +163,20 @@ pub(crate) fn bake_impostors(
         return;
     };
     for class in layers.iter().flat_map(|l| l.classes.iter()) {
-        let (Some(key), Some((mesh, material, impostor))) = (key_of(class), baked_look(class))
-        else {
+        let (Some(key), Some((mesh, look, impostor))) = (key_of(class), baked_look(class)) else {
             continue;
         };
         if atlases.atlases.contains_key(&key) {
             continue;
         }
-        let (Some(mesh), Some(material)) = (meshes.get(mesh), materials.get(material)) else {
+        let Some(mesh) = meshes.get(mesh) else {
             continue;
         };
-        let texture = match &material.base_color_texture {
-            Some(handle) => match images.get(handle) {
-                Some(image) => Some(image.clone()),
-                None => continue,
-            },
-            None => None,
+        let Some(source) = OwnedSource::of(mesh, &look, &materials, &images) else {
+            continue;
         };
-        let task = start_bake(mesh.clone(), material, texture, *impostor);
-        let roughness = material.perceptual_roughness;
+        let roughness = source.roughness;
+        let task = start_bake(source, *impostor);
         atlases
             .atlases
             .insert(key, Baking::Running(task, roughness));
@@ -162,26 +208,77 @@ pub(crate) fn bake_impostors(
     atlases.generation += ready;
 }
 
-/// A bake of `mesh` with `material` on the async compute pool.
-fn start_bake(
+/// What a bake task takes with it: the mesh, its look, the texture.
+struct OwnedSource {
     mesh: Mesh,
-    material: &StandardMaterial,
+    color: bake::BakeColor,
+    vertex_colors: bool,
+    lean: f32,
     texture: Option<Image>,
-    impostor: Impostor,
-) -> Task<Result<BakedImpostor, BakeError>> {
-    let base_color = material.base_color.to_linear();
-    let alpha_cutoff = match material.alpha_mode {
-        AlphaMode::Mask(cutoff) => Some(cutoff),
-        _ => None,
-    };
-    AsyncComputeTaskPool::get().spawn(async move {
-        let source = bake::BakeSource {
-            mesh: &mesh,
-            base_color,
-            texture: texture.as_ref(),
-            alpha_cutoff,
+    alpha_cutoff: Option<f32>,
+    roughness: f32,
+}
+
+impl OwnedSource {
+    /// The bake's source for `mesh` with `look`, once its material and texture loaded.
+    fn of(
+        mesh: &Mesh,
+        look: &BakedLook,
+        materials: &Assets<StandardMaterial>,
+        images: &Assets<Image>,
+    ) -> Option<Self> {
+        let texture = |handle: Option<&Handle<Image>>| match handle {
+            Some(h) => images.get(h).map(|i| Some(i.clone())),
+            None => Some(None),
         };
-        bake::bake(&source, &impostor)
+        Some(match look {
+            BakedLook::Material(handle) => {
+                let material = materials.get(*handle)?;
+                Self {
+                    mesh: mesh.clone(),
+                    color: bake::BakeColor::Plain(material.base_color.to_linear()),
+                    vertex_colors: true,
+                    lean: 0.0,
+                    texture: texture(material.base_color_texture.as_ref())?,
+                    alpha_cutoff: match material.alpha_mode {
+                        AlphaMode::Mask(cutoff) => Some(cutoff),
+                        _ => None,
+                    },
+                    roughness: material.perceptual_roughness,
+                }
+            }
+            BakedLook::Shading(shading) => Self {
+                mesh: mesh.clone(),
+                color: bake::BakeColor::Gradient {
+                    base: shading.base_color.to_linear(),
+                    tip: shading.tip_color.to_linear(),
+                    tip_from: shading.tip_from,
+                },
+                vertex_colors: false,
+                lean: INSTANCED_LEAN,
+                texture: texture(shading.texture.as_ref())?,
+                alpha_cutoff: shading.texture.as_ref().map(|_| shading.alpha_cutoff),
+                roughness: shading.roughness,
+            },
+        })
+    }
+}
+
+/// How far the instanced shading leans its normals towards the sky (`instanced.wgsl`).
+const INSTANCED_LEAN: f32 = 0.45;
+
+/// A bake of `source` on the async compute pool.
+fn start_bake(source: OwnedSource, impostor: Impostor) -> Task<Result<BakedImpostor, BakeError>> {
+    AsyncComputeTaskPool::get().spawn(async move {
+        let s = bake::BakeSource {
+            mesh: &source.mesh,
+            color: source.color,
+            vertex_colors: source.vertex_colors,
+            lean: source.lean,
+            texture: source.texture.as_ref(),
+            alpha_cutoff: source.alpha_cutoff,
+        };
+        bake::bake(&s, &impostor)
     })
 }
 

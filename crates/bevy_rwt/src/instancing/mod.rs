@@ -200,6 +200,9 @@ pub struct InstancedChunk {
     /// Drawn as impostors: cards showing the atlas (the material's texture) from the
     /// nearest view, from the start of the band on.
     pub impostor: Option<ImpostorDraw>,
+    /// The crossfade band (distance from the camera to an instance's root) over which the
+    /// instances fade out, dithered, where the class's impostors take over.
+    pub fade_out: Option<(f32, f32)>,
 }
 
 /// How a chunk of impostors is drawn: where the atlas's views lie, and the crossfade band

@@ -47,9 +47,13 @@ impl Plugin for RwtInstancingPlugin {
             .add_systems(
                 self.schedule,
                 (
+                    // The bake writes meshes and images: before planning reads them.
+                    crate::impostor::bake_impostors
+                        .after(RwtSystems::Viewers)
+                        .before(RwtSystems::Plan)
+                        .before(mesh::refit_changed_meshes),
                     mesh::refit_changed_meshes.before(RwtSystems::Apply),
                     bend::update_bend_field,
-                    crate::impostor::bake_impostors.before(RwtSystems::Apply),
                     (far::choose_chunk_meshes, mesh::report_class_errors)
                         .chain()
                         .after(RwtSystems::Apply)

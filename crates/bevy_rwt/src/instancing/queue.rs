@@ -20,8 +20,12 @@ use std::sync::Arc;
 
 /// A chunk's instances of one class.
 pub(super) struct ClassBuffer {
-    /// The entity drawing the instances that are not promoted (none when there are none).
+    /// The entity drawing the instances that are not promoted (none when there are none,
+    /// or the class is drawn as entities).
     pub entity: Option<Entity>,
+    /// The entity drawing them as impostors, for a class with an impostor once its atlas is
+    /// baked.
+    pub impostor: Option<Entity>,
     /// The instances as generated, promoted ones included.
     pub whole: Arc<InstanceBuffer>,
     /// Promoted instances and the entities that hold them.
@@ -56,6 +60,7 @@ impl ClassBuffer {
     fn entities(&self) -> impl Iterator<Item = Entity> + '_ {
         self.entity
             .into_iter()
+            .chain(self.impostor)
             .chain(self.promoted.values().copied())
     }
 }
@@ -266,8 +271,9 @@ impl<'a> Upload<'a> {
         slot: Option<ClassBuffer>,
         packed: PackedClass,
     ) -> Option<(u16, ClassBuffer)> {
-        let (entity, mut promoted) =
-            slot.map_or((None, HashMap::new()), |s| (s.entity, s.promoted));
+        let (entity, impostor, mut promoted) = slot.map_or((None, None, HashMap::new()), |s| {
+            (s.entity, s.impostor, s.promoted)
+        });
         // Promoted instances that are no longer in the buffer go (only promoted classes
         // have any).
         if !promoted.is_empty() {
@@ -282,6 +288,7 @@ impl<'a> Upload<'a> {
         }
         let mut class = ClassBuffer {
             entity,
+            impostor,
             whole: packed.buffer,
             promoted,
         };
@@ -305,25 +312,30 @@ impl<'a> Upload<'a> {
                 buffer.promoted.contains_key(id)
             }))
         };
-        let component = match drawn.instances.is_empty() {
-            true => None,
-            false => self.component(target, class, drawn),
+        let (mesh, impostor) = match drawn.instances.is_empty() {
+            true => (None, None),
+            false => (
+                self.component(target, class, drawn.clone()),
+                self.impostor_component(target, class, drawn),
+            ),
         };
-        match (component, buffer.entity) {
-            (Some(bundle), Some(e)) => {
-                commands.entity(e).insert(bundle);
-            }
-            (Some(bundle), None) => {
-                let corner = target.chunk.rect(target.layer.streaming.chunk_size).min();
-                let transform = Transform::from_xyz(corner.x as f32, 0.0, corner.y as f32);
-                buffer.entity = Some(commands.spawn((bundle, transform)).id());
-            }
-            (None, Some(e)) => {
-                commands.entity(e).try_despawn();
-                buffer.entity = None;
-            }
-            (None, None) => {}
-        }
+        place(commands, target, &mut buffer.entity, mesh);
+        place(commands, target, &mut buffer.impostor, impostor);
+    }
+
+    /// The component drawing `buffer` of a class of the target's layer as impostors, with
+    /// its bounds (`None` when the class has none, or its atlas is not baked yet).
+    fn impostor_component(
+        &mut self,
+        target: Target,
+        class: u16,
+        buffer: Arc<InstanceBuffer>,
+    ) -> Option<(InstancedChunk, Aabb)> {
+        let c = target.layer.classes.get(class as usize)?;
+        let atlas = self.impostors?.of(c)?;
+        let component = impostor_chunk(target, class, c, atlas, buffer);
+        let aabb = component.aabb(self.checked.bounds(&atlas.card, self.meshes));
+        Some((component, aabb))
     }
 
     /// The component drawing `buffer` of a class of the target's layer, with its bounds
@@ -337,12 +349,11 @@ impl<'a> Upload<'a> {
         let layer = target.layer;
         let c = layer.classes.get(class as usize)?;
         let ClassLook::Instanced(look) = &c.look else {
-            return self.impostors?.of(c).map(|atlas| {
-                let component = impostor_chunk(target, class, c, atlas, buffer);
-                let aabb = component.aabb(self.checked.bounds(&atlas.card, self.meshes));
-                (component, aabb)
-            });
+            return None;
         };
+        // Where its impostors are drawn, the meshes fade out as they fade in.
+        let impostors = self.impostors.and_then(|a| a.of(c)).is_some();
+        let fade_out = c.impostor.filter(|_| impostors).map(|i| i.band());
         let mesh_bounds = self.checked.bounds(&look.mesh, self.meshes);
         let component = InstancedChunk {
             layer: target.entity,
@@ -356,6 +367,7 @@ impl<'a> Upload<'a> {
             falloff: layer_falloff(layer),
             buffer,
             impostor: None,
+            fade_out,
         };
         let aabb = component.aabb(self.checked.class_bounds(&component.meshes, self.meshes));
         Some((component, aabb))
@@ -370,7 +382,7 @@ fn layer_falloff(layer: &ScatterLayer) -> Option<(f32, f32, f32)> {
 }
 
 /// The chunk drawing the class's instances in `buffer` as impostors of `atlas`: lit cards,
-/// still in the wind, casting no shadow.
+/// still in the wind, casting no shadow, varied in colour as the class's meshes are.
 fn impostor_chunk(
     target: Target,
     class: u16,
@@ -379,10 +391,14 @@ fn impostor_chunk(
     buffer: Arc<InstanceBuffer>,
 ) -> InstancedChunk {
     let frames = atlas.frames;
+    let color_variation = match &c.look {
+        ClassLook::Instanced(look) => look.material.color_variation,
+        _ => 0.0,
+    };
     let material = InstancedShading {
         base_color: Color::WHITE,
         tip_color: Color::WHITE,
-        color_variation: 0.0,
+        color_variation,
         roughness: atlas.roughness,
         wind_response: 0.0,
         tip_from: 0.0,
@@ -405,5 +421,31 @@ fn impostor_chunk(
         falloff: layer_falloff(target.layer),
         buffer,
         impostor: Some(ImpostorDraw { frames, band }),
+        fade_out: None,
+    }
+}
+
+/// Puts `component` on the chunk entity in `slot`: spawned at the chunk's corner, updated,
+/// or despawned when there is none.
+fn place(
+    commands: &mut Commands,
+    target: Target,
+    slot: &mut Option<Entity>,
+    component: Option<(InstancedChunk, Aabb)>,
+) {
+    match (component, *slot) {
+        (Some(bundle), Some(e)) => {
+            commands.entity(e).insert(bundle);
+        }
+        (Some(bundle), None) => {
+            let corner = target.chunk.rect(target.layer.streaming.chunk_size).min();
+            let transform = Transform::from_xyz(corner.x as f32, 0.0, corner.y as f32);
+            *slot = Some(commands.spawn((bundle, transform)).id());
+        }
+        (None, Some(e)) => {
+            commands.entity(e).try_despawn();
+            *slot = None;
+        }
+        (None, None) => {}
     }
 }

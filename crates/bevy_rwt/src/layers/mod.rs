@@ -130,7 +130,8 @@ pub struct ScatterClass {
     pub promotion: Option<Promotion>,
     /// How its instances stand on their surface: upright, along its normal, or between.
     pub stance: Stance,
-    /// Far instances drawn as impostors (for [`ClassLook::Mesh`] classes).
+    /// Far instances drawn as impostors (for [`ClassLook::Mesh`] and
+    /// [`ClassLook::Instanced`] classes).
     pub impostor: Option<Impostor>,
 }
 
@@ -246,8 +247,8 @@ impl ScatterClass {
         }
     }
 
-    /// Draws the instances of this mesh class from `impostor.distance` on as impostors
-    /// baked from its look (see [`Impostor`]).
+    /// Draws the instances of this class (a mesh or an instanced class) from
+    /// `impostor.distance` on as impostors baked from its look (see [`Impostor`]).
     pub fn with_impostor(mut self, impostor: Impostor) -> Self {
         self.impostor = Some(impostor);
         self

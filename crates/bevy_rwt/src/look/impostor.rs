@@ -10,10 +10,12 @@ use serde::{Deserialize, Serialize};
 /// `views` directions around it in each of `rows` elevations, crossfading (dithered, as
 /// Bevy's visibility ranges do) with the mesh over `crossfade` around `distance`.
 ///
-/// Entity instances are spawned only in chunks within reach of the crossfade; farther ones
-/// are drawn from per-chunk instance buffers, so a forest costs one instanced draw per
-/// chunk to the horizon instead of an entity per tree. Impostors cast no shadow (far
-/// cascades rarely reach them) and stand upright (a class's tilt is not applied).
+/// A mesh class's entity instances are spawned only in chunks within reach of the
+/// crossfade; farther ones are drawn from per-chunk instance buffers, so a forest costs one
+/// instanced draw per chunk to the horizon instead of an entity per tree. An instanced
+/// class's chunks draw both from one buffer, the meshes fading out as the cards fade in.
+/// Impostors cast no shadow (far cascades rarely reach them) and stand upright (a class's
+/// tilt is not applied).
 ///
 /// In a layer file: `impostor: Some((distance: 400.0, crossfade: 40.0))`; fields left out
 /// take [`Impostor::default`]'s values.

@@ -1,7 +1,8 @@
 //! Impostors: a mesh class drawn far as impostors spawns entities only in chunks within
 //! reach of its crossfade, and every instance of the class, near or far, is in an impostor
 //! chunk's buffer, where the entity path puts it; chopping a far tree takes its impostor
-//! away.
+//! away. An instanced class draws its meshes and its impostors from one buffer, the meshes
+//! fading out over the band the cards fade in over.
 
 use crate::common::*;
 use bevy::prelude::*;
@@ -133,4 +134,50 @@ fn a_tree_chopped_far_away_loses_its_impostor() {
         "the chopped tree's impostor stays"
     );
     assert!(cards.len() > 10);
+}
+
+#[test]
+fn an_instanced_class_draws_meshes_and_impostors_from_one_buffer() {
+    let mut app = create_app_with(|app| {
+        app.init_asset::<Mesh>()
+            .init_asset::<StandardMaterial>()
+            .init_asset::<Image>();
+    });
+    let mesh = app.world_mut().resource_mut::<Assets<Mesh>>().add(
+        Cuboid::new(1.0, 4.0, 1.0)
+            .mesh()
+            .build()
+            .translated_by(Vec3::Y * 2.0),
+    );
+    let trees = ScatterClass::instanced(LayerDensity::Constant(0.05), mesh, default())
+        .with_impostor(impostor());
+    let mut l = layer(LayerDensity::Constant(0.0));
+    l.classes = vec![trees];
+    app.world_mut().spawn(l);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    settle(&mut app);
+    let mut q = app.world_mut().query::<&InstancedChunk>();
+    let chunks: Vec<&InstancedChunk> = q.iter(app.world()).collect();
+    let (cards, meshes): (Vec<&InstancedChunk>, Vec<&InstancedChunk>) =
+        chunks.into_iter().partition(|c| c.impostor.is_some());
+    assert!(
+        !meshes.is_empty() && cards.len() == meshes.len(),
+        "{} {}",
+        meshes.len(),
+        cards.len()
+    );
+    for m in &meshes {
+        assert_eq!(m.fade_out, Some(impostor().band()));
+        let card = cards
+            .iter()
+            .find(|c| c.chunk == m.chunk)
+            .expect("each chunk has its impostors");
+        assert!(std::sync::Arc::ptr_eq(&card.buffer, &m.buffer));
+        assert_eq!(card.impostor.unwrap().band, impostor().band());
+        assert_eq!(card.fade_out, None);
+    }
+    assert!(
+        instances(&mut app).is_empty(),
+        "no entity for an instanced class"
+    );
 }

@@ -49,9 +49,12 @@ struct Chunk {
     thinning_from: f32,
     thinning_floor: f32,
     thinning_on: u32,
-    // Impostors: the crossfade band (distance from the eye to a root) they fade in over.
-    visible_from: f32,
-    visible_to: f32,
+    // The crossfade band (distance from the eye to a root) impostors fade in over, and the
+    // one a class's mesh fades out over where impostors take over.
+    fade_in_from: f32,
+    fade_in_to: f32,
+    fade_out_from: f32,
+    fade_out_to: f32,
     // Half the width and height one baked view covers, at scale 1.
     impostor_half: vec2<f32>,
     // Where the views look (the mesh's bounds' centre), and how many there are around.
@@ -116,6 +119,10 @@ struct VertexOutput {
 #ifdef RWT_IMPOSTOR
     // The instance's turn (cosine, sine) and its crossfade's dither level (-16..0).
     @location(6) @interpolate(flat) impostor: vec4<f32>,
+#endif
+#ifdef RWT_FADE_OUT
+    // The mesh's dither level as impostors take over (0..16).
+    @location(7) @interpolate(flat) fade_out: f32,
 #endif
 };
 
@@ -231,13 +238,51 @@ fn tilt(v: vec3<f32>, up: vec3<f32>) -> vec3<f32> {
     return v + wv + cross(w, wv) / (1.0 + up.y);
 }
 
+// Where distances are measured from, as Bevy's visibility ranges measure them: the view's
+// camera, or the main camera in shadow passes.
+fn lod_eye() -> vec3<f32> {
+#ifdef RWT_SHADOW_PASS
+    return frame.viewer;
+#else
+    return view.world_position;
+#endif
+}
+
+// Bevy's ordered dither (`visibility_range_dither`): discards the fragment at `frag_coord`
+// of a look at dither `level`: 0 whole, -16..0 fading in, 0..16 fading out, +-16 gone.
+fn dither(frag_coord: vec4<f32>, level: f32) {
+    let coords = vec2<u32>(floor(frag_coord.xy)) % 4u;
+    let map = vec4<u32>(0x0a020800u, 0x060e040cu, 0x09010b03u, 0x050d070fu);
+    let threshold = f32((map[coords.y] >> (coords.x * 8u)) & 0xffu);
+    let gone = abs(level) >= 16.0;
+    let leaving = level > 0.0 && level + threshold >= 16.0;
+    let coming = level < 0.0 && 1.0 + level + threshold <= 0.0;
+    if gone || leaving || coming {
+        discard;
+    }
+}
+
+// The dither level of a class's mesh at `root` as its impostors take over: 0 (whole)
+// before their crossfade band, rising to 16 (gone) at its end; 0 without impostors.
+fn fade_out_level(root: vec3<f32>) -> f32 {
+#ifdef RWT_FADE_OUT
+    let span = max(chunk.fade_out_to - chunk.fade_out_from, 1e-3);
+    let d = distance(lod_eye(), root);
+    return clamp(round((d - chunk.fade_out_from) / span * 16.0), 0.0, 16.0);
+#else
+    return 0.0;
+#endif
+}
+
 fn place(in: Vertex, time: f32) -> Placed {
     let root = chunk.origin + in.offset_scale.xyz;
     let yaw = in.yaw_appear_tint.x * 6.2831853;
     let tint = in.yaw_appear_tint.z;
     let fade = chunk_fade();
     let kept = kept_fraction(fade, root);
-    let scale = in.offset_scale.w * growth(fade, root, in.yaw_appear_tint.y, kept);
+    // A mesh its impostor replaced collapses to its root.
+    let shown = select(1.0, 0.0, fade_out_level(root) >= 16.0);
+    let scale = in.offset_scale.w * growth(fade, root, in.yaw_appear_tint.y, kept) * shown;
     let c = cos(yaw);
     let s = sin(yaw);
     // A thinned field's instances are widened to cover as the whole field did (seen from
@@ -274,22 +319,13 @@ fn place(in: Vertex, time: f32) -> Placed {
 }
 
 #ifdef RWT_IMPOSTOR
-// Where distances are measured from, as Bevy's visibility ranges measure them: the view's
-// camera, or the main camera in shadow passes.
-fn lod_eye() -> vec3<f32> {
-#ifdef RWT_SHADOW_PASS
-    return frame.viewer;
-#else
-    return view.world_position;
-#endif
-}
-
 // The dither level of an impostor `d` from the eye: -16 (not drawn) before the crossfade
-// band, rising to 0 (whole) at its end. Bevy's visibility range fades the mesh out over
-// the same band with the level 16 more, so every pixel shows one of the two.
+// band, rising to 0 (whole) at its end. The mesh fades out over the same band with the
+// level 16 more (Bevy's visibility range, or `fade_out_level`), so every pixel shows one of
+// the two.
 fn fade_in_level(d: f32) -> f32 {
-    let span = max(chunk.visible_to - chunk.visible_from, 1e-3);
-    return -16.0 + clamp(round((d - chunk.visible_from) / span * 16.0), 0.0, 16.0);
+    let span = max(chunk.fade_in_to - chunk.fade_in_from, 1e-3);
+    return -16.0 + clamp(round((d - chunk.fade_in_from) / span * 16.0), 0.0, 16.0);
 }
 
 // An impostor's card: centred on the baked views' centre (turned with the instance), facing
@@ -327,7 +363,9 @@ fn card(in: Vertex) -> VertexOutput {
     out.world_position = vec4<f32>(world, 1.0);
     out.clip_position = position_world_to_clip(world);
     out.world_normal = dir;
-    out.color = vec4<f32>(1.0);
+    // The class's colour variation per instance, as its meshes have it.
+    let variation = (in.yaw_appear_tint.z - 0.5) * chunk.color_variation;
+    out.color = vec4<f32>(vec3<f32>(1.0 + variation) + vec3<f32>(variation * 0.15, variation * 0.05, 0.0), 1.0);
 #ifdef MOTION_VECTOR_PREPASS
     out.previous_world_position = out.world_position;
 #endif
@@ -338,17 +376,6 @@ fn card(in: Vertex) -> VertexOutput {
     out.clip_position.z = min(out.clip_position.z, 1.0);
 #endif
     return out;
-}
-
-// Bevy's ordered dither: discards the fragment at `frag_coord` of a look fading in at
-// `level` (-16: gone, 0: whole), as `visibility_range_dither` does.
-fn dither_in(frag_coord: vec4<f32>, level: f32) {
-    let coords = vec2<u32>(floor(frag_coord.xy)) % 4u;
-    let map = vec4<u32>(0x0a020800u, 0x060e040cu, 0x09010b03u, 0x050d070fu);
-    let threshold = f32((map[coords.y] >> (coords.x * 8u)) & 0xffu);
-    if level <= -16.0 || 1.0 + level + threshold <= 0.0 {
-        discard;
-    }
 }
 
 // The atlas's normal where the albedo is read at `uv`, in the world (the instance turned).
@@ -378,6 +405,9 @@ fn vertex(in: Vertex) -> VertexOutput {
 #endif
 #ifdef RWT_TEXTURE
     out.uv = in.uv;
+#endif
+#ifdef RWT_FADE_OUT
+    out.fade_out = fade_out_level(chunk.origin + in.offset_scale.xyz);
 #endif
 #ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
     out.unclipped_depth = out.clip_position.z;
@@ -417,12 +447,15 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> Fragment
 #ifdef RWT_IMPOSTOR
     let n = impostor_normal(in.uv, in.impostor);
     _ = cut_out(in.uv);
-    dither_in(in.clip_position, in.impostor.z);
+    dither(in.clip_position, in.impostor.z);
 #else
 #ifdef RWT_TEXTURE
     _ = cut_out(in.uv);
 #endif
     let n = facing_normal(in.world_normal, is_front);
+#endif
+#ifdef RWT_FADE_OUT
+    dither(in.clip_position, in.fade_out);
 #endif
     var out: FragmentOutput;
 #ifdef NORMAL_PREPASS
@@ -440,14 +473,25 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> Fragment
 }
 #else
 #ifdef RWT_TEXTURE
-// Depth alone (a shadow map, a depth prepass): only the cut-out.
+// Depth alone (a shadow map, a depth prepass): only the cut-out and the crossfades.
 @fragment
 fn fragment(in: VertexOutput) {
     _ = cut_out(in.uv);
 #ifdef RWT_IMPOSTOR
-    dither_in(in.clip_position, in.impostor.z);
+    dither(in.clip_position, in.impostor.z);
+#endif
+#ifdef RWT_FADE_OUT
+    dither(in.clip_position, in.fade_out);
 #endif
 }
+#else
+#ifdef RWT_FADE_OUT
+// Depth alone of an untextured class: only the crossfade with its impostors.
+@fragment
+fn fragment(in: VertexOutput) {
+    dither(in.clip_position, in.fade_out);
+}
+#endif
 #endif
 #endif
 #else
@@ -463,7 +507,10 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @locatio
     color = vec4<f32>(color.rgb * cut_out(in.uv).rgb, 1.0);
 #endif
 #ifdef RWT_IMPOSTOR
-    dither_in(in.clip_position, in.impostor.z);
+    dither(in.clip_position, in.impostor.z);
+#endif
+#ifdef RWT_FADE_OUT
+    dither(in.clip_position, in.fade_out);
 #endif
     var pbr_input = pbr_types::pbr_input_new();
     pbr_input.material.base_color = color;

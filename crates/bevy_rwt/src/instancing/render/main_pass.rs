@@ -92,6 +92,9 @@ pub(super) fn mesh_attributes(
     if features.impostor {
         defs.push("RWT_IMPOSTOR".into());
     }
+    if features.fades_out {
+        defs.push("RWT_FADE_OUT".into());
+    }
     attributes
 }
 

@@ -93,6 +93,7 @@ impl ExtractedChunk {
             textured: self.texture.is_some(),
             bends: self.uniform.bend_response != 0.0,
             impostor: self.uniform.impostor_views != 0 && self.texture.is_some(),
+            fades_out: self.uniform.fade_out_to > 0.0,
         }
     }
 }
@@ -109,6 +110,8 @@ pub(in crate::instancing) struct ClassFeatures {
     bends: bool,
     /// The chunk draws impostors, cards showing its texture's atlas (`RWT_IMPOSTOR`).
     impostor: bool,
+    /// The chunk's meshes fade out where its class's impostors take over (`RWT_FADE_OUT`).
+    fades_out: bool,
 }
 
 impl SyncComponent for InstancedChunk {
@@ -137,7 +140,7 @@ impl ExtractComponent for InstancedChunk {
             buffer: chunk.buffer.clone(),
             mesh: chunk.mesh.id(),
             uniform: ChunkUniform::new(origin, chunk.mesh_top, &chunk.material, chunk.falloff)
-                .with_impostor(chunk.impostor.as_ref()),
+                .with_impostor(chunk.impostor.as_ref(), chunk.fade_out),
             bounds: Aabb {
                 center: local.center + origin.to_vec3a(),
                 half_extents: local.half_extents,

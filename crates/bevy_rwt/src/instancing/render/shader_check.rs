@@ -128,7 +128,13 @@ fn cache_with_library() -> ShaderCache<String, ()> {
 /// every class feature and pass option the pipelines combine.
 fn permutations() -> Vec<Vec<ShaderDefVal>> {
     let global = ShaderDefVal::UInt("AVAILABLE_STORAGE_BUFFER_BINDINGS".into(), 8);
-    let features = ["RWT_NORMALS", "RWT_BEND", "RWT_TEXTURE", "RWT_IMPOSTOR"];
+    let features = [
+        "RWT_NORMALS",
+        "RWT_BEND",
+        "RWT_TEXTURE",
+        "RWT_IMPOSTOR",
+        "RWT_FADE_OUT",
+    ];
     let passes = [
         "NORMAL_PREPASS",
         "MOTION_VECTOR_PREPASS",
@@ -140,9 +146,9 @@ fn permutations() -> Vec<Vec<ShaderDefVal>> {
         on.map(|(_, n)| ShaderDefVal::from(*n)).collect()
     };
     let mut all = Vec::new();
-    // Impostors are always textured (their atlas).
-    let impostor_untextured = |f: usize| f & 0b1100 == 0b1000;
-    for f in (0..1 << features.len()).filter(|f| !impostor_untextured(*f)) {
+    // Impostors are always textured (their atlas), and never fade out.
+    let impossible = |f: usize| f & 0b1100 == 0b1000 || f & 0b11000 == 0b11000;
+    for f in (0..1 << features.len()).filter(|f| !impossible(*f)) {
         let mut main = vec![
             global.clone(),
             ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 3),
@@ -153,8 +159,8 @@ fn permutations() -> Vec<Vec<ShaderDefVal>> {
             let mut depth = vec![global.clone(), "PREPASS_PIPELINE".into()];
             depth.extend(subset(&features, f));
             depth.extend(subset(&passes, p));
-            // The depth pipeline writes a fragment where a prepass target or the
-            // emulation asks for one.
+            // The depth pipeline has a fragment where a prepass target or the emulation
+            // asks for one; one that writes nothing for a textured or fading class.
             if p & 0b111 != 0 {
                 depth.push("PREPASS_FRAGMENT".into());
             }
@@ -210,12 +216,14 @@ fn marked_chunk() -> (Vec<(String, usize)>, usize) {
         thinning_from: f(20),
         thinning_floor: f(21),
         thinning_on: 22,
-        visible_from: f(23),
-        visible_to: f(24),
-        impostor_half: Vec2::splat(f(25)),
-        impostor_center: Vec3::splat(f(26)),
-        impostor_views: 27,
-        impostor_rows: 28,
+        fade_in_from: f(23),
+        fade_in_to: f(24),
+        fade_out_from: f(25),
+        fade_out_to: f(26),
+        impostor_half: Vec2::splat(f(27)),
+        impostor_center: Vec3::splat(f(28)),
+        impostor_views: 29,
+        impostor_rows: 30,
     };
     let names = [
         "origin",
@@ -241,14 +249,16 @@ fn marked_chunk() -> (Vec<(String, usize)>, usize) {
         "thinning_from",
         "thinning_floor",
         "thinning_on",
-        "visible_from",
-        "visible_to",
+        "fade_in_from",
+        "fade_in_to",
+        "fade_out_from",
+        "fade_out_to",
         "impostor_half",
         "impostor_center",
         "impostor_views",
         "impostor_rows",
     ];
-    let words = [11, 19, 22, 27, 28];
+    let words = [11, 19, 22, 29, 30];
     let markers: Vec<(&str, u32)> = (0u32..)
         .zip(names)
         .map(|(k, n)| {
@@ -327,7 +337,7 @@ fn every_permutation_composes_and_validates_with_the_uniform_layouts() {
         failed.len(),
         failed.join("\n")
     );
-    assert_eq!(composed.len(), 12 * 17);
+    assert_eq!(composed.len(), 20 * 17);
     let (chunk, frame) = (marked_chunk(), marked_frame());
     for types in &composed {
         assert_eq!(struct_layout(types, "Chunk"), chunk);

@@ -43,10 +43,14 @@ pub(super) struct ChunkUniform {
     pub thinning_from: f32,
     pub thinning_floor: f32,
     pub thinning_on: u32,
-    /// Impostors: the crossfade band (distance from the eye to a root) they fade in over;
-    /// both 0 for other classes.
-    pub visible_from: f32,
-    pub visible_to: f32,
+    /// The crossfade band (distance from the eye to a root) impostors fade in over; both 0
+    /// for other chunks.
+    pub fade_in_from: f32,
+    pub fade_in_to: f32,
+    /// The crossfade band a class's mesh fades out over where its impostors take over;
+    /// both 0 for other chunks.
+    pub fade_out_from: f32,
+    pub fade_out_to: f32,
     /// Impostors: half the width and height of a baked view, at scale 1.
     pub impostor_half: Vec2,
     /// Impostors: where the views look, and how many there are around and up.
@@ -92,17 +96,24 @@ impl ChunkUniform {
         }
     }
 
-    /// The uniform drawing impostors as `draw` says.
-    pub fn with_impostor(self, draw: Option<&ImpostorDraw>) -> Self {
-        let Some(d) = draw else { return self };
+    /// The uniform drawing impostors as `draw` says, or a mesh fading out over
+    /// `fade_out`.
+    pub fn with_impostor(self, draw: Option<&ImpostorDraw>, fade_out: Option<(f32, f32)>) -> Self {
+        let (fade_out_from, fade_out_to) = fade_out.unwrap_or((0.0, 0.0));
+        let this = Self {
+            fade_out_from,
+            fade_out_to,
+            ..self
+        };
+        let Some(d) = draw else { return this };
         Self {
-            visible_from: d.band.0,
-            visible_to: d.band.1,
+            fade_in_from: d.band.0,
+            fade_in_to: d.band.1,
             impostor_half: d.frames.half,
             impostor_center: d.frames.center,
             impostor_views: d.frames.views,
             impostor_rows: d.frames.rows,
-            ..self
+            ..this
         }
     }
 }

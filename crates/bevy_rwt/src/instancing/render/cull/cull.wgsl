@@ -23,7 +23,8 @@ struct Cull {
     // Fall-off near, far, 1 when the fade is on, and its floor.
     falloff: vec4<f32>,
     // Fade band (x); distance from the eye within which instances are not drawn (y: the
-    // start of an impostor's crossfade; 0 for other classes).
+    // start of an impostor's crossfade; 0 for other chunks) and beyond which they are not
+    // (z: the end of a mesh's crossfade with its impostors; 0 for other chunks).
     fade: vec4<f32>,
     // Far thinning: its distance, its floor, 1 when on.
     thinning: vec4<f32>,
@@ -77,7 +78,7 @@ fn seen(root: vec3<f32>, scale: f32, widen: f32) -> bool {
     if cull.eye.w >= 0.0 && from_eye - radius > cull.eye.w {
         return false;
     }
-    if from_eye < cull.fade.y {
+    if from_eye < cull.fade.y || (cull.fade.z > 0.0 && from_eye >= cull.fade.z) {
         return false;
     }
     for (var k = 0u; k < 6u; k++) {

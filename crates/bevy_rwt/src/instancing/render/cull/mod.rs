@@ -65,7 +65,8 @@ pub(super) struct CullUniform {
     /// Fall-off near, far, 1 when the fade is on, floor.
     falloff: Vec4,
     /// Fade band (x); distance from the eye within which instances are not drawn (y: the
-    /// start of an impostor's crossfade; 0 for other classes).
+    /// start of an impostor's crossfade; 0 for other chunks) and beyond which they are not
+    /// (z: the end of a mesh's crossfade with its impostors; 0 for other chunks).
     fade: Vec4,
     /// Far thinning: its distance, its floor, 1 when on.
     thinning: Vec4,
@@ -94,7 +95,7 @@ impl CullUniform {
         if self.eye.w >= 0.0 && distance - radius > self.eye.w {
             return false;
         }
-        if distance < self.fade.y {
+        if distance < self.fade.y || (self.fade.z > 0.0 && distance >= self.fade.z) {
             return false;
         }
         self.planes
@@ -762,7 +763,7 @@ fn uniform(d: &Dispatch, o: &Offsets) -> CullUniform {
             u.falloff_on as f32,
             u.falloff_floor,
         ),
-        fade: Vec4::new(u.fade_band, u.visible_from, 0.0, 0.0),
+        fade: Vec4::new(u.fade_band, u.fade_in_from, u.fade_out_to, 0.0),
         thinning: Vec4::new(u.thinning_from, u.thinning_floor, u.thinning_on as f32, 0.0),
         slots: UVec4::new(d.gpu.count, o.draw * ARGS_WORDS + 1, x, 0),
         clip_from_world,

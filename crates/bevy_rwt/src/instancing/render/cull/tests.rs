@@ -116,6 +116,13 @@ fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
     };
     assert!(!impostors.keeps(&at(Vec3::new(11.9, 0.0, 0.0), 0.0)));
     assert!(impostors.keeps(&at(Vec3::new(12.1, 0.0, 0.0), 0.0)));
+    // A class's meshes, gone past the end of their crossfade with its impostors at 14 m.
+    let meshes = CullUniform {
+        fade: Vec4::new(0.1, 0.0, 14.0, 0.0),
+        ..no_fade
+    };
+    assert!(meshes.keeps(&at(Vec3::new(13.9, 0.0, 0.0), 0.0)));
+    assert!(!meshes.keeps(&at(Vec3::new(14.1, 0.0, 0.0), 0.0)));
     // Down to the floor, however far.
     assert!(thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.09)));
     assert!(!thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.13)));
