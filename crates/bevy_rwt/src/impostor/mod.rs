@@ -1,5 +1,5 @@
 //! Impostors: far instances of a class drawn as camera-facing cards (see
-//! [`Impostor`](crate::look::Impostor)).
+//! [`crate::look::Impostor`]).
 //!
 //! Each class with an impostor has its atlas baked once, on the async compute pool, from the
 //! look it shows at the impostor's distance (its far level of detail when that starts
