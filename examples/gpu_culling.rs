@@ -20,7 +20,8 @@ use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::frame_check::{
-    Captures, culling_check_app, mean_difference, output_dir, passed, spawn_shadow_sun,
+    Captures, culling_check_app, mean_difference, out_of_patience, output_dir, passed,
+    spawn_shadow_sun,
 };
 use rwt_examples::grass_field;
 
@@ -89,10 +90,7 @@ fn run_check(
     mut commands: Commands,
     mut exit: MessageWriter<AppExit>,
 ) {
-    check.frame += 1;
-    if check.frame > PATIENCE {
-        eprintln!("rwt-culling: FAIL no result in {PATIENCE} frames");
-        exit.write(AppExit::error());
+    if out_of_patience(&mut check.frame, PATIENCE, "rwt-culling", &mut exit) {
         return;
     }
     let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && stats.live_instanced > 0;

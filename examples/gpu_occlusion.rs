@@ -23,8 +23,8 @@ use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::frame_check::{
-    Captures, culling_check_app, mean_difference, output_dir, passed, pixels_differing,
-    spawn_shadow_sun,
+    Captures, culling_check_app, mean_difference, out_of_patience, output_dir, passed,
+    pixels_differing, spawn_shadow_sun,
 };
 use rwt_examples::grass_field;
 
@@ -120,10 +120,7 @@ fn run_check(
     mut commands: Commands,
     mut exit: MessageWriter<AppExit>,
 ) {
-    check.frame += 1;
-    if check.frame > PATIENCE {
-        eprintln!("rwt-occlusion: FAIL no result in {PATIENCE} frames");
-        exit.write(AppExit::error());
+    if out_of_patience(&mut check.frame, PATIENCE, "rwt-occlusion", &mut exit) {
         return;
     }
     let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && stats.live_instanced > 0;

@@ -20,7 +20,7 @@ use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::density::Density;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::foliage;
-use rwt_examples::frame_check::{Captures, output_dir, passed, spawn_shadow_sun};
+use rwt_examples::frame_check::{Captures, out_of_patience, output_dir, passed, spawn_shadow_sun};
 use std::sync::Arc;
 
 /// Least intersection over union of the two frames' tree pixels.
@@ -156,10 +156,7 @@ fn run_check(
     mut commands: Commands,
     mut exit: MessageWriter<AppExit>,
 ) {
-    check.frame += 1;
-    if check.frame > PATIENCE {
-        eprintln!("rwt-impostor: FAIL no result in {PATIENCE} frames");
-        exit.write(AppExit::error());
+    if out_of_patience(&mut check.frame, PATIENCE, "rwt-impostor", &mut exit) {
         return;
     }
     let meshes_done = captures.get("meshes").is_some();

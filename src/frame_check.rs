@@ -125,3 +125,21 @@ pub fn passed(prefix: &str, checks: &[(bool, &str)]) -> bool {
     }
     checks.iter().all(|(failed, _)| !failed)
 }
+
+/// Counts one more frame of a check that may take `patience` frames; past them prints
+/// `PREFIX: FAIL no result in N frames`, asks the app to exit with an error and returns
+/// true (the check gives up).
+pub fn out_of_patience(
+    frame: &mut u32,
+    patience: u32,
+    prefix: &str,
+    exit: &mut MessageWriter<AppExit>,
+) -> bool {
+    *frame += 1;
+    if *frame <= patience {
+        return false;
+    }
+    eprintln!("{prefix}: FAIL no result in {patience} frames");
+    exit.write(AppExit::error());
+    true
+}

@@ -143,11 +143,16 @@ fn baked_look(class: &ScatterClass) -> Option<(&Handle<Mesh>, BakedLook<'_>, &Im
 
 fn key_of(class: &ScatterClass) -> Option<ImpostorKey> {
     let (mesh, look, impostor) = baked_look(class)?;
-    Some(ImpostorKey {
+    Some(key(mesh, &look, impostor))
+}
+
+/// What an atlas of `mesh` with `look` and `impostor`'s views is baked from.
+fn key(mesh: &Handle<Mesh>, look: &BakedLook, impostor: &Impostor) -> ImpostorKey {
+    ImpostorKey {
         mesh: mesh.id(),
         look: look.key(),
         views: impostor.clamped(),
-    })
+    }
 }
 
 /// Starts a bake for every class with an impostor whose look has loaded, and puts finished
@@ -163,9 +168,10 @@ pub(crate) fn bake_impostors(
         return;
     };
     for class in layers.iter().flat_map(|l| l.classes.iter()) {
-        let (Some(key), Some((mesh, look, impostor))) = (key_of(class), baked_look(class)) else {
+        let Some((mesh, look, impostor)) = baked_look(class) else {
             continue;
         };
+        let key = key(mesh, &look, impostor);
         if atlases.atlases.contains_key(&key) {
             continue;
         }

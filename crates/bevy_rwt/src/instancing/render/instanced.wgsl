@@ -262,6 +262,17 @@ fn dither(frag_coord: vec4<f32>, level: f32) {
     }
 }
 
+// The crossfades between a class's meshes and its impostors this fragment takes part in:
+// an impostor fading in, a mesh fading out.
+fn crossfade(in: VertexOutput) {
+#ifdef RWT_IMPOSTOR
+    dither(in.clip_position, in.impostor.z);
+#endif
+#ifdef RWT_FADE_OUT
+    dither(in.clip_position, in.fade_out);
+#endif
+}
+
 // The dither level of a class's mesh at `root` as its impostors take over: 0 (whole)
 // before their crossfade band, rising to 16 (gone) at its end; 0 without impostors.
 fn fade_out_level(root: vec3<f32>) -> f32 {
@@ -446,17 +457,13 @@ struct FragmentOutput {
 fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> FragmentOutput {
 #ifdef RWT_IMPOSTOR
     let n = impostor_normal(in.uv, in.impostor);
-    _ = cut_out(in.uv);
-    dither(in.clip_position, in.impostor.z);
 #else
+    let n = facing_normal(in.world_normal, is_front);
+#endif
 #ifdef RWT_TEXTURE
     _ = cut_out(in.uv);
 #endif
-    let n = facing_normal(in.world_normal, is_front);
-#endif
-#ifdef RWT_FADE_OUT
-    dither(in.clip_position, in.fade_out);
-#endif
+    crossfade(in);
     var out: FragmentOutput;
 #ifdef NORMAL_PREPASS
     out.normal = vec4<f32>(n * 0.5 + vec3<f32>(0.5), 1.0);
@@ -477,19 +484,14 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> Fragment
 @fragment
 fn fragment(in: VertexOutput) {
     _ = cut_out(in.uv);
-#ifdef RWT_IMPOSTOR
-    dither(in.clip_position, in.impostor.z);
-#endif
-#ifdef RWT_FADE_OUT
-    dither(in.clip_position, in.fade_out);
-#endif
+    crossfade(in);
 }
 #else
 #ifdef RWT_FADE_OUT
 // Depth alone of an untextured class: only the crossfade with its impostors.
 @fragment
 fn fragment(in: VertexOutput) {
-    dither(in.clip_position, in.fade_out);
+    crossfade(in);
 }
 #endif
 #endif
@@ -506,12 +508,7 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @locatio
 #ifdef RWT_TEXTURE
     color = vec4<f32>(color.rgb * cut_out(in.uv).rgb, 1.0);
 #endif
-#ifdef RWT_IMPOSTOR
-    dither(in.clip_position, in.impostor.z);
-#endif
-#ifdef RWT_FADE_OUT
-    dither(in.clip_position, in.fade_out);
-#endif
+    crossfade(in);
     var pbr_input = pbr_types::pbr_input_new();
     pbr_input.material.base_color = color;
     pbr_input.material.perceptual_roughness = chunk.roughness;
