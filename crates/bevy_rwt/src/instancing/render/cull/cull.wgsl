@@ -11,35 +11,52 @@
 
 #import rwt::fade::{Fade, kept_fraction, growth}
 
+// One dispatch's settings (`CullParams`): the view's, then the chunk's.
 struct Cull {
     // The view's half-spaces (normal, distance; inside where dot(n, p) + d > 0).
     planes: array<vec4<f32>, 6>,
-    // Chunk corner (xyz); radius around its root of an instance of scale 1, its sway and
-    // any lean or tilt included (w).
-    origin: vec4<f32>,
-    // Where the level of detail is measured from (xyz): the view's camera, or the main
-    // camera for shadow views; the class's shadow distance from it (w; negative: none).
-    eye: vec4<f32>,
-    // Fall-off near, far, 1 when the fade is on, and its floor.
-    falloff: vec4<f32>,
-    // Fade band (x); distance from the eye within which instances are not drawn (y: the
-    // start of an impostor's crossfade; 0 for other chunks) and beyond which they are not
-    // (z: the end of a mesh's crossfade with its impostors; 0 for other chunks).
-    fade: vec4<f32>,
-    // Far thinning: its distance, its floor, 1 when on.
-    thinning: vec4<f32>,
-    // Instances in the chunk, the word of its draw's instance count in the arguments,
-    // workgroups along x.
-    slots: vec4<u32>,
     // The view's clip space from world space: last frame's in the early phase, this
     // frame's in the late one.
     clip_from_world: mat4x4<f32>,
+    // Where the level of detail is measured from: the view's camera, or the main camera
+    // for shadow views; the class's shadow distance from it in a shadow view (negative:
+    // none).
+    eye: vec3<f32>,
+    shadow_distance: f32,
+    // The chunk's corner; the radius around its root of an instance of scale 1, its sway
+    // and any lean or tilt included.
+    origin: vec3<f32>,
+    reach: f32,
+    // The fall-off: near, far, the factor's floor; 1 when on.
+    falloff_near: f32,
+    falloff_far: f32,
+    falloff_floor: f32,
+    falloff_on: u32,
+    // The band of ranks an instance grows over; distance from the eye within which
+    // instances are not drawn (the start of an impostor's crossfade; 0 for other chunks)
+    // and beyond which they are not (the end of a mesh's crossfade with its impostors; 0:
+    // none).
+    fade_band: f32,
+    fade_in_from: f32,
+    fade_out_to: f32,
+    // Far thinning: its distance, its floor, 1 when on.
+    thinning_from: f32,
+    thinning_floor: f32,
+    thinning_on: u32,
+    // Instances in the chunk, the word of its draw's instance count in the arguments,
+    // workgroups along x.
+    instances: u32,
+    count_word: u32,
+    workgroups_x: u32,
     // Occlusion's phase (0: none, 1: early, 2: late), the chunk's first word of marks.
-    occlusion: vec4<u32>,
+    phase: u32,
+    first_mark: u32,
 };
 
 @group(0) @binding(0) var<storage, read> instances: array<u32>;
-@group(0) @binding(1) var<uniform> cull: Cull;
+// A storage buffer, not a uniform: lavapipe compiles a variant of a shader for each set of
+// the uniform values its branches read.
+@group(0) @binding(1) var<storage, read> cull: Cull;
 // The chunk's kept instances in this view (bound at its place in the frame's pool).
 @group(0) @binding(2) var<storage, read_write> kept_instances: array<u32>;
 @group(0) @binding(3) var<storage, read_write> args: array<atomic<u32>>;
@@ -56,14 +73,14 @@ const WORDS: u32 = 6u;
 fn cull_fade() -> Fade {
     return Fade(
         cull.eye.xz,
-        cull.falloff.x,
-        cull.falloff.y,
-        cull.falloff.w,
-        cull.falloff.z != 0.0,
-        cull.fade.x,
-        cull.thinning.x,
-        cull.thinning.y,
-        cull.thinning.z != 0.0,
+        cull.falloff_near,
+        cull.falloff_far,
+        cull.falloff_floor,
+        cull.falloff_on != 0u,
+        cull.fade_band,
+        cull.thinning_from,
+        cull.thinning_floor,
+        cull.thinning_on != 0u,
     );
 }
 
@@ -73,12 +90,13 @@ fn seen(root: vec3<f32>, scale: f32, widen: f32) -> bool {
     if scale <= 0.0 {
         return false;
     }
-    let radius = cull.origin.w * scale * widen;
-    let from_eye = distance(root, cull.eye.xyz);
-    if cull.eye.w >= 0.0 && from_eye - radius > cull.eye.w {
+    let radius = cull.reach * scale * widen;
+    let from_eye = distance(root, cull.eye);
+    if cull.shadow_distance >= 0.0 && from_eye - radius > cull.shadow_distance {
         return false;
     }
-    if from_eye < cull.fade.y || (cull.fade.z > 0.0 && from_eye >= cull.fade.z) {
+    let beyond = cull.fade_out_to > 0.0 && from_eye >= cull.fade_out_to;
+    if from_eye < cull.fade_in_from || beyond {
         return false;
     }
     for (var k = 0u; k < 6u; k++) {
@@ -150,13 +168,13 @@ fn keep(i: u32, count: u32) {
 fn cull_instances(
     @builtin(global_invocation_id) id: vec3<u32>,
 ) {
-    let i = id.x + id.y * cull.slots.z * 64u;
-    if i >= cull.slots.x {
+    let i = id.x + id.y * cull.workgroups_x * 64u;
+    if i >= cull.instances {
         return;
     }
-    let mark = cull.occlusion.y + i / 32u;
+    let mark = cull.first_mark + i / 32u;
     let bit = 1u << (i % 32u);
-    let late = cull.occlusion.x == 2u;
+    let late = cull.phase == 2u;
     if late && (atomicLoad(&marks[mark]) & bit) == 0u {
         return;
     }
@@ -166,7 +184,7 @@ fn cull_instances(
         bitcast<f32>(instances[w + 1u]),
         bitcast<f32>(instances[w + 2u]),
     );
-    let root = cull.origin.xyz + offset;
+    let root = cull.origin + offset;
     // The appearance factor is the high half of the fifth word (the yaw is the low half).
     let appear = f32(instances[w + 4u] >> 16u) / 65535.0;
     let fade = cull_fade();
@@ -175,11 +193,11 @@ fn cull_instances(
     if !seen(root, scale, 1.0 / kept) {
         return;
     }
-    if cull.occlusion.x != 0u && hidden(root, cull.origin.w * scale / kept, cull.clip_from_world) {
+    if cull.phase != 0u && hidden(root, cull.reach * scale / kept, cull.clip_from_world) {
         if !late {
             atomicOr(&marks[mark], bit);
         }
         return;
     }
-    keep(i, cull.slots.y);
+    keep(i, cull.count_word);
 }

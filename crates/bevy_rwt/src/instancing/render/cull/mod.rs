@@ -7,7 +7,7 @@
 //! their count from the arguments ([`CulledDraw`]). The compute work is submitted before
 //! the frame's passes, so every pass of the view (prepasses, main pass, shadow map) reads
 //! what it wrote. A chunk without a culled draw (culling off, the adapter unable, the pool
-//! full) is drawn directly, whole.
+//! full, or nothing culling could drop: [`whole`]) is drawn directly, whole.
 //!
 //! A camera with Bevy's `OcclusionCulling` and `DepthPrepass` also culls what its depth
 //! pyramid hides, in two phases ([`occlusion`]): what last frame's depth hid is tested again
@@ -16,6 +16,7 @@
 mod occlusion;
 #[cfg(test)]
 mod tests;
+mod whole;
 
 pub(in crate::instancing) use occlusion::{cull_late, restore_early};
 
@@ -35,7 +36,7 @@ use bevy::render::mesh::RenderMesh;
 use bevy::render::mesh::allocator::MeshAllocator;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
-    storage_buffer_read_only_sized, storage_buffer_sized, uniform_buffer,
+    storage_buffer_read_only, storage_buffer_read_only_sized, storage_buffer_sized,
 };
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
@@ -52,50 +53,72 @@ pub(super) const ARGS_WORDS: u32 = 5;
 /// Bytes of one instance.
 const INSTANCE_BYTES: u64 = GPU_BYTES_PER_INSTANCE as u64;
 
-/// One dispatch's settings, as `cull.wgsl` reads them.
-#[derive(Clone, Copy, Debug, ShaderType)]
-pub(super) struct CullUniform {
-    /// The view's half-spaces (normal, distance).
-    planes: [Vec4; 6],
-    /// Chunk corner (xyz), reach of an instance of scale 1 (w).
-    origin: Vec4,
-    /// Where the level of detail is measured from (xyz); the shadow distance (w, negative:
-    /// none).
-    eye: Vec4,
-    /// Fall-off near, far, 1 when the fade is on, floor.
-    falloff: Vec4,
-    /// Fade band (x); distance from the eye within which instances are not drawn (y: the
-    /// start of an impostor's crossfade; 0 for other chunks) and beyond which they are not
-    /// (z: the end of a mesh's crossfade with its impostors; 0 for other chunks).
-    fade: Vec4,
-    /// Far thinning: its distance, its floor, 1 when on.
-    thinning: Vec4,
-    /// Instances, the word of the draw's instance count, workgroups along x.
-    slots: UVec4,
+/// One dispatch's settings, as `cull.wgsl` reads them (from a storage buffer): the view's,
+/// then the chunk's.
+#[derive(Clone, Copy, Debug, Default, ShaderType)]
+pub(super) struct CullParams {
+    /// The view's half-spaces (normal, distance; inside where `dot(n, p) + d > 0`).
+    pub planes: [Vec4; 6],
     /// The view's clip space from world space: last frame's (early phase), this frame's
     /// (late phase).
-    clip_from_world: Mat4,
-    /// Occlusion's phase (0: none, 1: early, 2: late), the chunk's first word of marks.
-    occlusion: UVec4,
+    pub clip_from_world: Mat4,
+    /// Where the level of detail is measured from: the view's camera, or the main camera
+    /// for shadow views.
+    pub eye: Vec3,
+    /// In a shadow view, the class's shadow distance from the eye; negative: none.
+    pub shadow_distance: f32,
+    /// The chunk's corner.
+    pub origin: Vec3,
+    /// The radius around its root of an instance of scale 1, its sway and any lean or
+    /// tilt included.
+    pub reach: f32,
+    /// The level of detail's fall-off: near, far, the factor's floor; 1 when on.
+    pub falloff_near: f32,
+    pub falloff_far: f32,
+    pub falloff_floor: f32,
+    pub falloff_on: u32,
+    /// The band of ranks an instance grows over.
+    pub fade_band: f32,
+    /// Distance from the eye within which instances are not drawn (the start of an
+    /// impostor's crossfade; 0 for other chunks).
+    pub fade_in_from: f32,
+    /// Distance from the eye beyond which instances are not drawn (the end of a mesh's
+    /// crossfade with its impostors; 0: none).
+    pub fade_out_to: f32,
+    /// Far thinning: its distance, its floor; 1 when on.
+    pub thinning_from: f32,
+    pub thinning_floor: f32,
+    pub thinning_on: u32,
+    /// Instances in the chunk.
+    pub instances: u32,
+    /// The word of the draw's instance count in the indirect arguments.
+    pub count_word: u32,
+    /// Workgroups along x.
+    pub workgroups_x: u32,
+    /// Occlusion's phase: 0 none, 1 early, 2 late.
+    pub phase: u32,
+    /// The chunk's first word of marks (occlusion).
+    pub first_mark: u32,
 }
 
 #[cfg(any(test, feature = "testing"))]
-impl CullUniform {
+impl CullParams {
     /// Whether `instance` may be seen: `cull.wgsl`'s test, on the CPU.
     pub(super) fn keeps(&self, instance: &GpuInstance) -> bool {
-        let root = self.origin.truncate() + Vec3::from(instance.offset);
+        let root = self.origin + Vec3::from(instance.offset);
         let appear = f32::from(instance.appear) / 65535.0;
         let kept = self.kept_fraction(root);
         let scale = instance.scale * self.growth(root, appear, kept);
         if scale <= 0.0 {
             return false;
         }
-        let radius = self.origin.w * scale / kept;
-        let distance = root.distance(self.eye.truncate());
-        if self.eye.w >= 0.0 && distance - radius > self.eye.w {
+        let radius = self.reach * scale / kept;
+        let distance = root.distance(self.eye);
+        if self.shadow_distance >= 0.0 && distance - radius > self.shadow_distance {
             return false;
         }
-        if distance < self.fade.y || (self.fade.z > 0.0 && distance >= self.fade.z) {
+        let beyond = self.fade_out_to > 0.0 && distance >= self.fade_out_to;
+        if distance < self.fade_in_from || beyond {
             return false;
         }
         self.planes
@@ -105,24 +128,24 @@ impl CullUniform {
 
     /// `cull.wgsl`'s fraction kept by far thinning.
     fn kept_fraction(&self, root: Vec3) -> f32 {
-        if self.thinning.z == 0.0 {
+        if self.thinning_on == 0 {
             return 1.0;
         }
-        let ratio = self.thinning.x / (root.xz() - self.eye.xz()).length().max(1e-3);
-        (ratio * ratio).clamp(self.thinning.y, 1.0)
+        let ratio = self.thinning_from / (root.xz() - self.eye.xz()).length().max(1e-3);
+        (ratio * ratio).clamp(self.thinning_floor, 1.0)
     }
 
     /// `cull.wgsl`'s growth.
     fn growth(&self, root: Vec3, appear: f32, kept: f32) -> f32 {
-        let band = self.fade.x;
+        let band = self.fade_band;
         let thinned = ((kept * (1.0 + band) - appear) / band).clamp(0.0, 1.0);
-        if self.falloff.z == 0.0 {
+        if self.falloff_on == 0 {
             return thinned;
         }
         let distance = (root.xz() - self.eye.xz()).length();
-        let span = (self.falloff.y - self.falloff.x).max(1e-3);
-        let near = (1.0 - (distance - self.falloff.x) / span).clamp(0.0, 1.0);
-        let factor = self.falloff.w.max(near);
+        let span = (self.falloff_far - self.falloff_near).max(1e-3);
+        let near = (1.0 - (distance - self.falloff_near) / span).clamp(0.0, 1.0);
+        let factor = self.falloff_floor.max(near);
         ((factor - appear) / band).clamp(0.0, 1.0) * thinned
     }
 }
@@ -156,7 +179,11 @@ pub(in crate::instancing) struct InstanceCuller {
     /// The pipeline, where the adapter runs compute shaders and indirect draws.
     pipeline: Option<CachedComputePipelineId>,
     layout: BindGroupLayoutDescriptor,
-    uniforms: DynamicUniformBuffer<CullUniform>,
+    /// Each dispatch's settings, read through a dynamic offset. A storage buffer: lavapipe
+    /// specialises a shader on the values of the uniforms its branches read and keeps
+    /// every variant, so a uniform that varies by chunk compiled one per chunk, without
+    /// end.
+    params: DynamicStorageBuffer<CullParams>,
     /// The pool of kept instances.
     kept: Option<Buffer>,
     /// Whether the pool was made this frame and not yet cleared.
@@ -222,7 +249,7 @@ pub(in crate::instancing) fn init_culler(
             ShaderStages::COMPUTE,
             (
                 storage_buffer_read_only_sized(false, None),
-                uniform_buffer::<CullUniform>(true),
+                storage_buffer_read_only::<CullParams>(true),
                 storage_buffer_sized(true, NonZero::new(INSTANCE_BYTES)),
                 storage_buffer_sized(false, None),
                 storage_buffer_sized(false, None),
@@ -242,7 +269,7 @@ pub(in crate::instancing) fn init_culler(
     commands.insert_resource(InstanceCuller {
         pipeline,
         layout,
-        uniforms: DynamicUniformBuffer::default(),
+        params: DynamicStorageBuffer::default(),
         kept: None,
         fresh_pool: false,
         args: None,
@@ -411,7 +438,7 @@ impl InstanceCuller {
                 pass.set_bind_group(1, pyramid, &[]);
                 bound_view = Some(d.view.entity);
             }
-            pass.set_bind_group(0, &chunk.bind_group, &[o.uniform, o.kept as u32]);
+            pass.set_bind_group(0, &chunk.bind_group, &[o.params, o.kept as u32]);
             let (x, y) = workgroups(d.gpu.count);
             pass.dispatch_workgroups(x, y, 1);
         }
@@ -424,7 +451,7 @@ impl InstanceCuller {
             let bytes = u64::from(d.gpu.count) * INSTANCE_BYTES;
             #[cfg(feature = "testing")]
             self.checked.push(super::cull_check::Checked {
-                uniform: uniform(d, &o),
+                params: params(d, &o),
                 instances: d.extracted.buffer.clone(),
                 occludes: o.late.is_some(),
                 kept: o.kept..o.kept + bytes,
@@ -461,10 +488,10 @@ fn workgroups(count: u32) -> (u32, u32) {
     (x, groups.div_ceil(x))
 }
 
-/// Where one dispatch's data lies: its uniform, its kept instances (bytes), its draw; and
+/// Where one dispatch's data lies: its settings, its kept instances (bytes), its draw; and
 /// its late phase's, where it occludes.
 struct Offsets {
-    uniform: u32,
+    params: u32,
     kept: u64,
     draw: u32,
     late: Option<occlusion::LateOffsets>,
@@ -520,6 +547,9 @@ impl CullInputs<'_, '_> {
         pairs
             .into_iter()
             .filter(|(.., gpu)| gpu.count > 0)
+            .filter(|(view, _, extracted, gpu)| {
+                whole::may_drop(view, &extracted.bounds, &gpu.uniform, extracted.shadows)
+            })
             .filter_map(|(view, chunk, extracted, gpu)| {
                 let args = self.args(extracted)?;
                 Some(Dispatch {
@@ -565,7 +595,7 @@ impl InstanceCuller {
             let kept = place(d.gpu.count);
             let late = d.occludes().map(|_| {
                 let late = occlusion::LateOffsets {
-                    uniform: 0,
+                    params: 0,
                     kept: place(d.gpu.count),
                     marks,
                 };
@@ -573,7 +603,7 @@ impl InstanceCuller {
                 late
             });
             offsets.push(Offsets {
-                uniform: 0,
+                params: 0,
                 kept,
                 draw: i as u32,
                 late,
@@ -623,7 +653,7 @@ impl InstanceCuller {
         grow(&mut self.marks, device, marks, "rwt_cull_marks", usage);
     }
 
-    /// Writes the uniforms (their offsets into `offsets`), the arguments (both blocks with
+    /// Writes the settings (their offsets into `offsets`), the arguments (both blocks with
     /// no instances) and the early block with no instances the late phase restores.
     fn write(
         &mut self,
@@ -632,23 +662,24 @@ impl InstanceCuller {
         device: &RenderDevice,
         queue: &RenderQueue,
     ) {
-        self.uniforms.clear();
+        self.params.clear();
         let mut args = Vec::with_capacity(dispatches.len() * ARGS_WORDS as usize);
         let late_block = dispatches.len() as u32 * ARGS_WORDS;
         for (d, o) in dispatches.iter().zip(offsets.iter_mut()) {
-            let early = uniform(d, o);
-            o.uniform = self.uniforms.push(&early);
+            let early = params(d, o);
+            o.params = self.params.push(early);
             if let (Some(late), Some((_, current))) = (o.late.as_mut(), d.occludes()) {
-                late.uniform = self.uniforms.push(&CullUniform {
+                late.params = self.params.push(CullParams {
                     clip_from_world: current,
-                    occlusion: UVec4::new(2, late.marks, 0, 0),
-                    slots: early.slots.with_y(late_block + o.draw * ARGS_WORDS + 1),
+                    phase: 2,
+                    first_mark: late.marks,
+                    count_word: late_block + o.draw * ARGS_WORDS + 1,
                     ..early
                 });
             }
             args.extend_from_slice(&d.args);
         }
-        self.uniforms.write_buffer(device, queue);
+        self.params.write_buffer(device, queue);
         let block: &[u8] = bytemuck::cast_slice(&args);
         if let (Some(buffer), Some(phases)) = (&self.args, &self.phases) {
             queue.write_buffer(buffer, 0, block);
@@ -660,14 +691,16 @@ impl InstanceCuller {
     /// Makes the bind group of each dispatched chunk whose buffers changed; forgets those of
     /// chunks not dispatched.
     fn bind(&mut self, dispatches: &[Dispatch], device: &RenderDevice, cache: &PipelineCache) {
-        let (Some(kept), Some(args), Some(marks), Some(uniforms), Some(uniform)) = (
-            &self.kept,
-            &self.args,
-            &self.marks,
-            self.uniforms.buffer(),
-            self.uniforms.binding(),
-        ) else {
+        let (Some(kept), Some(args), Some(marks), Some(params)) =
+            (&self.kept, &self.args, &self.marks, self.params.buffer())
+        else {
             return;
+        };
+        // One dispatch's settings, at its dynamic offset.
+        let one = BufferBinding {
+            buffer: params,
+            offset: 0,
+            size: Some(CullParams::min_size()),
         };
         let binding = kept_binding(dispatches);
         let layout = cache.get_bind_group_layout(&self.layout);
@@ -678,7 +711,7 @@ impl InstanceCuller {
             }
             let made_with = [
                 d.gpu.instances.id(),
-                uniforms.id(),
+                params.id(),
                 kept.id(),
                 args.id(),
                 marks.id(),
@@ -693,7 +726,7 @@ impl InstanceCuller {
                         &layout,
                         &BindGroupEntries::sequential((
                             d.gpu.instances.as_entire_binding(),
-                            uniform.clone(),
+                            one.clone(),
                             BufferBinding {
                                 buffer: kept,
                                 offset: 0,
@@ -741,32 +774,38 @@ fn grow(
     true
 }
 
-/// The early phase's uniform of one dispatch.
-fn uniform(d: &Dispatch, o: &Offsets) -> CullUniform {
+/// The early phase's settings of one dispatch.
+fn params(d: &Dispatch, o: &Offsets) -> CullParams {
     let u = &d.gpu.uniform;
     let shadow_distance = match (d.view.shadow, d.extracted.shadows) {
         (true, InstancedShadows::Within(distance)) => distance,
         _ => -1.0,
     };
-    let (x, _) = workgroups(d.gpu.count);
-    let (clip_from_world, occlusion) = match (d.occludes(), &o.late) {
-        (Some((previous, _)), Some(late)) => (previous, UVec4::new(1, late.marks, 0, 0)),
-        _ => (Mat4::IDENTITY, UVec4::ZERO),
+    let (clip_from_world, phase, first_mark) = match (d.occludes(), &o.late) {
+        (Some((previous, _)), Some(late)) => (previous, 1, late.marks),
+        _ => (Mat4::IDENTITY, 0, 0),
     };
-    CullUniform {
+    CullParams {
         planes: d.view.planes,
-        origin: u.origin.extend(d.extracted.reach),
-        eye: d.view.eye.extend(shadow_distance),
-        falloff: Vec4::new(
-            u.falloff_near,
-            u.falloff_far,
-            u.falloff_on as f32,
-            u.falloff_floor,
-        ),
-        fade: Vec4::new(u.fade_band, u.fade_in_from, u.fade_out_to, 0.0),
-        thinning: Vec4::new(u.thinning_from, u.thinning_floor, u.thinning_on as f32, 0.0),
-        slots: UVec4::new(d.gpu.count, o.draw * ARGS_WORDS + 1, x, 0),
         clip_from_world,
-        occlusion,
+        eye: d.view.eye,
+        shadow_distance,
+        origin: u.origin,
+        reach: d.extracted.reach,
+        falloff_near: u.falloff_near,
+        falloff_far: u.falloff_far,
+        falloff_floor: u.falloff_floor,
+        falloff_on: u.falloff_on,
+        fade_band: u.fade_band,
+        fade_in_from: u.fade_in_from,
+        fade_out_to: u.fade_out_to,
+        thinning_from: u.thinning_from,
+        thinning_floor: u.thinning_floor,
+        thinning_on: u.thinning_on,
+        instances: d.gpu.count,
+        count_word: o.draw * ARGS_WORDS + 1,
+        workgroups_x: workgroups(d.gpu.count).0,
+        phase,
+        first_mark,
     }
 }

@@ -144,10 +144,10 @@ impl Pyramids {
     }
 }
 
-/// Where one dispatch's late phase lies: its uniform, its kept instances (bytes), its
+/// Where one dispatch's late phase lies: its settings, its kept instances (bytes), its
 /// first word of marks.
 pub(super) struct LateOffsets {
-    pub uniform: u32,
+    pub params: u32,
     pub kept: u64,
     pub marks: u32,
 }
@@ -155,7 +155,7 @@ pub(super) struct LateOffsets {
 /// One chunk's late dispatch.
 struct LateDispatch {
     chunk: Entity,
-    uniform: u32,
+    params: u32,
     kept: u64,
     count: u32,
 }
@@ -178,7 +178,7 @@ impl LateWork {
         self.draws.end = self.draws.end.max(draw + 1);
         self.dispatches.push(LateDispatch {
             chunk,
-            uniform: offsets.uniform,
+            params: offsets.params,
             kept: offsets.kept,
             count,
         });
@@ -239,7 +239,7 @@ pub(in crate::instancing) fn cull_late(
             let Some(chunk) = culler.chunks.get(&d.chunk) else {
                 continue;
             };
-            pass.set_bind_group(0, &chunk.bind_group, &[d.uniform, d.kept as u32]);
+            pass.set_bind_group(0, &chunk.bind_group, &[d.params, d.kept as u32]);
             let (x, y) = workgroups(d.count);
             pass.dispatch_workgroups(x, y, 1);
         }

@@ -8,7 +8,7 @@ use bevy::camera::primitives::Aabb;
 use bevy::shader::Shader;
 
 #[test]
-fn the_cull_shader_validates_and_reads_the_uniform_as_rust_writes_it() {
+fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
     let mut cache = cache_with_fade();
     let id = AssetId::from(Uuid::from_u128(7));
     cache.set_shader(
@@ -19,28 +19,60 @@ fn the_cull_shader_validates_and_reads_the_uniform_as_rust_writes_it() {
         .get(0, id, &[])
         .expect("cull.wgsl composes and validates");
     // Each member's first word marked, then found in encase's bytes.
-    let marked = CullUniform {
-        planes: [Vec4::new(1.0, 0.0, 0.0, 0.0); 6],
-        origin: Vec4::new(2.0, 0.0, 0.0, 0.0),
-        eye: Vec4::new(3.0, 0.0, 0.0, 0.0),
-        falloff: Vec4::new(4.0, 0.0, 0.0, 0.0),
-        fade: Vec4::new(5.0, 0.0, 0.0, 0.0),
-        thinning: Vec4::new(7.0, 0.0, 0.0, 0.0),
-        slots: UVec4::new(6, 0, 0, 0),
-        clip_from_world: Mat4::from_cols_array(&[8.0; 16]),
-        occlusion: UVec4::new(9, 0, 0, 0),
+    let f = |k: u32| 100.0 + k as f32;
+    let marked = CullParams {
+        planes: [Vec4::splat(f(0)); 6],
+        clip_from_world: Mat4::from_cols_array(&[f(1); 16]),
+        eye: Vec3::splat(f(2)),
+        shadow_distance: f(3),
+        origin: Vec3::splat(f(4)),
+        reach: f(5),
+        falloff_near: f(6),
+        falloff_far: f(7),
+        falloff_floor: f(8),
+        falloff_on: 9,
+        fade_band: f(10),
+        fade_in_from: f(11),
+        fade_out_to: f(12),
+        thinning_from: f(13),
+        thinning_floor: f(14),
+        thinning_on: 15,
+        instances: 16,
+        count_word: 17,
+        workgroups_x: 18,
+        phase: 19,
+        first_mark: 20,
     };
-    let markers = [
-        ("planes", 1.0f32.to_bits()),
-        ("origin", 2.0f32.to_bits()),
-        ("eye", 3.0f32.to_bits()),
-        ("falloff", 4.0f32.to_bits()),
-        ("fade", 5.0f32.to_bits()),
-        ("thinning", 7.0f32.to_bits()),
-        ("slots", 6),
-        ("clip_from_world", 8.0f32.to_bits()),
-        ("occlusion", 9),
+    let names = [
+        "planes",
+        "clip_from_world",
+        "eye",
+        "shadow_distance",
+        "origin",
+        "reach",
+        "falloff_near",
+        "falloff_far",
+        "falloff_floor",
+        "falloff_on",
+        "fade_band",
+        "fade_in_from",
+        "fade_out_to",
+        "thinning_from",
+        "thinning_floor",
+        "thinning_on",
+        "instances",
+        "count_word",
+        "workgroups_x",
+        "phase",
+        "first_mark",
     ];
+    let markers: Vec<(&str, u32)> = (0u32..)
+        .zip(names)
+        .map(|(k, n)| {
+            let word = matches!(k, 9 | 15..);
+            (n, if word { k } else { f(k).to_bits() })
+        })
+        .collect();
     assert_eq!(
         struct_layout(&types, "Cull"),
         encase_layout(&marked, &markers)
@@ -68,57 +100,58 @@ fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
         Vec4::W,
         Vec4::W,
     ];
-    let uniform = CullUniform {
+    let params = CullParams {
         planes,
-        origin: Vec4::new(0.0, 0.0, 0.0, 0.5),
-        eye: Vec4::new(0.0, 0.0, 0.0, -1.0),
-        falloff: Vec4::new(10.0, 20.0, 1.0, 0.0),
-        fade: Vec4::new(0.1, 0.0, 0.0, 0.0),
-        thinning: Vec4::ZERO,
-        slots: UVec4::ZERO,
-        clip_from_world: Mat4::IDENTITY,
-        occlusion: UVec4::ZERO,
+        reach: 0.5,
+        shadow_distance: -1.0,
+        falloff_near: 10.0,
+        falloff_far: 20.0,
+        falloff_on: 1,
+        fade_band: 0.1,
+        ..default()
     };
-    assert!(uniform.keeps(&at(Vec3::new(5.0, 0.0, 0.0), 0.5)));
+    assert!(params.keeps(&at(Vec3::new(5.0, 0.0, 0.0), 0.5)));
     // Behind the eye, or beside the view by more than its reach: culled.
-    assert!(!uniform.keeps(&at(Vec3::new(-1.0, 0.0, 0.0), 0.0)));
-    assert!(!uniform.keeps(&at(Vec3::new(3.0, 0.0, 4.0), 0.0)));
+    assert!(!params.keeps(&at(Vec3::new(-1.0, 0.0, 0.0), 0.0)));
+    assert!(!params.keeps(&at(Vec3::new(3.0, 0.0, 4.0), 0.0)));
     // Beside it by less than its reach: kept.
-    assert!(uniform.keeps(&at(Vec3::new(3.0, 0.0, 3.3), 0.0)));
+    assert!(params.keeps(&at(Vec3::new(3.0, 0.0, 3.3), 0.0)));
     // At 15 m the factor is 0.5: the instances of rank above it have not grown.
-    assert!(uniform.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.45)));
-    assert!(!uniform.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.55)));
+    assert!(params.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.45)));
+    assert!(!params.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.55)));
     // Without the fade every rank is drawn.
-    let no_fade = CullUniform {
-        falloff: Vec4::ZERO,
-        ..uniform
+    let no_fade = CullParams {
+        falloff_on: 0,
+        ..params
     };
     assert!(no_fade.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.95)));
     // In a shadow view, beyond the class's shadow distance from the camera: culled.
-    let shadow = CullUniform {
-        eye: Vec4::new(0.0, 0.0, 0.0, 8.0),
+    let shadow = CullParams {
+        shadow_distance: 8.0,
         ..no_fade
     };
     assert!(shadow.keeps(&at(Vec3::new(8.4, 0.0, 0.0), 0.0)));
     assert!(!shadow.keeps(&at(Vec3::new(8.6, 0.0, 0.0), 0.0)));
     // Thinned from 20 m: at 40 m a quarter is kept, the lowest ranks; nearer, all.
-    let thinned = CullUniform {
-        thinning: Vec4::new(20.0, 0.1, 1.0, 0.0),
+    let thinned = CullParams {
+        thinning_from: 20.0,
+        thinning_floor: 0.1,
+        thinning_on: 1,
         ..no_fade
     };
     assert!(thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.2)));
     assert!(!thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.3)));
     assert!(thinned.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.99)));
     // Impostors fading in from 12 m: nearer ones are the meshes' to draw.
-    let impostors = CullUniform {
-        fade: Vec4::new(0.1, 12.0, 0.0, 0.0),
+    let impostors = CullParams {
+        fade_in_from: 12.0,
         ..no_fade
     };
     assert!(!impostors.keeps(&at(Vec3::new(11.9, 0.0, 0.0), 0.0)));
     assert!(impostors.keeps(&at(Vec3::new(12.1, 0.0, 0.0), 0.0)));
     // A class's meshes, gone past the end of their crossfade with its impostors at 14 m.
-    let meshes = CullUniform {
-        fade: Vec4::new(0.1, 0.0, 14.0, 0.0),
+    let meshes = CullParams {
+        fade_out_to: 14.0,
         ..no_fade
     };
     assert!(meshes.keeps(&at(Vec3::new(13.9, 0.0, 0.0), 0.0)));
