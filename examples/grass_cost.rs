@@ -35,13 +35,11 @@ use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass, NormalPrep
 use bevy::prelude::*;
 use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
-use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy_rwt::prelude::*;
 use rwt_examples::forest::{FarTrees, tree_layer};
+use rwt_examples::frame_clock::{FrameClock, FrameClockPlugin};
 use rwt_examples::grass_field::{self, field_layer, nominal_density, set_instanced_shadows};
 use rwt_examples::prelude::*;
-use std::sync::{Arc, Mutex};
-use std::time::Instant;
 
 /// Frames timed once streaming has settled.
 const TIMED: usize = 30;
@@ -113,37 +111,27 @@ fn main() {
         }
     };
     let count: f64 = args.next().and_then(|c| c.parse().ok()).unwrap_or(1.0e6);
-    let clock = Clock::default();
-    let mut app = App::new();
-    app.add_plugins(
-        example_plugins("rwt grass_cost")
-            .build()
-            .disable::<PipelinedRenderingPlugin>(),
-    )
-    .add_plugins(
-        RwtPlugins::default()
-            .with_spawn_budget(200_000)
-            .with_max_tasks(16),
-    )
-    .insert_resource(Field {
-        entities,
-        count,
-        setting: 0,
-        frame_ms: Vec::new(),
-    })
-    .insert_resource(clock.clone())
-    .add_systems(Startup, setup)
-    .add_systems(First, start_frame)
-    .add_systems(Last, (end_main_world, settle).chain());
-    app.sub_app_mut(RenderApp)
-        .insert_resource(clock)
-        .add_systems(
-            Render,
-            end_render_world
-                .after(RenderSystems::PrepareBindGroups)
-                .before(RenderSystems::Render),
-        );
-    app.run();
+    App::new()
+        .add_plugins(
+            example_plugins("rwt grass_cost")
+                .build()
+                .disable::<PipelinedRenderingPlugin>(),
+        )
+        .add_plugins((
+            FrameClockPlugin,
+            RwtPlugins::default()
+                .with_spawn_budget(200_000)
+                .with_max_tasks(16),
+        ))
+        .insert_resource(Field {
+            entities,
+            count,
+            setting: 0,
+            frame_ms: Vec::new(),
+        })
+        .add_systems(Startup, setup)
+        .add_systems(Last, settle)
+        .run();
 }
 
 /// The forests' layer.
@@ -161,22 +149,6 @@ struct Field {
     count: f64,
     setting: usize,
     frame_ms: Vec<f64>,
-}
-
-/// Timestamps shared by the main and render worlds.
-#[derive(Resource, Clone, Default)]
-struct Clock(Arc<Mutex<Timing>>);
-
-#[derive(Default)]
-struct Timing {
-    frame_start: Option<Instant>,
-    main_end: Option<Instant>,
-    /// Whether the current frame is timed.
-    recording: bool,
-    /// Per frame: main world, render world, whole frame (ms).
-    samples: Vec<[f64; 3]>,
-    /// Render-world time of the frame in progress.
-    render_ms: f64,
 }
 
 fn setup(
@@ -216,38 +188,11 @@ fn setup(
     })));
 }
 
-fn start_frame(clock: Res<Clock>) {
-    let mut t = clock.0.lock().unwrap();
-    let now = Instant::now();
-    if t.recording
-        && let (Some(start), Some(end)) = (t.frame_start, t.main_end)
-    {
-        let sample = [
-            (end - start).as_secs_f64() * 1e3,
-            t.render_ms,
-            (now - start).as_secs_f64() * 1e3,
-        ];
-        t.samples.push(sample);
-    }
-    t.frame_start = Some(now);
-}
-
-fn end_main_world(clock: Res<Clock>) {
-    clock.0.lock().unwrap().main_end = Some(Instant::now());
-}
-
-fn end_render_world(clock: Res<Clock>) {
-    let mut t = clock.0.lock().unwrap();
-    if let Some(end) = t.main_end {
-        t.render_ms = end.elapsed().as_secs_f64() * 1e3;
-    }
-}
-
 /// Waits for streaming to settle, warms up for [`WARM_UP`] frames, times [`TIMED`]
 /// frames and prints them; then moves to the next setting, or prints the ratios and exits.
 #[allow(clippy::too_many_arguments)]
 fn settle(
-    clock: Res<Clock>,
+    clock: Res<FrameClock>,
     stats: Res<RwtStats>,
     mut field: ResMut<Field>,
     mut settled_frames: Local<usize>,
@@ -262,27 +207,16 @@ fn settle(
         return;
     }
     *settled_frames += 1;
-    let mut t = clock.0.lock().unwrap();
-    t.recording = *settled_frames > WARM_UP;
-    if t.samples.len() < TIMED {
+    clock.record(*settled_frames > WARM_UP);
+    if clock.recorded() < TIMED {
         return;
     }
-    let column = |i: usize| {
-        let mut v: Vec<f64> = t.samples.iter().map(|s| s[i]).collect();
-        v.sort_by(f64::total_cmp);
-        (v[v.len() / 2], v[v.len() * 95 / 100])
-    };
-    let shown = |(median, p95): (f64, f64)| format!("{median:.2}/{p95:.2}");
+    let times = clock.take();
     println!(
-        "grass-cost: {} live={live} main_ms={} render_world_ms={} frame_ms={}",
+        "grass-cost: {} live={live} {times}",
         describe(field.entities, SETTINGS[field.setting]),
-        shown(column(0)),
-        shown(column(1)),
-        shown(column(2))
     );
-    field.frame_ms.push(column(2).0);
-    t.samples.clear();
-    t.recording = false;
+    field.frame_ms.push(times.frame.median);
     *settled_frames = 0;
     field.setting += 1;
     if field.entities || field.setting == SETTINGS.len() {

@@ -1,8 +1,8 @@
 //! What the examples share: the scripted smoke session that lets CI run each example in a
 //! real renderer ([`smoke`]), a fly camera ([`fly_camera`]), a text HUD ([`hud`]) and the
 //! brush's last answer for it ([`brush_status`]), the field of grass the cost benchmarks
-//! time ([`grass_field`]), and frames captured and compared by the examples that check
-//! themselves ([`frame_check`]).
+//! time ([`grass_field`]) and their frame timing ([`frame_clock`]), and frames captured and
+//! compared by the examples that check themselves ([`frame_check`]).
 //!
 //! Run an example as a user would (`cargo run --release --example open_world`), or as CI
 //! does: `RWT_SCREENSHOT=out.png cargo run --example open_world` plays the example's script,
@@ -13,6 +13,7 @@ pub mod fly_camera;
 pub mod foliage;
 pub mod forest;
 pub mod frame_check;
+pub mod frame_clock;
 pub mod grass_field;
 pub mod hud;
 pub mod smoke;

@@ -2,7 +2,8 @@
 //!
 //! `scripts/gpu_bench.sh` runs it (built on any machine, run on one with a GPU), or
 //! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
-//! [--thin 25] [--forest thinned|impostors] [--shots DIR] [--detail]`; `--shots` saves one
+//! [--thin 25] [--shadow-distance 0] [--forest thinned|impostors] [--shots DIR] [--detail]`;
+//! `--shots` saves one
 //! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
 //! ([`detail`]).
@@ -10,7 +11,9 @@
 //! The scene is [`grass_field`]'s: instanced blades streamed around a camera 2 m above a
 //! field, under a sun with cascaded shadow maps, drawn into an image; the grass thins out
 //! from `--thin` metres (25 by default, as a game sets it; 0: never), see
-//! [`InstancedThinning`]. For each blade count
+//! [`InstancedThinning`]. With shadows on, every blade casts, or with `--shadow-distance`
+//! those within that many metres of the camera (open_world's grass casts within 25 m,
+//! [`InstancedShadows::Within`]). For each blade count
 //! (millions of live blades) with the grass's shadows off, then on, each with culling per
 //! instance on the GPU off, then on ([`InstanceCulling`]), it waits for streaming to settle,
 //! warms up for 2 s, times `--frames` frames and prints exactly one line:
@@ -67,7 +70,7 @@ fn main() {
         Err(message) => {
             eprintln!("gpu_bench: {message}");
             eprintln!(
-                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--forest thinned|impostors] (M: millions)"
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--forest thinned|impostors] (M: millions)"
             );
             std::process::exit(2);
         }
@@ -127,6 +130,8 @@ struct Options {
     detail: bool,
     /// Distance from which the grass thins out (metres; 0: it does not).
     thin: f32,
+    /// Distance from the camera within which blades cast shadows (metres; 0: all do).
+    shadow_distance: f32,
     /// Forests around the field, and how far trees are drawn.
     forest: Option<FarTrees>,
 }
@@ -140,6 +145,7 @@ impl Options {
             shots: None,
             detail: false,
             thin: THIN_FROM,
+            shadow_distance: 0.0,
             forest: None,
         };
         while let Some(flag) = args.next() {
@@ -175,12 +181,17 @@ impl Options {
                     options.size = UVec2::new(side(w).ok_or_else(bad)?, side(h).ok_or_else(bad)?);
                 }
                 "--shots" => options.shots = Some(value.into()),
-                "--thin" => {
-                    options.thin = value
+                "--thin" | "--shadow-distance" => {
+                    let metres = value
                         .parse()
                         .ok()
                         .filter(|m: &f32| (0.0..=1e4).contains(m))
                         .ok_or_else(bad)?;
+                    if flag == "--thin" {
+                        options.thin = metres;
+                    } else {
+                        options.shadow_distance = metres;
+                    }
                 }
                 "--forest" => {
                     options.forest = Some(match value.as_str() {
@@ -278,10 +289,11 @@ impl Bench {
         match (self.case, self.area) {
             (Some(i), Some(area)) => {
                 let case = self.cases[i];
-                let shadows = if case.shadows {
-                    InstancedShadows::On
-                } else {
-                    InstancedShadows::Off
+                let within = self.options.shadow_distance;
+                let shadows = match (case.shadows, within > 0.0) {
+                    (false, _) => InstancedShadows::Off,
+                    (true, false) => InstancedShadows::On,
+                    (true, true) => InstancedShadows::Within(within),
                 };
                 (case.blades / area, shadows)
             }

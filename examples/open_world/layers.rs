@@ -17,6 +17,8 @@ use std::sync::Arc;
 const MAP_TEXELS: u32 = 2048;
 /// Grass and flowers cast shadows this close to the camera (metres).
 const GRASS_SHADOWS: f32 = 25.0;
+/// Grass thins out from this far from the camera (metres).
+const GRASS_THINNING: f32 = 25.0;
 const MAP_SIZE: f32 = 4096.0;
 
 /// Flower colours (petals), one painted map and instanced class each.
@@ -195,6 +197,9 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
             tip_color: Color::srgb(0.33, 0.47, 0.12),
             // Blades cast near the player only: far grass costs nothing in shadow passes.
             shadows: InstancedShadows::Within(GRASS_SHADOWS),
+            // Fewer, wider blades from 25 m: the far field costs vertices as the pixels
+            // it covers (culled per instance, the thinned blades are not drawn at all).
+            thinning: Some(InstancedThinning::from(GRASS_THINNING)),
             ..default()
         },
     );

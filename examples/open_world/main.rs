@@ -16,7 +16,12 @@
 //! - with the brush off, a left click chops the tree under the cursor (a stump stays), H
 //!   places a cabin that clears the ground under it; F5 saves these edits with the maps;
 //! - K walks on foot (a capsule that trunks, stumps and rocks stop; avian3d), K again flies.
+//!
+//! The camera culls what hills, trees and bushes hide (`OcclusionCulling`; `RWT_OCCLUSION=0`
+//! draws it all); `RWT_COST=1` times the scripted view's frame culled so and drawn whole
+//! (`cost`).
 
+mod cost;
 mod gameplay;
 mod layers;
 mod play;
@@ -27,6 +32,8 @@ use bevy::anti_alias::taa::TemporalAntiAliasing;
 use bevy::light::CascadeShadowConfigBuilder;
 use bevy::pbr::{DistanceFog, FogFalloff, ScreenSpaceAmbientOcclusion};
 use bevy::prelude::*;
+use bevy::render::occlusion_culling::OcclusionCulling;
+use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
 use rwt_examples::prelude::*;
@@ -36,11 +43,16 @@ use rwt_examples::terrain::{GROUND_RECENTRE, Terrain, WATER, ground_centre, grou
 const SKY: Color = Color::srgb(0.66, 0.77, 0.88);
 
 fn main() {
+    let mut window = example_plugins("rwt open_world").build();
+    if cost::requested() {
+        // The render world's time is its own only when the worlds run one after the other.
+        window = window.disable::<PipelinedRenderingPlugin>();
+    }
     App::new()
         .insert_resource(ClearColor(SKY))
         .insert_resource(Terrain::new(2006))
         .add_plugins((
-            example_plugins("rwt open_world"),
+            window,
             SmokePlugin,
             HudPlugin,
             FlyCameraPlugin,
@@ -56,6 +68,7 @@ fn main() {
             gameplay::GameplayPlugin,
             walk::WalkPlugin,
             script::ScriptPlugin,
+            cost::CostPlugin,
         ))
         .add_systems(Startup, (setup_scene, layers::setup_layers))
         .add_systems(
@@ -124,6 +137,11 @@ fn setup_scene(
     // TAA and SSAO read the depth, normal and motion-vector prepasses, which the instanced
     // grass takes part in (its sway included), and need MSAA off.
     commands.entity(camera).insert(taa_ssao());
+    // Grass, trees and rocks behind hills are not drawn (the depth prepass TAA and SSAO
+    // need is there anyway); `RWT_OCCLUSION=0` draws them.
+    if std::env::var("RWT_OCCLUSION").map_or(true, |v| v != "0") {
+        commands.entity(camera).insert(OcclusionCulling);
+    }
     commands.spawn((
         DirectionalLight {
             illuminance: 11_000.0,
