@@ -1,0 +1,104 @@
+//! One dispatch's settings, as `cull.wgsl` reads them, and the same test on the CPU (for
+//! the check and the unit tests).
+
+#[cfg(any(test, feature = "testing"))]
+use crate::instancing::GpuInstance;
+use bevy::prelude::*;
+use bevy::render::render_resource::ShaderType;
+
+/// One dispatch's settings, as `cull.wgsl` reads them (from a storage buffer): the view's,
+/// then the chunk's.
+#[derive(Clone, Copy, Debug, Default, ShaderType)]
+pub(in crate::instancing) struct CullParams {
+    /// The view's half-spaces (normal, distance; inside where `dot(n, p) + d > 0`).
+    pub planes: [Vec4; 6],
+    /// The view's clip space from world space: last frame's (early phase), this frame's
+    /// (late phase).
+    pub clip_from_world: Mat4,
+    /// Where the level of detail is measured from: the view's camera, or the main camera
+    /// for shadow views.
+    pub eye: Vec3,
+    /// In a shadow view, the class's shadow distance from the eye; negative: none.
+    pub shadow_distance: f32,
+    /// The chunk's corner.
+    pub origin: Vec3,
+    /// The radius around its root of an instance of scale 1, its sway and any lean or
+    /// tilt included.
+    pub reach: f32,
+    /// The level of detail's fall-off: near, far, the factor's floor; 1 when on.
+    pub falloff_near: f32,
+    pub falloff_far: f32,
+    pub falloff_floor: f32,
+    pub falloff_on: u32,
+    /// The band of ranks an instance grows over.
+    pub fade_band: f32,
+    /// Distance from the eye within which instances are not drawn (the start of an
+    /// impostor's crossfade; 0 for other chunks).
+    pub fade_in_from: f32,
+    /// Distance from the eye beyond which instances are not drawn (the end of a mesh's
+    /// crossfade with its impostors; 0: none).
+    pub fade_out_to: f32,
+    /// Far thinning: its distance, its floor; 1 when on.
+    pub thinning_from: f32,
+    pub thinning_floor: f32,
+    pub thinning_on: u32,
+    /// Instances in the chunk.
+    pub instances: u32,
+    /// The word of the draw's instance count in the indirect arguments.
+    pub count_word: u32,
+    /// Workgroups along x.
+    pub workgroups_x: u32,
+    /// Occlusion's phase: 0 none, 1 early, 2 late.
+    pub phase: u32,
+    /// The chunk's first word of marks (occlusion).
+    pub first_mark: u32,
+}
+
+#[cfg(any(test, feature = "testing"))]
+impl CullParams {
+    /// Whether `instance` may be seen: `cull.wgsl`'s test, on the CPU.
+    pub(in crate::instancing) fn keeps(&self, instance: &GpuInstance) -> bool {
+        let root = self.origin + Vec3::from(instance.offset);
+        let appear = f32::from(instance.appear) / 65535.0;
+        let kept = self.kept_fraction(root);
+        let scale = instance.scale * self.growth(root, appear, kept);
+        if scale <= 0.0 {
+            return false;
+        }
+        let radius = self.reach * scale / kept;
+        let distance = root.distance(self.eye);
+        if self.shadow_distance >= 0.0 && distance - radius > self.shadow_distance {
+            return false;
+        }
+        let beyond = self.fade_out_to > 0.0 && distance >= self.fade_out_to;
+        if distance < self.fade_in_from || beyond {
+            return false;
+        }
+        self.planes
+            .iter()
+            .all(|p| p.truncate().dot(root) + p.w + radius > 0.0)
+    }
+
+    /// `cull.wgsl`'s fraction kept by far thinning.
+    fn kept_fraction(&self, root: Vec3) -> f32 {
+        if self.thinning_on == 0 {
+            return 1.0;
+        }
+        let ratio = self.thinning_from / (root.xz() - self.eye.xz()).length().max(1e-3);
+        (ratio * ratio).clamp(self.thinning_floor, 1.0)
+    }
+
+    /// `cull.wgsl`'s growth.
+    fn growth(&self, root: Vec3, appear: f32, kept: f32) -> f32 {
+        let band = self.fade_band;
+        let thinned = ((kept * (1.0 + band) - appear) / band).clamp(0.0, 1.0);
+        if self.falloff_on == 0 {
+            return thinned;
+        }
+        let distance = (root.xz() - self.eye.xz()).length();
+        let span = (self.falloff_far - self.falloff_near).max(1e-3);
+        let near = (1.0 - (distance - self.falloff_near) / span).clamp(0.0, 1.0);
+        let factor = self.falloff_floor.max(near);
+        ((factor - appear) / band).clamp(0.0, 1.0) * thinned
+    }
+}
