@@ -79,6 +79,19 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
     );
 }
 
+/// The half-spaces of a view looking down +x from the origin: x > 0 and |z| < x (no near
+/// or far plane).
+pub(super) fn looking_down_x() -> [Vec4; 6] {
+    [
+        Vec4::new(1.0, 0.0, 0.0, 0.0),
+        Vec4::new(1.0, 0.0, 1.0, 0.0).normalize(),
+        Vec4::new(1.0, 0.0, -1.0, 0.0).normalize(),
+        Vec4::W,
+        Vec4::W,
+        Vec4::W,
+    ]
+}
+
 /// An instance at `offset` (from the chunk corner) of scale 1.
 fn at(offset: Vec3, appear: f32) -> GpuInstance {
     GpuInstance {
@@ -91,17 +104,8 @@ fn at(offset: Vec3, appear: f32) -> GpuInstance {
 
 #[test]
 fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
-    // A view looking down +x from the origin: half-spaces x > 0 and |z| < x.
-    let planes = [
-        Vec4::new(1.0, 0.0, 0.0, 0.0),
-        Vec4::new(1.0, 0.0, 1.0, 0.0).normalize(),
-        Vec4::new(1.0, 0.0, -1.0, 0.0).normalize(),
-        Vec4::W,
-        Vec4::W,
-        Vec4::W,
-    ];
     let params = CullParams {
-        planes,
+        planes: looking_down_x(),
         reach: 0.5,
         shadow_distance: -1.0,
         falloff_near: 10.0,

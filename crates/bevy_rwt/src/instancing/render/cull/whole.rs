@@ -44,20 +44,14 @@ pub(super) fn may_drop(
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::looking_down_x;
     use super::*;
 
     /// A camera at the origin looking down +x (x > 0, |z| < x, no far plane).
     fn view() -> ViewCull {
         ViewCull {
             entity: Entity::PLACEHOLDER,
-            planes: [
-                Vec4::new(1.0, 0.0, 0.0, 0.0),
-                Vec4::new(1.0, 0.0, 1.0, 0.0).normalize(),
-                Vec4::new(1.0, 0.0, -1.0, 0.0).normalize(),
-                Vec4::W,
-                Vec4::W,
-                Vec4::W,
-            ],
+            planes: looking_down_x(),
             eye: Vec3::ZERO,
             shadow: false,
             occluding: None,
