@@ -96,6 +96,7 @@ fn build_render(app: &mut App) {
         .init_resource::<SpecializedMeshPipelines<render::InstancedDepthPipeline>>()
         .init_resource::<render::ReportedMeshes>()
         .init_resource::<render::MainViewer>()
+        .init_resource::<render::InstanceSlab>()
         .init_resource::<render::Queued<Opaque3d>>()
         .init_resource::<render::Queued<Opaque3dPrepass>>()
         .init_resource::<render::Queued<Shadow>>()

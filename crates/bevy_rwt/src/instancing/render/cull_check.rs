@@ -3,7 +3,7 @@
 //! for every culled draw, the instances it draws with those the same test keeps on the CPU
 //! ([`CullingCheck`]).
 
-use super::cull::{ARGS_WORDS, CullParams, InstanceCuller};
+use super::cull::{ARGS_WORDS, CullRecord, CullView, InstanceCuller};
 use crate::instancing::InstanceBuffer;
 use bevy::prelude::*;
 use bevy::render::Extract;
@@ -87,10 +87,11 @@ pub(in crate::instancing) fn extract_culling_check(
     frame.requested = frame.check.as_ref().is_some_and(CullingCheck::take_request);
 }
 
-/// One culled draw as the check sees it: the dispatch's settings, the chunk's instances,
-/// whether its view occludes.
+/// One culled draw as the check sees it: its view's early dispatch, its record, the chunk's
+/// instances, whether its view occludes.
 pub(super) struct Checked {
-    pub params: CullParams,
+    pub view: CullView,
+    pub record: CullRecord,
     pub instances: Arc<InstanceBuffer>,
     pub occludes: bool,
     /// The byte ranges of the pool its early and late phases keep into.
@@ -145,7 +146,7 @@ pub(in crate::instancing) fn check_culling(
             .instances
             .instances
             .iter()
-            .filter(|g| c.params.keeps(g))
+            .filter(|g| c.record.keeps(&c.view, g))
             .map(|g| bytemuck::cast(*g))
             .collect();
         gpu.sort_unstable();

@@ -1,7 +1,7 @@
 //! The draw of one chunk: its bind group, its mesh once per instance: the instances culling
 //! kept for the view, drawn indirectly, or all of them.
 
-use super::{ExtractedChunk, GpuChunk, InstanceCuller};
+use super::{ExtractedChunk, GpuChunk, InstanceCuller, InstanceSlab};
 use bevy::ecs::system::{SystemParamItem, lifetimeless::*};
 use bevy::pbr::{SetMeshViewBindGroup, SetMeshViewBindingArrayBindGroup};
 use bevy::prelude::{AssetId, Entity, Mesh};
@@ -53,6 +53,7 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
     type Param = (
         SRes<RenderAssets<RenderMesh>>,
         SRes<MeshAllocator>,
+        SRes<InstanceSlab>,
         Option<SRes<InstanceCuller>>,
     );
     type ViewQuery = Entity;
@@ -62,7 +63,7 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
         item_of: &P,
         view: Entity,
         item: Option<(&'w ExtractedChunk, &'w GpuChunk)>,
-        (meshes, allocator, culler): SystemParamItem<'w, '_, Self::Param>,
+        (meshes, allocator, slab, culler): SystemParamItem<'w, '_, Self::Param>,
         pass: &mut TrackedRenderPass<'w>,
     ) -> RenderCommandResult {
         let (meshes, allocator) = (meshes.into_inner(), allocator.into_inner());
@@ -89,13 +90,20 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
                     }
                 }
             }
-            (None, true) => {
-                pass.set_vertex_buffer(1, gpu.instances.slice(..));
-                pass.draw_indexed(first..first + count, base as i32, 0..gpu.count);
-            }
-            (None, false) => {
-                pass.set_vertex_buffer(1, gpu.instances.slice(..));
-                pass.draw(first..first + count, 0..gpu.count);
+            (None, indexed) => {
+                let instances = match &gpu.own {
+                    Some(own) => own.slice(..),
+                    None => match slab.into_inner().slice(item_of.entity()) {
+                        Some((buffer, bytes)) => buffer.slice(bytes),
+                        None => return RenderCommandResult::Skip,
+                    },
+                };
+                pass.set_vertex_buffer(1, instances);
+                if indexed {
+                    pass.draw_indexed(first..first + count, base as i32, 0..gpu.count);
+                } else {
+                    pass.draw(first..first + count, 0..gpu.count);
+                }
             }
         }
         RenderCommandResult::Success

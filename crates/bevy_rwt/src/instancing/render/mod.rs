@@ -18,6 +18,7 @@ mod main_pass;
 mod retained;
 #[cfg(test)]
 mod shader_check;
+mod slab;
 mod uniforms;
 
 pub(super) use cull::{InstanceCuller, cull_instances, cull_late, init_culler, restore_early};
@@ -32,6 +33,7 @@ pub(super) use draw::DrawInstancedChunk;
 pub(super) use main_pass::{InstancedPipeline, init_main_pipeline, queue_main};
 use retained::BinnedChunk;
 pub(super) use retained::Queued;
+pub(super) use slab::InstanceSlab;
 use uniforms::{ChunkUniform, FrameUniform, uniform_bytes};
 
 use super::bend::{BEND_FIELD_TEXELS, BendField};
@@ -204,7 +206,9 @@ impl ExtractResource for InstanceCulling {
 pub(super) struct GpuChunk {
     /// The main world's buffer these were made from.
     source: Arc<InstanceBuffer>,
-    instances: Buffer,
+    /// The instances' own buffer, where [`InstanceSlab`] could not hold them (then drawn
+    /// whole, never culled per instance); `None`: in the slab.
+    own: Option<Buffer>,
     count: u32,
     uniform: ChunkUniform,
     uniform_buffer: Buffer,
@@ -404,9 +408,11 @@ pub(super) fn prepare_chunks(
     textures: ChunkTextures,
     wind: Option<Res<RwtWind>>,
     fade: Option<Res<RwtFadeIn>>,
+    mut slab: ResMut<InstanceSlab>,
 ) {
     let wind = wind.map(|w| *w).unwrap_or_default();
     let fade = fade.map(|f| *f).unwrap_or_default();
+    slab.keep_only(|e| chunks.contains(e));
     for (entity, chunk, gpu) in &mut chunks {
         let mut uniform = chunk.uniform;
         uniform.wind_direction = wind.direction;
@@ -418,7 +424,10 @@ pub(super) fn prepare_chunks(
         }
         let texture = textures.of(chunk);
         match gpu {
-            Some(mut gpu) if Arc::ptr_eq(&gpu.source, &chunk.buffer) => {
+            Some(mut gpu)
+                if Arc::ptr_eq(&gpu.source, &chunk.buffer)
+                    && (gpu.own.is_some() || slab.range(entity).is_some()) =>
+            {
                 if gpu.uniform != uniform {
                     queue.write_buffer(&gpu.uniform_buffer, 0, &uniform_bytes(&uniform));
                     gpu.uniform = uniform;
@@ -430,27 +439,34 @@ pub(super) fn prepare_chunks(
                 }
             }
             _ => {
-                let gpu = upload(&device, &bindings, &cache, (chunk, uniform), texture);
+                let own = (!slab.place(entity, &chunk.buffer.instances, &device, &queue))
+                    .then(|| own_buffer(&device, chunk));
+                let gpu = upload(&device, &bindings, &cache, (chunk, uniform), texture, own);
                 commands.entity(entity).insert(gpu);
             }
         }
     }
 }
 
-/// The GPU resources of one chunk.
+/// A buffer of `chunk`'s instances alone, where the slab cannot hold them.
+fn own_buffer(device: &RenderDevice, chunk: &ExtractedChunk) -> Buffer {
+    device.create_buffer_with_data(&BufferInitDescriptor {
+        label: Some("rwt_instances"),
+        contents: bytemuck::cast_slice(&chunk.buffer.instances),
+        usage: BufferUsages::VERTEX,
+    })
+}
+
+/// The GPU resources of one chunk, its instances placed already (`own`: in a buffer of
+/// their own).
 fn upload(
     device: &RenderDevice,
     bindings: &ChunkBindings,
     cache: &PipelineCache,
     (chunk, uniform): (&ExtractedChunk, ChunkUniform),
     texture: &GpuImage,
+    own: Option<Buffer>,
 ) -> GpuChunk {
-    let instances = device.create_buffer_with_data(&BufferInitDescriptor {
-        label: Some("rwt_instances"),
-        contents: bytemuck::cast_slice(&chunk.buffer.instances),
-        // Read as a storage buffer by culling per instance.
-        usage: BufferUsages::VERTEX | BufferUsages::STORAGE,
-    });
     let uniform_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
         label: Some("rwt_instanced_chunk"),
         contents: &uniform_bytes(&uniform),
@@ -458,7 +474,7 @@ fn upload(
     });
     GpuChunk {
         source: chunk.buffer.clone(),
-        instances,
+        own,
         count: chunk.buffer.instances.len() as u32,
         uniform,
         bind_group: bind_chunk(device, bindings, cache, &uniform_buffer, texture),

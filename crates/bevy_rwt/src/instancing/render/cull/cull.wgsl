@@ -1,6 +1,8 @@
-// Culling per instance: one dispatch per (view, chunk) the CPU kept. Each invocation tests
-// one instance against the view and, when it may be seen, copies it into the view's kept
-// instances and counts it in the chunk's indirect draw arguments.
+// Culling per instance: one dispatch per view, over every chunk the CPU kept in it (a
+// record each, their instances in one slab). Each workgroup finds its record; each
+// invocation tests one instance against the view and, when it may be seen, copies it into
+// the chunk's kept instances in the view and counts it in the chunk's indirect draw
+// arguments.
 //
 // Occlusion takes two phases in a camera with a depth pyramid. The early phase (before the
 // frame's passes) also tests each instance against last frame's pyramid, seen from last
@@ -11,22 +13,33 @@
 
 #import rwt::fade::{Fade, kept_fraction, growth}
 
-// One dispatch's settings (`CullParams`): the view's, then the chunk's.
-struct Cull {
+// The view's dispatch (`CullView`).
+struct View {
     // The view's half-spaces (normal, distance; inside where dot(n, p) + d > 0).
     planes: array<vec4<f32>, 6>,
     // The view's clip space from world space: last frame's in the early phase, this
     // frame's in the late one.
     clip_from_world: mat4x4<f32>,
     // Where the level of detail is measured from: the view's camera, or the main camera
-    // for shadow views; the class's shadow distance from it in a shadow view (negative:
-    // none).
+    // for shadow views.
     eye: vec3<f32>,
-    shadow_distance: f32,
+    // Occlusion's phase (0: none, 1: early, 2: late).
+    phase: u32,
+    // The view's first record and how many it has; its workgroups, and how many along x.
+    first_record: u32,
+    records: u32,
+    workgroups: u32,
+    workgroups_x: u32,
+};
+
+// One chunk in the view (`CullRecord`).
+struct Record {
     // The chunk's corner; the radius around its root of an instance of scale 1, its sway
     // and any lean or tilt included.
     origin: vec3<f32>,
     reach: f32,
+    // The class's shadow distance from the eye in a shadow view (negative: none).
+    shadow_distance: f32,
     // The fall-off: near, far, the factor's floor; 1 when on.
     falloff_near: f32,
     falloff_far: f32,
@@ -43,25 +56,32 @@ struct Cull {
     thinning_from: f32,
     thinning_floor: f32,
     thinning_on: u32,
-    // Instances in the chunk, the word of its draw's instance count in the arguments,
-    // workgroups along x.
+    // Instances in the chunk, the first in the slab; the view's first workgroup testing it.
     instances: u32,
+    first_instance: u32,
+    first_workgroup: u32,
+    // Where its kept instances go (instances into the view's binding of the pool) and the
+    // word of the draw's instance count: in the early phase, in the late one.
+    kept: u32,
+    late_kept: u32,
     count_word: u32,
-    workgroups_x: u32,
-    // Occlusion's phase (0: none, 1: early, 2: late), the chunk's first word of marks.
-    phase: u32,
+    late_count_word: u32,
+    // The chunk's first word of marks.
     first_mark: u32,
 };
 
+// Every chunk's instances.
 @group(0) @binding(0) var<storage, read> instances: array<u32>;
-// A storage buffer, not a uniform: lavapipe compiles a variant of a shader for each set of
+// Every view's records, each view's in the order of their first workgroups.
+@group(0) @binding(1) var<storage, read> records: array<Record>;
+// Storage buffers, not uniforms: lavapipe compiles a variant of a shader for each set of
 // the uniform values its branches read.
-@group(0) @binding(1) var<storage, read> cull: Cull;
-// The chunk's kept instances in this view (bound at its place in the frame's pool).
-@group(0) @binding(2) var<storage, read_write> kept_instances: array<u32>;
-@group(0) @binding(3) var<storage, read_write> args: array<atomic<u32>>;
+@group(0) @binding(2) var<storage, read> view: View;
+// The view's kept instances (bound at its place in the frame's pool).
+@group(0) @binding(3) var<storage, read_write> kept_instances: array<u32>;
+@group(0) @binding(4) var<storage, read_write> args: array<atomic<u32>>;
 // One bit per instance: hidden in the early phase, to be tested again in the late one.
-@group(0) @binding(4) var<storage, read_write> marks: array<atomic<u32>>;
+@group(0) @binding(5) var<storage, read_write> marks: array<atomic<u32>>;
 // The view's depth pyramid (reversed depth, each texel the farthest of those it covers).
 @group(1) @binding(0) var pyramid: texture_2d<f32>;
 
@@ -69,38 +89,57 @@ struct Cull {
 // tilt).
 const WORDS: u32 = 6u;
 
+// The workgroup's record, found by its first invocation.
+var<workgroup> workgroup_record: u32;
+
+// The record of the view's workgroup `group`: the last whose first workgroup is not after
+// it.
+fn record_of(group: u32) -> u32 {
+    var lo = view.first_record;
+    var hi = view.first_record + view.records;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if records[mid].first_workgroup <= group {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
 // The chunk's level of detail, seen from the view's eye.
-fn cull_fade() -> Fade {
+fn cull_fade(r: Record) -> Fade {
     return Fade(
-        cull.eye.xz,
-        cull.falloff_near,
-        cull.falloff_far,
-        cull.falloff_floor,
-        cull.falloff_on != 0u,
-        cull.fade_band,
-        cull.thinning_from,
-        cull.thinning_floor,
-        cull.thinning_on != 0u,
+        view.eye.xz,
+        r.falloff_near,
+        r.falloff_far,
+        r.falloff_floor,
+        r.falloff_on != 0u,
+        r.fade_band,
+        r.thinning_from,
+        r.thinning_floor,
+        r.thinning_on != 0u,
     );
 }
 
 // Whether the instance may be seen: grown, within the shadow distance, and its sphere
 // (widened as thinning widens it) inside or across every half-space.
-fn seen(root: vec3<f32>, scale: f32, widen: f32) -> bool {
+fn seen(r: Record, root: vec3<f32>, scale: f32, widen: f32) -> bool {
     if scale <= 0.0 {
         return false;
     }
-    let radius = cull.reach * scale * widen;
-    let from_eye = distance(root, cull.eye);
-    if cull.shadow_distance >= 0.0 && from_eye - radius > cull.shadow_distance {
+    let radius = r.reach * scale * widen;
+    let from_eye = distance(root, view.eye);
+    if r.shadow_distance >= 0.0 && from_eye - radius > r.shadow_distance {
         return false;
     }
-    let beyond = cull.fade_out_to > 0.0 && from_eye >= cull.fade_out_to;
-    if from_eye < cull.fade_in_from || beyond {
+    let beyond = r.fade_out_to > 0.0 && from_eye >= r.fade_out_to;
+    if from_eye < r.fade_in_from || beyond {
         return false;
     }
     for (var k = 0u; k < 6u; k++) {
-        let plane = cull.planes[k];
+        let plane = view.planes[k];
         if dot(plane.xyz, root) + plane.w + radius <= 0.0 {
             return false;
         }
@@ -155,10 +194,11 @@ fn hidden(center: vec3<f32>, radius: f32, clip_from_world: mat4x4<f32>) -> bool 
     return nearest < far;
 }
 
-// Copies instance `i` into the kept instances, counted in the arguments' word `count`.
-fn keep(i: u32, count: u32) {
-    let w = i * WORDS;
-    let to = atomicAdd(&args[count], 1u) * WORDS;
+// Copies the slab's instance `at` into the view's kept instances at `first` (instances),
+// counted in the arguments' word `count`.
+fn keep(at: u32, first: u32, count: u32) {
+    let w = at * WORDS;
+    let to = (first + atomicAdd(&args[count], 1u)) * WORDS;
     for (var k = 0u; k < WORDS; k++) {
         kept_instances[to + k] = instances[w + k];
     }
@@ -166,38 +206,53 @@ fn keep(i: u32, count: u32) {
 
 @compute @workgroup_size(64)
 fn cull_instances(
-    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(workgroup_id) workgroup: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
 ) {
-    let i = id.x + id.y * cull.workgroups_x * 64u;
-    if i >= cull.instances {
+    let group = workgroup.x + workgroup.y * view.workgroups_x;
+    if lane == 0u && group < view.workgroups {
+        workgroup_record = record_of(group);
+    }
+    let record = workgroupUniformLoad(&workgroup_record);
+    if group >= view.workgroups {
         return;
     }
-    let mark = cull.first_mark + i / 32u;
+    let r = records[record];
+    let i = (group - r.first_workgroup) * 64u + lane;
+    if i >= r.instances {
+        return;
+    }
+    let mark = r.first_mark + i / 32u;
     let bit = 1u << (i % 32u);
-    let late = cull.phase == 2u;
+    let late = view.phase == 2u;
     if late && (atomicLoad(&marks[mark]) & bit) == 0u {
         return;
     }
-    let w = i * WORDS;
+    let at = r.first_instance + i;
+    let w = at * WORDS;
     let offset = vec3<f32>(
         bitcast<f32>(instances[w]),
         bitcast<f32>(instances[w + 1u]),
         bitcast<f32>(instances[w + 2u]),
     );
-    let root = cull.origin + offset;
+    let root = r.origin + offset;
     // The appearance factor is the high half of the fifth word (the yaw is the low half).
     let appear = f32(instances[w + 4u] >> 16u) / 65535.0;
-    let fade = cull_fade();
+    let fade = cull_fade(r);
     let kept = kept_fraction(fade, root);
     let scale = bitcast<f32>(instances[w + 3u]) * growth(fade, root, appear, kept);
-    if !seen(root, scale, 1.0 / kept) {
+    if !seen(r, root, scale, 1.0 / kept) {
         return;
     }
-    if cull.phase != 0u && hidden(root, cull.reach * scale / kept, cull.clip_from_world) {
+    if view.phase != 0u && hidden(root, r.reach * scale / kept, view.clip_from_world) {
         if !late {
             atomicOr(&marks[mark], bit);
         }
         return;
     }
-    keep(i, cull.count_word);
+    if late {
+        keep(at, r.late_kept, r.late_count_word);
+    } else {
+        keep(at, r.kept, r.count_word);
+    }
 }

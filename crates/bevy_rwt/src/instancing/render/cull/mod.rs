@@ -1,8 +1,9 @@
 //! Culling per instance on the GPU ([`InstanceCulling`]).
 //!
-//! After queueing, each (view, chunk) binned into any of the view's phases gets one compute
-//! dispatch (`cull.wgsl`): each instance is tested against the view and, when it may be
-//! seen, copied into the frame's pool of kept instances, and counted in the draw's indirect
+//! After queueing, each view gets one compute dispatch (`cull.wgsl`) over a record of each
+//! chunk binned into any of its phases ([`CullRecord`]), the chunks' instances all in one
+//! buffer ([`InstanceSlab`]): each instance is tested against the view and, when it may be
+//! seen, copied into the frame's pool of kept instances, and counted in its draw's indirect
 //! arguments. The chunk's draws in that view then read their instances from the pool and
 //! their count from the arguments ([`CulledDraw`]). The compute work is submitted before
 //! the frame's passes, so every pass of the view (prepasses, main pass, shadow map) reads
@@ -13,21 +14,22 @@
 //! pyramid hides, in two phases ([`occlusion`]): what last frame's depth hid is tested again
 //! once this frame's early depth is reduced, and drawn from the late prepass on.
 
+mod layout;
 mod occlusion;
 mod params;
 #[cfg(test)]
 mod tests;
 mod whole;
 
+use layout::{Offsets, Plan, ViewWork};
 pub(in crate::instancing) use occlusion::{cull_late, restore_early};
-pub(super) use params::CullParams;
+pub(super) use params::{CullRecord, CullView};
 
 use super::draw::MeshSlices;
-use super::{ExtractedChunk, GpuChunk, MainViewer, Queued};
+use super::{ExtractedChunk, GpuChunk, InstanceSlab, MainViewer, Queued};
 #[cfg(test)]
 use crate::instancing::GpuInstance;
 use crate::instancing::{GPU_BYTES_PER_INSTANCE, InstanceCulling};
-use crate::look::InstancedShadows;
 use bevy::camera::primitives::Frustum;
 use bevy::core_pipeline::core_3d::Opaque3d;
 use bevy::core_pipeline::prepass::Opaque3dPrepass;
@@ -71,10 +73,10 @@ pub(in crate::instancing) struct CulledDraw {
     pub late: Option<CulledRange>,
 }
 
-/// A chunk's cull bind group, and the buffers it was made with.
-struct ChunkCull {
-    made_with: [BufferId; 5],
-    kept_binding: u64,
+/// The frame's cull bind group, and the buffers it was made with.
+struct FrameBind {
+    made_with: [BufferId; 6],
+    pool_binding: u64,
     bind_group: BindGroup,
 }
 
@@ -84,11 +86,13 @@ pub(in crate::instancing) struct InstanceCuller {
     /// The pipeline, where the adapter runs compute shaders and indirect draws.
     pipeline: Option<CachedComputePipelineId>,
     layout: BindGroupLayoutDescriptor,
-    /// Each dispatch's settings, read through a dynamic offset. A storage buffer: lavapipe
-    /// specialises a shader on the values of the uniforms its branches read and keeps
-    /// every variant, so a uniform that varies by chunk compiled one per chunk, without
-    /// end.
-    params: DynamicStorageBuffer<CullParams>,
+    /// Each view's dispatches (early, late), read through a dynamic offset. A storage
+    /// buffer: lavapipe specialises a shader on the values of the uniforms its branches
+    /// read and keeps every variant, so a uniform that varies by dispatch compiled one per
+    /// dispatch, without end.
+    views: DynamicStorageBuffer<CullView>,
+    /// Every view's records, a view's together.
+    records: StorageBuffer<Vec<CullRecord>>,
     /// The pool of kept instances.
     kept: Option<Buffer>,
     /// Whether the pool was made this frame and not yet cleared.
@@ -102,9 +106,11 @@ pub(in crate::instancing) struct InstanceCuller {
     phases: Option<Buffer>,
     /// The pyramids views occlude with.
     pyramids: occlusion::Pyramids,
-    chunks: HashMap<Entity, ChunkCull>,
+    bind: Option<FrameBind>,
     /// This frame's culled draws, by (view, chunk) render entity.
     draws: HashMap<(Entity, Entity), CulledDraw>,
+    /// This frame's early phase, a dispatch per view.
+    early: Vec<ViewWork>,
     /// This frame's late phase, by view.
     late: HashMap<Entity, occlusion::LateWork>,
     /// This frame's draws (records in each block of the arguments).
@@ -154,7 +160,8 @@ pub(in crate::instancing) fn init_culler(
             ShaderStages::COMPUTE,
             (
                 storage_buffer_read_only_sized(false, None),
-                storage_buffer_read_only::<CullParams>(true),
+                storage_buffer_read_only_sized(false, None),
+                storage_buffer_read_only::<CullView>(true),
                 storage_buffer_sized(true, NonZero::new(INSTANCE_BYTES)),
                 storage_buffer_sized(false, None),
                 storage_buffer_sized(false, None),
@@ -174,15 +181,17 @@ pub(in crate::instancing) fn init_culler(
     commands.insert_resource(InstanceCuller {
         pipeline,
         layout,
-        params: DynamicStorageBuffer::default(),
+        views: DynamicStorageBuffer::default(),
+        records: StorageBuffer::default(),
         kept: None,
         fresh_pool: false,
         args: None,
         marks: None,
         phases: None,
         pyramids,
-        chunks: HashMap::default(),
+        bind: None,
         draws: HashMap::default(),
+        early: Vec::new(),
         late: HashMap::default(),
         draw_count: 0,
         #[cfg(feature = "testing")]
@@ -198,8 +207,8 @@ fn culls_on(device: &RenderDevice, adapter: &RenderAdapter) -> bool {
     flags.contains(DownlevelFlags::COMPUTE_SHADERS | DownlevelFlags::INDIRECT_EXECUTION)
         && limits.max_compute_workgroup_size_x >= WORKGROUP
         && limits.max_compute_invocations_per_workgroup >= WORKGROUP
-        && limits.max_storage_buffers_per_shader_stage >= 4
-        && limits.max_dynamic_storage_buffers_per_pipeline_layout >= 1
+        && limits.max_storage_buffers_per_shader_stage >= 6
+        && limits.max_dynamic_storage_buffers_per_pipeline_layout >= 2
 }
 
 /// How each view culls: its half-spaces, where its level of detail is measured from, and
@@ -213,12 +222,14 @@ struct ViewCull {
     occluding: Option<occlusion::Occluding>,
 }
 
-/// One dispatch: a chunk in a view.
+/// One chunk in a view (a record of the view's dispatch).
 struct Dispatch<'a> {
     view: ViewCull,
     chunk: Entity,
     extracted: &'a ExtractedChunk,
     gpu: &'a GpuChunk,
+    /// The chunk's first instance in the slab.
+    first_instance: u32,
     /// The draw's arguments before culling (the instance count 0).
     args: [u32; ARGS_WORDS as usize],
 }
@@ -262,6 +273,7 @@ pub(in crate::instancing) struct CullInputs<'w, 's> {
     meshes: Res<'w, RenderAssets<RenderMesh>>,
     allocator: Res<'w, MeshAllocator>,
     viewer: Res<'w, MainViewer>,
+    slab: Res<'w, InstanceSlab>,
 }
 
 /// Culls the instances of every chunk binned into every view, and submits the work before
@@ -274,6 +286,7 @@ pub(in crate::instancing) fn cull_instances(
     cache: Res<PipelineCache>,
 ) {
     culler.draws.clear();
+    culler.early.clear();
     culler.late.clear();
     #[cfg(feature = "testing")]
     culler.checked.clear();
@@ -294,11 +307,14 @@ pub(in crate::instancing) fn cull_instances(
     if dispatches.is_empty() {
         return;
     }
-    let Some(mut offsets) = culler.lay_out(&dispatches, &device) else {
+    let Some(slab) = inputs.slab.buffer() else {
         return;
     };
-    culler.write(&dispatches, &mut offsets, &device, &queue);
-    culler.bind(&dispatches, &device, &cache);
+    let Some(mut plan) = culler.lay_out(&dispatches, &device) else {
+        return;
+    };
+    culler.write(&dispatches, &mut plan, &device, &queue);
+    culler.bind(slab, plan.pool_binding, &device, &cache);
     let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor {
         label: Some("rwt_cull"),
     });
@@ -312,73 +328,59 @@ pub(in crate::instancing) fn cull_instances(
         encoder.clear_buffer(kept, 0, None);
         culler.fresh_pool = false;
     }
-    culler.dispatch_early(&mut encoder, pipeline, &dispatches, &offsets);
+    culler.early = plan.early;
+    culler.dispatch_early(&mut encoder, pipeline);
     queue.submit([encoder.finish()]);
-    culler.record(&dispatches, offsets);
+    culler.record(&dispatches, &plan.offsets, &plan.records);
 }
 
 impl InstanceCuller {
-    /// Encodes the early phase (the only one, where the view does not occlude).
-    fn dispatch_early(
-        &self,
-        encoder: &mut CommandEncoder,
-        pipeline: &ComputePipeline,
-        dispatches: &[Dispatch],
-        offsets: &[Offsets],
-    ) {
+    /// Encodes the early phase (the only one, where the view does not occlude): one
+    /// dispatch per view.
+    fn dispatch_early(&self, encoder: &mut CommandEncoder, pipeline: &ComputePipeline) {
+        let Some(bind) = &self.bind else { return };
         let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor {
             label: Some("rwt_cull"),
             timestamp_writes: None,
         });
         pass.set_pipeline(pipeline);
-        let mut bound_view = None;
-        for (d, o) in dispatches.iter().zip(offsets) {
-            let (Some(chunk), Some(pyramid)) = (
-                self.chunks.get(&d.chunk),
-                self.pyramids.bind_group(d.view.entity),
-            ) else {
+        for view in &self.early {
+            let Some(pyramid) = self.pyramids.bind_group(view.entity) else {
                 continue;
             };
-            if bound_view != Some(d.view.entity) {
-                pass.set_bind_group(1, pyramid, &[]);
-                bound_view = Some(d.view.entity);
-            }
-            pass.set_bind_group(0, &chunk.bind_group, &[o.params, o.kept as u32]);
-            let (x, y) = workgroups(d.gpu.count);
+            pass.set_bind_group(1, pyramid, &[]);
+            pass.set_bind_group(0, &bind.bind_group, &[view.params, view.pool as u32]);
+            let (x, y) = grid(view.workgroups);
             pass.dispatch_workgroups(x, y, 1);
         }
     }
 
     /// Records this frame's culled draws and each occluding view's late phase.
-    fn record(&mut self, dispatches: &[Dispatch], offsets: Vec<Offsets>) {
+    fn record(&mut self, dispatches: &[Dispatch], offsets: &[Offsets], records: &[CullRecord]) {
         self.draw_count = dispatches.len() as u32;
-        for (d, o) in dispatches.iter().zip(offsets) {
-            let bytes = u64::from(d.gpu.count) * INSTANCE_BYTES;
-            #[cfg(feature = "testing")]
+        let bytes = |d: &Dispatch| u64::from(d.gpu.count) * INSTANCE_BYTES;
+        #[cfg(feature = "testing")]
+        for ((d, o), record) in dispatches.iter().zip(offsets).zip(records) {
+            let view = self.early.iter().find(|v| v.entity == d.view.entity);
             self.checked.push(super::cull_check::Checked {
-                params: params(d, &o),
+                view: view.map(|v| v.params_value).unwrap_or_default(),
+                record: *record,
                 instances: d.extracted.buffer.clone(),
                 occludes: o.late.is_some(),
-                kept: o.kept..o.kept + bytes,
-                late: o.late.as_ref().map(|l| l.kept..l.kept + bytes),
+                kept: o.kept..o.kept + bytes(d),
+                late: o.late.as_ref().map(|l| l.kept..l.kept + bytes(d)),
             });
-            if !self.chunks.contains_key(&d.chunk) {
-                // Not dispatched (no bind group): its arguments count nothing; drawn whole.
-                continue;
-            }
+        }
+        #[cfg(not(feature = "testing"))]
+        let _ = records;
+        for (d, o) in dispatches.iter().zip(offsets) {
             let early = CulledRange {
                 args: u64::from(o.draw * ARGS_WORDS * 4),
-                kept: o.kept..o.kept + bytes,
+                kept: o.kept..o.kept + bytes(d),
             };
-            let late = o.late.as_ref().map(|late| {
-                self.late
-                    .entry(d.view.entity)
-                    .or_insert_with(|| occlusion::LateWork::new(o.draw))
-                    .push(d.chunk, o.draw, late, d.gpu.count);
-                CulledRange {
-                    args: u64::from((self.draw_count + o.draw) * ARGS_WORDS * 4),
-                    kept: late.kept..late.kept + bytes,
-                }
+            let late = o.late.as_ref().map(|late| CulledRange {
+                args: u64::from((self.draw_count + o.draw) * ARGS_WORDS * 4),
+                kept: late.kept..late.kept + bytes(d),
             });
             self.draws
                 .insert((d.view.entity, d.chunk), CulledDraw { early, late });
@@ -386,20 +388,11 @@ impl InstanceCuller {
     }
 }
 
-/// Workgroups covering `count` instances (x, y): at most 65 535 along x.
-fn workgroups(count: u32) -> (u32, u32) {
-    let groups = count.div_ceil(WORKGROUP).max(1);
+/// `groups` workgroups as a grid (x, y): at most 65 535 along x.
+fn grid(groups: u32) -> (u32, u32) {
+    let groups = groups.max(1);
     let x = groups.min(65_535);
     (x, groups.div_ceil(x))
-}
-
-/// Where one dispatch's data lies: its settings, its kept instances (bytes), its draw; and
-/// its late phase's, where it occludes.
-struct Offsets {
-    params: u32,
-    kept: u64,
-    draw: u32,
-    late: Option<occlusion::LateOffsets>,
 }
 
 impl CullInputs<'_, '_> {
@@ -457,11 +450,13 @@ impl CullInputs<'_, '_> {
             })
             .filter_map(|(view, chunk, extracted, gpu)| {
                 let args = self.args(extracted)?;
+                let first_instance = self.slab.range(chunk).filter(|_| gpu.own.is_none())?.start;
                 Some(Dispatch {
                     view,
                     chunk,
                     extracted,
                     gpu,
+                    first_instance,
                     args,
                 })
             })
@@ -475,116 +470,61 @@ impl CullInputs<'_, '_> {
 }
 
 impl InstanceCuller {
-    /// Places each dispatch's kept instances in the pool (at the storage offset alignment;
-    /// twice where it occludes, once a phase) and its marks, and makes the buffers large
-    /// enough; `None` when the pool would pass the device's largest buffer (the frame
-    /// draws directly).
-    fn lay_out(&mut self, dispatches: &[Dispatch], device: &RenderDevice) -> Option<Vec<Offsets>> {
-        let limits = device.limits();
-        let align = u64::from(limits.min_storage_buffer_offset_alignment.max(4));
-        let binding = kept_binding(dispatches);
-        if binding > limits.max_storage_buffer_binding_size {
-            warn_once!(
-                "rwt: a chunk holds more instances than a GPU binding; drawing chunks whole"
-            );
-            return None;
-        }
-        let mut offsets = Vec::with_capacity(dispatches.len());
-        let (mut end, mut marks) = (0u64, 0u32);
-        let mut place = |count: u32| {
-            let at = end.next_multiple_of(align);
-            end = at + u64::from(count) * INSTANCE_BYTES;
-            at
-        };
-        for (i, d) in dispatches.iter().enumerate() {
-            let kept = place(d.gpu.count);
-            let late = d.occludes().map(|_| {
-                let late = occlusion::LateOffsets {
-                    params: 0,
-                    kept: place(d.gpu.count),
-                    marks,
-                };
-                marks += d.gpu.count.div_ceil(32);
-                late
-            });
-            offsets.push(Offsets {
-                params: 0,
-                kept,
-                draw: i as u32,
-                late,
-            });
-        }
-        let last = offsets
-            .iter()
-            .map(|o| o.late.as_ref().map_or(o.kept, |l| l.kept))
-            .max()
-            .unwrap_or(0);
-        let size = (last + binding).max(end);
-        if size > limits.max_buffer_size || last > u64::from(u32::MAX) {
-            warn_once!(
-                "rwt: the instances kept by culling pass the GPU's largest buffer; drawing chunks whole"
-            );
-            return None;
-        }
-        self.grow(dispatches.len() as u64, size, marks, device);
-        Some(offsets)
-    }
-
-    /// Grows the buffers for `draws` draws, a pool of `kept` bytes and `marks` words.
-    fn grow(&mut self, draws: u64, kept: u64, marks: u32, device: &RenderDevice) {
-        // Cleared once made (below), copied from by the check (`testing`).
-        let usage = BufferUsages::VERTEX
-            | BufferUsages::STORAGE
-            | BufferUsages::COPY_DST
-            | BufferUsages::COPY_SRC;
-        self.fresh_pool |= grow(&mut self.kept, device, kept, "rwt_kept_instances", usage);
-        let block = draws * u64::from(ARGS_WORDS) * 4;
-        // Copied from by the check (`testing`) and the late phase, into by the late phase.
-        let usage = BufferUsages::INDIRECT
-            | BufferUsages::STORAGE
-            | BufferUsages::COPY_DST
-            | BufferUsages::COPY_SRC;
-        grow(&mut self.args, device, 2 * block, "rwt_cull_args", usage);
-        let usage = BufferUsages::COPY_DST | BufferUsages::COPY_SRC;
-        grow(
-            &mut self.phases,
-            device,
-            2 * block,
-            "rwt_cull_phases",
-            usage,
-        );
-        let usage = BufferUsages::STORAGE | BufferUsages::COPY_DST;
-        let marks = u64::from(marks.max(1)) * 4;
-        grow(&mut self.marks, device, marks, "rwt_cull_marks", usage);
-    }
-
-    /// Writes the settings (their offsets into `offsets`), the arguments (both blocks with
-    /// no instances) and the early block with no instances the late phase restores.
+    /// Writes the records, each view's settings (their offsets into `plan`; a late phase's
+    /// where the view occludes), the arguments (both blocks with no instances) and the early
+    /// block with no instances the late phase restores.
     fn write(
         &mut self,
         dispatches: &[Dispatch],
-        offsets: &mut [Offsets],
+        plan: &mut Plan,
         device: &RenderDevice,
         queue: &RenderQueue,
     ) {
-        self.params.clear();
-        let mut args = Vec::with_capacity(dispatches.len() * ARGS_WORDS as usize);
         let late_block = dispatches.len() as u32 * ARGS_WORDS;
-        for (d, o) in dispatches.iter().zip(offsets.iter_mut()) {
-            let early = params(d, o);
-            o.params = self.params.push(early);
-            if let (Some(late), Some((_, current))) = (o.late.as_mut(), d.occludes()) {
-                late.params = self.params.push(CullParams {
-                    clip_from_world: current,
-                    phase: 2,
-                    first_mark: late.marks,
-                    count_word: late_block + o.draw * ARGS_WORDS + 1,
-                    ..early
-                });
-            }
-            args.extend_from_slice(&d.args);
+        for r in &mut plan.records {
+            r.late_count_word = late_block + r.count_word;
         }
-        self.params.write_buffer(device, queue);
+        self.records.set(plan.records.clone());
+        self.records.write_buffer(device, queue);
+        self.views.clear();
+        for work in &mut plan.early {
+            let d = &dispatches[work.records.start as usize];
+            let (x, _) = grid(work.workgroups);
+            let early = CullView {
+                planes: d.view.planes,
+                clip_from_world: Mat4::IDENTITY,
+                eye: d.view.eye,
+                phase: 0,
+                first_record: work.records.start,
+                records: work.records.len() as u32,
+                workgroups: work.workgroups,
+                workgroups_x: x,
+            };
+            let early = match d.occludes() {
+                Some((previous, current)) => {
+                    let late = self.views.push(CullView {
+                        clip_from_world: current,
+                        phase: 2,
+                        ..early
+                    });
+                    self.late
+                        .insert(d.view.entity, occlusion::LateWork::new(work, late));
+                    CullView {
+                        clip_from_world: previous,
+                        phase: 1,
+                        ..early
+                    }
+                }
+                None => early,
+            };
+            work.params = self.views.push(early);
+            #[cfg(feature = "testing")]
+            {
+                work.params_value = early;
+            }
+        }
+        self.views.write_buffer(device, queue);
+        let args: Vec<u32> = dispatches.iter().flat_map(|d| d.args).collect();
         let block: &[u8] = bytemuck::cast_slice(&args);
         if let (Some(buffer), Some(phases)) = (&self.args, &self.phases) {
             queue.write_buffer(buffer, 0, block);
@@ -593,124 +533,64 @@ impl InstanceCuller {
         }
     }
 
-    /// Makes the bind group of each dispatched chunk whose buffers changed; forgets those of
-    /// chunks not dispatched.
-    fn bind(&mut self, dispatches: &[Dispatch], device: &RenderDevice, cache: &PipelineCache) {
-        let (Some(kept), Some(args), Some(marks), Some(params)) =
-            (&self.kept, &self.args, &self.marks, self.params.buffer())
-        else {
+    /// Makes the frame's bind group when its buffers or the pool's binding changed.
+    fn bind(
+        &mut self,
+        slab: &Buffer,
+        pool_binding: u64,
+        device: &RenderDevice,
+        cache: &PipelineCache,
+    ) {
+        let (Some(kept), Some(args), Some(marks), Some(records), Some(views)) = (
+            &self.kept,
+            &self.args,
+            &self.marks,
+            self.records.buffer(),
+            self.views.buffer(),
+        ) else {
+            self.bind = None;
             return;
         };
-        // One dispatch's settings, at its dynamic offset.
-        let one = BufferBinding {
-            buffer: params,
-            offset: 0,
-            size: Some(CullParams::min_size()),
-        };
-        let binding = kept_binding(dispatches);
-        let layout = cache.get_bind_group_layout(&self.layout);
-        let mut chunks = HashMap::default();
-        for d in dispatches {
-            if chunks.contains_key(&d.chunk) {
-                continue;
-            }
-            let made_with = [
-                d.gpu.instances.id(),
-                params.id(),
-                kept.id(),
-                args.id(),
-                marks.id(),
-            ];
-            let chunk = match self.chunks.remove(&d.chunk) {
-                Some(c) if c.made_with == made_with && c.kept_binding == binding => c,
-                _ => ChunkCull {
-                    made_with,
-                    kept_binding: binding,
-                    bind_group: device.create_bind_group(
-                        "rwt_cull",
-                        &layout,
-                        &BindGroupEntries::sequential((
-                            d.gpu.instances.as_entire_binding(),
-                            one.clone(),
-                            BufferBinding {
-                                buffer: kept,
-                                offset: 0,
-                                size: NonZero::new(binding),
-                            },
-                            args.as_entire_binding(),
-                            marks.as_entire_binding(),
-                        )),
-                    ),
-                },
-            };
-            chunks.insert(d.chunk, chunk);
+        let made_with = [
+            slab.id(),
+            records.id(),
+            views.id(),
+            kept.id(),
+            args.id(),
+            marks.id(),
+        ];
+        if self
+            .bind
+            .as_ref()
+            .is_some_and(|b| b.made_with == made_with && b.pool_binding == pool_binding)
+        {
+            return;
         }
-        self.chunks = chunks;
-    }
-}
-
-/// The size every chunk's binding of the pool has: the largest chunk's instances.
-fn kept_binding(dispatches: &[Dispatch]) -> u64 {
-    let most = dispatches.iter().map(|d| d.gpu.count).max().unwrap_or(1);
-    let size = u64::from(most.max(1)) * INSTANCE_BYTES;
-    // Grown in steps, so that bind groups are not made anew for every new largest chunk.
-    size.next_power_of_two()
-}
-
-/// Makes `buffer` anew, of at least `size` bytes (grown by halves), when it is smaller;
-/// whether it did.
-fn grow(
-    buffer: &mut Option<Buffer>,
-    device: &RenderDevice,
-    size: u64,
-    label: &str,
-    usage: BufferUsages,
-) -> bool {
-    if buffer.as_ref().is_some_and(|b| b.size() >= size) {
-        return false;
-    }
-    let size = (size + size / 2).next_multiple_of(256);
-    *buffer = Some(device.create_buffer(&BufferDescriptor {
-        label: Some(label),
-        size,
-        usage,
-        mapped_at_creation: false,
-    }));
-    true
-}
-
-/// The early phase's settings of one dispatch.
-fn params(d: &Dispatch, o: &Offsets) -> CullParams {
-    let u = &d.gpu.uniform;
-    let shadow_distance = match (d.view.shadow, d.extracted.shadows) {
-        (true, InstancedShadows::Within(distance)) => distance,
-        _ => -1.0,
-    };
-    let (clip_from_world, phase, first_mark) = match (d.occludes(), &o.late) {
-        (Some((previous, _)), Some(late)) => (previous, 1, late.marks),
-        _ => (Mat4::IDENTITY, 0, 0),
-    };
-    CullParams {
-        planes: d.view.planes,
-        clip_from_world,
-        eye: d.view.eye,
-        shadow_distance,
-        origin: u.origin,
-        reach: d.extracted.reach,
-        falloff_near: u.falloff_near,
-        falloff_far: u.falloff_far,
-        falloff_floor: u.falloff_floor,
-        falloff_on: u.falloff_on,
-        fade_band: u.fade_band,
-        fade_in_from: u.fade_in_from,
-        fade_out_to: u.fade_out_to,
-        thinning_from: u.thinning_from,
-        thinning_floor: u.thinning_floor,
-        thinning_on: u.thinning_on,
-        instances: d.gpu.count,
-        count_word: o.draw * ARGS_WORDS + 1,
-        workgroups_x: workgroups(d.gpu.count).0,
-        phase,
-        first_mark,
+        let bind_group = device.create_bind_group(
+            "rwt_cull",
+            &cache.get_bind_group_layout(&self.layout),
+            &BindGroupEntries::sequential((
+                slab.as_entire_binding(),
+                records.as_entire_binding(),
+                // One view's settings, at its dynamic offset.
+                BufferBinding {
+                    buffer: views,
+                    offset: 0,
+                    size: Some(CullView::min_size()),
+                },
+                BufferBinding {
+                    buffer: kept,
+                    offset: 0,
+                    size: NonZero::new(pool_binding),
+                },
+                args.as_entire_binding(),
+                marks.as_entire_binding(),
+            )),
+        );
+        self.bind = Some(FrameBind {
+            made_with,
+            pool_binding,
+            bind_group,
+        });
     }
 }

@@ -10,7 +10,7 @@
 //! it back for the main pass, which draws both. What the early depth holds, the frame
 //! holds too, so an instance seen this frame is never dropped, however the view moved.
 
-use super::{ARGS_WORDS, InstanceCuller, workgroups};
+use super::{ARGS_WORDS, InstanceCuller, ViewWork, grid};
 use bevy::core_pipeline::mip_generation::experimental::depth::ViewDepthPyramid;
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::platform::collections::HashMap;
@@ -144,44 +144,28 @@ impl Pyramids {
     }
 }
 
-/// Where one dispatch's late phase lies: its settings, its kept instances (bytes), its
-/// first word of marks.
+/// Where one chunk's late phase keeps its instances (bytes into the pool).
 pub(super) struct LateOffsets {
-    pub params: u32,
     pub kept: u64,
-    pub marks: u32,
 }
 
-/// One chunk's late dispatch.
-struct LateDispatch {
-    chunk: Entity,
-    params: u32,
-    kept: u64,
-    count: u32,
-}
-
-/// One view's late phase this frame: its draws (records of the early block) and dispatches.
+/// One view's late phase this frame: its draws (records of the early block), its settings'
+/// dynamic offset, its binding of the pool and its workgroups.
 pub(super) struct LateWork {
     draws: Range<u32>,
-    dispatches: Vec<LateDispatch>,
+    params: u32,
+    pool: u64,
+    workgroups: u32,
 }
 
 impl LateWork {
-    pub fn new(draw: u32) -> Self {
+    pub fn new(view: &ViewWork, params: u32) -> Self {
         Self {
-            draws: draw..draw,
-            dispatches: Vec::new(),
+            draws: view.records.clone(),
+            params,
+            pool: view.pool,
+            workgroups: view.workgroups,
         }
-    }
-
-    pub fn push(&mut self, chunk: Entity, draw: u32, offsets: &LateOffsets, count: u32) {
-        self.draws.end = self.draws.end.max(draw + 1);
-        self.dispatches.push(LateDispatch {
-            chunk,
-            params: offsets.params,
-            kept: offsets.kept,
-            count,
-        });
     }
 
     /// The view's records of the early block, in bytes.
@@ -196,6 +180,7 @@ impl LateWork {
 /// `restore_early` both ask for it, so the block is restored exactly when it was put aside.
 struct LateFrame<'a> {
     work: &'a LateWork,
+    bind_group: &'a BindGroup,
     pipeline: &'a ComputePipeline,
     pyramid: &'a BindGroup,
     args: &'a Buffer,
@@ -206,6 +191,7 @@ impl InstanceCuller {
     fn late_frame<'a>(&'a self, view: Entity, cache: &'a PipelineCache) -> Option<LateFrame<'a>> {
         Some(LateFrame {
             work: self.late.get(&view)?,
+            bind_group: &self.bind.as_ref()?.bind_group,
             pipeline: cache.get_compute_pipeline(self.pipeline?)?,
             pyramid: self.pyramids.bind_group(view)?,
             args: self.args.as_ref()?,
@@ -235,14 +221,10 @@ pub(in crate::instancing) fn cull_late(
         });
         pass.set_pipeline(late.pipeline);
         pass.set_bind_group(1, late.pyramid, &[]);
-        for d in &late.work.dispatches {
-            let Some(chunk) = culler.chunks.get(&d.chunk) else {
-                continue;
-            };
-            pass.set_bind_group(0, &chunk.bind_group, &[d.params, d.kept as u32]);
-            let (x, y) = workgroups(d.count);
-            pass.dispatch_workgroups(x, y, 1);
-        }
+        let offsets = [late.work.params, late.work.pool as u32];
+        pass.set_bind_group(0, late.bind_group, &offsets);
+        let (x, y) = grid(late.work.workgroups);
+        pass.dispatch_workgroups(x, y, 1);
     }
     let bytes = late.work.bytes();
     let block = u64::from(culler.draw_count * ARGS_WORDS * 4);

@@ -1,15 +1,15 @@
-//! One dispatch's settings, as `cull.wgsl` reads them, and the same test on the CPU (for
-//! the check and the unit tests).
+//! What `cull.wgsl` reads of a view and of each chunk in it, and the same test on the CPU
+//! (for the check and the unit tests).
 
 #[cfg(any(test, feature = "testing"))]
 use crate::instancing::GpuInstance;
 use bevy::prelude::*;
 use bevy::render::render_resource::ShaderType;
 
-/// One dispatch's settings, as `cull.wgsl` reads them (from a storage buffer): the view's,
-/// then the chunk's.
+/// One view's dispatch, as `cull.wgsl` reads it (from a storage buffer, at a dynamic
+/// offset): the view, its phase and its records.
 #[derive(Clone, Copy, Debug, Default, ShaderType)]
-pub(in crate::instancing) struct CullParams {
+pub(in crate::instancing) struct CullView {
     /// The view's half-spaces (normal, distance; inside where `dot(n, p) + d > 0`).
     pub planes: [Vec4; 6],
     /// The view's clip space from world space: last frame's (early phase), this frame's
@@ -18,13 +18,27 @@ pub(in crate::instancing) struct CullParams {
     /// Where the level of detail is measured from: the view's camera, or the main camera
     /// for shadow views.
     pub eye: Vec3,
-    /// In a shadow view, the class's shadow distance from the eye; negative: none.
-    pub shadow_distance: f32,
+    /// Occlusion's phase: 0 none, 1 early, 2 late.
+    pub phase: u32,
+    /// The view's first record, and how many it has.
+    pub first_record: u32,
+    pub records: u32,
+    /// The dispatch's workgroups, and how many along x.
+    pub workgroups: u32,
+    pub workgroups_x: u32,
+}
+
+/// One chunk in one view, as `cull.wgsl` reads it (an array of them in a storage buffer):
+/// its level of detail, its instances and where it keeps them.
+#[derive(Clone, Copy, Debug, Default, ShaderType)]
+pub(in crate::instancing) struct CullRecord {
     /// The chunk's corner.
     pub origin: Vec3,
     /// The radius around its root of an instance of scale 1, its sway and any lean or
     /// tilt included.
     pub reach: f32,
+    /// In a shadow view, the class's shadow distance from the eye; negative: none.
+    pub shadow_distance: f32,
     /// The level of detail's fall-off: near, far, the factor's floor; 1 when on.
     pub falloff_near: f32,
     pub falloff_far: f32,
@@ -42,31 +56,37 @@ pub(in crate::instancing) struct CullParams {
     pub thinning_from: f32,
     pub thinning_floor: f32,
     pub thinning_on: u32,
-    /// Instances in the chunk.
+    /// Instances in the chunk, and the first of them in the slab.
     pub instances: u32,
-    /// The word of the draw's instance count in the indirect arguments.
+    pub first_instance: u32,
+    /// The view's first workgroup that tests this chunk.
+    pub first_workgroup: u32,
+    /// Where the chunk's kept instances go in the view's binding of the pool (instances):
+    /// the early phase's, the late phase's.
+    pub kept: u32,
+    pub late_kept: u32,
+    /// The words of the draw's instance counts in the indirect arguments: the early
+    /// block's, the late block's.
     pub count_word: u32,
-    /// Workgroups along x.
-    pub workgroups_x: u32,
-    /// Occlusion's phase: 0 none, 1 early, 2 late.
-    pub phase: u32,
+    pub late_count_word: u32,
     /// The chunk's first word of marks (occlusion).
     pub first_mark: u32,
 }
 
 #[cfg(any(test, feature = "testing"))]
-impl CullParams {
-    /// Whether `instance` may be seen: `cull.wgsl`'s test, on the CPU.
-    pub(in crate::instancing) fn keeps(&self, instance: &GpuInstance) -> bool {
+impl CullRecord {
+    /// Whether `view` may see `instance` of this chunk: `cull.wgsl`'s test, on the CPU.
+    pub(in crate::instancing) fn keeps(&self, view: &CullView, instance: &GpuInstance) -> bool {
         let root = self.origin + Vec3::from(instance.offset);
         let appear = f32::from(instance.appear) / 65535.0;
-        let kept = self.kept_fraction(root);
-        let scale = instance.scale * self.growth(root, appear, kept);
+        let from_eye = (root.xz() - view.eye.xz()).length();
+        let kept = self.kept_fraction(from_eye);
+        let scale = instance.scale * self.growth(from_eye, appear, kept);
         if scale <= 0.0 {
             return false;
         }
         let radius = self.reach * scale / kept;
-        let distance = root.distance(self.eye);
+        let distance = root.distance(view.eye);
         if self.shadow_distance >= 0.0 && distance - radius > self.shadow_distance {
             return false;
         }
@@ -74,30 +94,29 @@ impl CullParams {
         if distance < self.fade_in_from || beyond {
             return false;
         }
-        self.planes
+        view.planes
             .iter()
             .all(|p| p.truncate().dot(root) + p.w + radius > 0.0)
     }
 
-    /// `cull.wgsl`'s fraction kept by far thinning.
-    fn kept_fraction(&self, root: Vec3) -> f32 {
+    /// `cull.wgsl`'s fraction kept by far thinning, `from_eye` from the eye across.
+    fn kept_fraction(&self, from_eye: f32) -> f32 {
         if self.thinning_on == 0 {
             return 1.0;
         }
-        let ratio = self.thinning_from / (root.xz() - self.eye.xz()).length().max(1e-3);
+        let ratio = self.thinning_from / from_eye.max(1e-3);
         (ratio * ratio).clamp(self.thinning_floor, 1.0)
     }
 
-    /// `cull.wgsl`'s growth.
-    fn growth(&self, root: Vec3, appear: f32, kept: f32) -> f32 {
+    /// `cull.wgsl`'s growth, `from_eye` from the eye across.
+    fn growth(&self, from_eye: f32, appear: f32, kept: f32) -> f32 {
         let band = self.fade_band;
         let thinned = ((kept * (1.0 + band) - appear) / band).clamp(0.0, 1.0);
         if self.falloff_on == 0 {
             return thinned;
         }
-        let distance = (root.xz() - self.eye.xz()).length();
         let span = (self.falloff_far - self.falloff_near).max(1e-3);
-        let near = (1.0 - (distance - self.falloff_near) / span).clamp(0.0, 1.0);
+        let near = (1.0 - (from_eye - self.falloff_near) / span).clamp(0.0, 1.0);
         let factor = self.falloff_floor.max(near);
         ((factor - appear) / band).clamp(0.0, 1.0) * thinned
     }

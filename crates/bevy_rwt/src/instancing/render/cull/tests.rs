@@ -7,6 +7,25 @@ use bevy::asset::uuid::Uuid;
 use bevy::camera::primitives::Aabb;
 use bevy::shader::Shader;
 
+/// The layout encase writes of `value`, each of `names` marked in order by `marked(k)`
+/// (floats 100 + k, or the word k where `word(k)`).
+fn marked_layout<T: ShaderType + bevy::render::render_resource::encase::internal::WriteInto>(
+    value: &T,
+    names: &[&str],
+    word: impl Fn(u32) -> bool,
+) -> (Vec<(String, usize)>, usize) {
+    let markers: Vec<(&str, u32)> = (0u32..)
+        .zip(names.iter().copied())
+        .map(|(k, n)| (n, if word(k) { k } else { mark(k).to_bits() }))
+        .collect();
+    encase_layout(value, &markers)
+}
+
+/// The float marking member `k`.
+fn mark(k: u32) -> f32 {
+    100.0 + k as f32
+}
+
 #[test]
 fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
     let mut cache = cache_with_fade();
@@ -19,37 +38,57 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
         .get(0, id, &[])
         .expect("cull.wgsl composes and validates");
     // Each member's first word marked, then found in encase's bytes.
-    let f = |k: u32| 100.0 + k as f32;
-    let marked = CullParams {
-        planes: [Vec4::splat(f(0)); 6],
-        clip_from_world: Mat4::from_cols_array(&[f(1); 16]),
-        eye: Vec3::splat(f(2)),
-        shadow_distance: f(3),
-        origin: Vec3::splat(f(4)),
-        reach: f(5),
-        falloff_near: f(6),
-        falloff_far: f(7),
-        falloff_floor: f(8),
-        falloff_on: 9,
-        fade_band: f(10),
-        fade_in_from: f(11),
-        fade_out_to: f(12),
-        thinning_from: f(13),
-        thinning_floor: f(14),
-        thinning_on: 15,
-        instances: 16,
-        count_word: 17,
-        workgroups_x: 18,
-        phase: 19,
-        first_mark: 20,
+    let view = CullView {
+        planes: [Vec4::splat(mark(0)); 6],
+        clip_from_world: Mat4::from_cols_array(&[mark(1); 16]),
+        eye: Vec3::splat(mark(2)),
+        phase: 3,
+        first_record: 4,
+        records: 5,
+        workgroups: 6,
+        workgroups_x: 7,
     };
     let names = [
         "planes",
         "clip_from_world",
         "eye",
-        "shadow_distance",
+        "phase",
+        "first_record",
+        "records",
+        "workgroups",
+        "workgroups_x",
+    ];
+    assert_eq!(
+        struct_layout(&types, "View"),
+        marked_layout(&view, &names, |k| k >= 3)
+    );
+    let record = CullRecord {
+        origin: Vec3::splat(mark(0)),
+        reach: mark(1),
+        shadow_distance: mark(2),
+        falloff_near: mark(3),
+        falloff_far: mark(4),
+        falloff_floor: mark(5),
+        falloff_on: 6,
+        fade_band: mark(7),
+        fade_in_from: mark(8),
+        fade_out_to: mark(9),
+        thinning_from: mark(10),
+        thinning_floor: mark(11),
+        thinning_on: 12,
+        instances: 13,
+        first_instance: 14,
+        first_workgroup: 15,
+        kept: 16,
+        late_kept: 17,
+        count_word: 18,
+        late_count_word: 19,
+        first_mark: 20,
+    };
+    let names = [
         "origin",
         "reach",
+        "shadow_distance",
         "falloff_near",
         "falloff_far",
         "falloff_floor",
@@ -61,21 +100,17 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
         "thinning_floor",
         "thinning_on",
         "instances",
+        "first_instance",
+        "first_workgroup",
+        "kept",
+        "late_kept",
         "count_word",
-        "workgroups_x",
-        "phase",
+        "late_count_word",
         "first_mark",
     ];
-    let markers: Vec<(&str, u32)> = (0u32..)
-        .zip(names)
-        .map(|(k, n)| {
-            let word = matches!(k, 9 | 15..);
-            (n, if word { k } else { f(k).to_bits() })
-        })
-        .collect();
     assert_eq!(
-        struct_layout(&types, "Cull"),
-        encase_layout(&marked, &markers)
+        struct_layout(&types, "Record"),
+        marked_layout(&record, &names, |k| matches!(k, 6 | 12..))
     );
 }
 
@@ -104,8 +139,11 @@ fn at(offset: Vec3, appear: f32) -> GpuInstance {
 
 #[test]
 fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
-    let params = CullParams {
+    let view = CullView {
         planes: looking_down_x(),
+        ..default()
+    };
+    let params = CullRecord {
         reach: 0.5,
         shadow_distance: -1.0,
         falloff_near: 10.0,
@@ -114,60 +152,60 @@ fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
         fade_band: 0.1,
         ..default()
     };
-    assert!(params.keeps(&at(Vec3::new(5.0, 0.0, 0.0), 0.5)));
+    assert!(params.keeps(&view, &at(Vec3::new(5.0, 0.0, 0.0), 0.5)));
     // Behind the eye, or beside the view by more than its reach: culled.
-    assert!(!params.keeps(&at(Vec3::new(-1.0, 0.0, 0.0), 0.0)));
-    assert!(!params.keeps(&at(Vec3::new(3.0, 0.0, 4.0), 0.0)));
+    assert!(!params.keeps(&view, &at(Vec3::new(-1.0, 0.0, 0.0), 0.0)));
+    assert!(!params.keeps(&view, &at(Vec3::new(3.0, 0.0, 4.0), 0.0)));
     // Beside it by less than its reach: kept.
-    assert!(params.keeps(&at(Vec3::new(3.0, 0.0, 3.3), 0.0)));
+    assert!(params.keeps(&view, &at(Vec3::new(3.0, 0.0, 3.3), 0.0)));
     // At 15 m the factor is 0.5: the instances of rank above it have not grown.
-    assert!(params.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.45)));
-    assert!(!params.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.55)));
+    assert!(params.keeps(&view, &at(Vec3::new(15.0, 0.0, 0.0), 0.45)));
+    assert!(!params.keeps(&view, &at(Vec3::new(15.0, 0.0, 0.0), 0.55)));
     // Without the fade every rank is drawn.
-    let no_fade = CullParams {
+    let no_fade = CullRecord {
         falloff_on: 0,
         ..params
     };
-    assert!(no_fade.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.95)));
+    assert!(no_fade.keeps(&view, &at(Vec3::new(15.0, 0.0, 0.0), 0.95)));
     // In a shadow view, beyond the class's shadow distance from the camera: culled.
-    let shadow = CullParams {
+    let shadow = CullRecord {
         shadow_distance: 8.0,
         ..no_fade
     };
-    assert!(shadow.keeps(&at(Vec3::new(8.4, 0.0, 0.0), 0.0)));
-    assert!(!shadow.keeps(&at(Vec3::new(8.6, 0.0, 0.0), 0.0)));
+    assert!(shadow.keeps(&view, &at(Vec3::new(8.4, 0.0, 0.0), 0.0)));
+    assert!(!shadow.keeps(&view, &at(Vec3::new(8.6, 0.0, 0.0), 0.0)));
     // Thinned from 20 m: at 40 m a quarter is kept, the lowest ranks; nearer, all.
-    let thinned = CullParams {
+    let thinned = CullRecord {
         thinning_from: 20.0,
         thinning_floor: 0.1,
         thinning_on: 1,
         ..no_fade
     };
-    assert!(thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.2)));
-    assert!(!thinned.keeps(&at(Vec3::new(40.0, 0.0, 0.0), 0.3)));
-    assert!(thinned.keeps(&at(Vec3::new(15.0, 0.0, 0.0), 0.99)));
+    assert!(thinned.keeps(&view, &at(Vec3::new(40.0, 0.0, 0.0), 0.2)));
+    assert!(!thinned.keeps(&view, &at(Vec3::new(40.0, 0.0, 0.0), 0.3)));
+    assert!(thinned.keeps(&view, &at(Vec3::new(15.0, 0.0, 0.0), 0.99)));
     // Impostors fading in from 12 m: nearer ones are the meshes' to draw.
-    let impostors = CullParams {
+    let impostors = CullRecord {
         fade_in_from: 12.0,
         ..no_fade
     };
-    assert!(!impostors.keeps(&at(Vec3::new(11.9, 0.0, 0.0), 0.0)));
-    assert!(impostors.keeps(&at(Vec3::new(12.1, 0.0, 0.0), 0.0)));
+    assert!(!impostors.keeps(&view, &at(Vec3::new(11.9, 0.0, 0.0), 0.0)));
+    assert!(impostors.keeps(&view, &at(Vec3::new(12.1, 0.0, 0.0), 0.0)));
     // A class's meshes, gone past the end of their crossfade with its impostors at 14 m.
-    let meshes = CullParams {
+    let meshes = CullRecord {
         fade_out_to: 14.0,
         ..no_fade
     };
-    assert!(meshes.keeps(&at(Vec3::new(13.9, 0.0, 0.0), 0.0)));
-    assert!(!meshes.keeps(&at(Vec3::new(14.1, 0.0, 0.0), 0.0)));
+    assert!(meshes.keeps(&view, &at(Vec3::new(13.9, 0.0, 0.0), 0.0)));
+    assert!(!meshes.keeps(&view, &at(Vec3::new(14.1, 0.0, 0.0), 0.0)));
     // Down to the floor, however far.
-    assert!(thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.09)));
-    assert!(!thinned.keeps(&at(Vec3::new(900.0, 0.0, 0.0), 0.13)));
+    assert!(thinned.keeps(&view, &at(Vec3::new(900.0, 0.0, 0.0), 0.09)));
+    assert!(!thinned.keeps(&view, &at(Vec3::new(900.0, 0.0, 0.0), 0.13)));
     // A widened instance is kept by a view it reaches into only widened (a fraction of
     // a quarter at 40 m: four times as wide).
     let beside = Vec3::new(40.0, 0.0, 40.0 + 1.2 * std::f32::consts::SQRT_2);
-    assert!(thinned.keeps(&at(beside, 0.0)));
-    assert!(!no_fade.keeps(&at(beside, 0.0)));
+    assert!(thinned.keeps(&view, &at(beside, 0.0)));
+    assert!(!no_fade.keeps(&view, &at(beside, 0.0)));
 }
 
 #[test]

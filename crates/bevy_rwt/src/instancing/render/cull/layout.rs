@@ -1,0 +1,240 @@
+//! How a frame's culling is laid out: each view's region of the pool of kept instances,
+//! each chunk's record in it (its ranges, marks and workgroups), and buffers large enough.
+
+use super::{
+    ARGS_WORDS, CullRecord, CullView, Dispatch, INSTANCE_BYTES, InstanceCuller, WORKGROUP,
+    occlusion,
+};
+use crate::look::InstancedShadows;
+use bevy::prelude::*;
+use bevy::render::render_resource::*;
+use bevy::render::renderer::RenderDevice;
+use std::ops::Range;
+
+/// Where one chunk's data in a view lies: its kept instances (bytes into the pool), its
+/// draw; and its late phase's, where the view occludes.
+pub(super) struct Offsets {
+    pub kept: u64,
+    pub draw: u32,
+    pub late: Option<occlusion::LateOffsets>,
+}
+
+/// One view's early dispatch: its records, its workgroups, where its kept instances lie in
+/// the pool, its settings (their dynamic offset, and themselves for the check).
+pub(super) struct ViewWork {
+    pub entity: Entity,
+    pub records: Range<u32>,
+    pub workgroups: u32,
+    /// Byte offset of the view's binding of the pool.
+    pub pool: u64,
+    pub params: u32,
+    #[cfg(feature = "testing")]
+    pub params_value: CullView,
+}
+
+/// This frame's layout: each chunk's offsets in its view, each view's dispatch, the
+/// records, and the size every view's binding of the pool has.
+pub(super) struct Plan {
+    pub offsets: Vec<Offsets>,
+    pub early: Vec<ViewWork>,
+    pub records: Vec<CullRecord>,
+    pub pool_binding: u64,
+}
+
+impl InstanceCuller {
+    /// Places each view's kept instances in the pool (a region per view at the storage
+    /// offset alignment: each chunk's early range, then where it occludes each chunk's late
+    /// range), each chunk's marks and workgroups, and makes the buffers large enough;
+    /// `None` when a view's region would pass one binding or the pool the device's largest
+    /// buffer (the frame draws directly).
+    pub(super) fn lay_out(
+        &mut self,
+        dispatches: &[Dispatch],
+        device: &RenderDevice,
+    ) -> Option<Plan> {
+        let limits = device.limits();
+        let align = u64::from(limits.min_storage_buffer_offset_alignment.max(4));
+        let mut plan = Plan {
+            offsets: Vec::with_capacity(dispatches.len()),
+            early: Vec::new(),
+            records: Vec::with_capacity(dispatches.len()),
+            pool_binding: 0,
+        };
+        let (mut end, mut marks, mut most) = (0u64, 0u32, 0u64);
+        let mut first = 0;
+        while first < dispatches.len() {
+            let view = dispatches[first].view.entity;
+            let last = first + dispatches[first..].partition_point(|d| d.view.entity == view);
+            let pool = end.next_multiple_of(align);
+            let (region, work) =
+                self.lay_out_view(&dispatches[first..last], first as u32, pool, &mut marks);
+            let (offsets, records) = region;
+            let bytes = offsets
+                .iter()
+                .zip(&dispatches[first..last])
+                .map(|(o, d)| {
+                    let range_end = o.late.as_ref().map_or(o.kept, |l| l.kept);
+                    range_end + u64::from(d.gpu.count) * INSTANCE_BYTES - pool
+                })
+                .max()
+                .unwrap_or(0);
+            most = most.max(bytes);
+            end = pool + bytes;
+            plan.offsets.extend(offsets);
+            plan.records.extend(records);
+            plan.early.push(work);
+            first = last;
+        }
+        // Grown in steps, so that the bind group is not made anew for every new largest view.
+        plan.pool_binding = most.max(INSTANCE_BYTES).next_power_of_two();
+        let last_pool = plan.early.iter().map(|v| v.pool).max().unwrap_or(0);
+        let size = (last_pool + plan.pool_binding).max(end);
+        if plan.pool_binding > limits.max_storage_buffer_binding_size
+            || size > limits.max_buffer_size
+            || last_pool > u64::from(u32::MAX)
+        {
+            warn_once!(
+                "rwt: the instances kept by culling pass the GPU's largest buffer; drawing chunks whole"
+            );
+            return None;
+        }
+        self.grow(dispatches.len() as u64, size, marks, device);
+        Some(plan)
+    }
+
+    /// Lays out one view's chunks (`dispatches`, the first of them the frame's draw
+    /// `first_draw`) from `pool` (bytes) on: their offsets and records, and the view's
+    /// dispatch (its settings written later).
+    fn lay_out_view(
+        &self,
+        dispatches: &[Dispatch],
+        first_draw: u32,
+        pool: u64,
+        marks: &mut u32,
+    ) -> ((Vec<Offsets>, Vec<CullRecord>), ViewWork) {
+        let view = dispatches[0].view;
+        let occludes = view.occluding.is_some_and(|o| o.previous.is_some());
+        let mut kept = 0u32;
+        let mut place = |count: u32| {
+            let at = kept;
+            kept += count;
+            at
+        };
+        let mut records: Vec<CullRecord> = dispatches
+            .iter()
+            .map(|d| CullRecord {
+                kept: place(d.gpu.count),
+                ..record(d)
+            })
+            .collect();
+        let mut workgroups = 0;
+        let mut offsets = Vec::with_capacity(dispatches.len());
+        for (i, (d, r)) in dispatches.iter().zip(&mut records).enumerate() {
+            r.first_workgroup = workgroups;
+            workgroups += d.gpu.count.div_ceil(WORKGROUP);
+            let at = |instance: u32| pool + u64::from(instance) * INSTANCE_BYTES;
+            let late = occludes.then(|| {
+                r.late_kept = place(d.gpu.count);
+                r.first_mark = *marks;
+                *marks += d.gpu.count.div_ceil(32);
+                occlusion::LateOffsets {
+                    kept: at(r.late_kept),
+                }
+            });
+            let draw = first_draw + i as u32;
+            r.count_word = draw * ARGS_WORDS + 1;
+            offsets.push(Offsets {
+                kept: at(r.kept),
+                draw,
+                late,
+            });
+        }
+        let work = ViewWork {
+            entity: view.entity,
+            records: first_draw..first_draw + dispatches.len() as u32,
+            workgroups,
+            pool,
+            params: 0,
+            #[cfg(feature = "testing")]
+            params_value: CullView::default(),
+        };
+        ((offsets, records), work)
+    }
+
+    /// Grows the buffers for `draws` draws, a pool of `kept` bytes and `marks` words.
+    fn grow(&mut self, draws: u64, kept: u64, marks: u32, device: &RenderDevice) {
+        // Cleared once made (below), copied from by the check (`testing`).
+        let usage = BufferUsages::VERTEX
+            | BufferUsages::STORAGE
+            | BufferUsages::COPY_DST
+            | BufferUsages::COPY_SRC;
+        self.fresh_pool |= grow(&mut self.kept, device, kept, "rwt_kept_instances", usage);
+        let block = draws * u64::from(ARGS_WORDS) * 4;
+        // Copied from by the check (`testing`) and the late phase, into by the late phase.
+        let usage = BufferUsages::INDIRECT
+            | BufferUsages::STORAGE
+            | BufferUsages::COPY_DST
+            | BufferUsages::COPY_SRC;
+        grow(&mut self.args, device, 2 * block, "rwt_cull_args", usage);
+        let usage = BufferUsages::COPY_DST | BufferUsages::COPY_SRC;
+        grow(
+            &mut self.phases,
+            device,
+            2 * block,
+            "rwt_cull_phases",
+            usage,
+        );
+        let usage = BufferUsages::STORAGE | BufferUsages::COPY_DST;
+        let marks = u64::from(marks.max(1)) * 4;
+        grow(&mut self.marks, device, marks, "rwt_cull_marks", usage);
+    }
+}
+
+/// Makes `buffer` anew, of at least `size` bytes (grown by halves), when it is smaller;
+/// whether it did.
+fn grow(
+    buffer: &mut Option<Buffer>,
+    device: &RenderDevice,
+    size: u64,
+    label: &str,
+    usage: BufferUsages,
+) -> bool {
+    if buffer.as_ref().is_some_and(|b| b.size() >= size) {
+        return false;
+    }
+    let size = (size + size / 2).next_multiple_of(256);
+    *buffer = Some(device.create_buffer(&BufferDescriptor {
+        label: Some(label),
+        size,
+        usage,
+        mapped_at_creation: false,
+    }));
+    true
+}
+
+/// A chunk's record in its view, before its place in the pool and the arguments is known.
+pub(super) fn record(d: &Dispatch) -> CullRecord {
+    let u = &d.gpu.uniform;
+    let shadow_distance = match (d.view.shadow, d.extracted.shadows) {
+        (true, InstancedShadows::Within(distance)) => distance,
+        _ => -1.0,
+    };
+    CullRecord {
+        origin: u.origin,
+        reach: d.extracted.reach,
+        shadow_distance,
+        falloff_near: u.falloff_near,
+        falloff_far: u.falloff_far,
+        falloff_floor: u.falloff_floor,
+        falloff_on: u.falloff_on,
+        fade_band: u.fade_band,
+        fade_in_from: u.fade_in_from,
+        fade_out_to: u.fade_out_to,
+        thinning_from: u.thinning_from,
+        thinning_floor: u.thinning_floor,
+        thinning_on: u.thinning_on,
+        instances: d.gpu.count,
+        first_instance: d.first_instance,
+        ..default()
+    }
+}

@@ -1,0 +1,243 @@
+//! One buffer holding every chunk's instances ([`InstanceSlab`]), so that culling reads all
+//! of them through one binding and tests every chunk of a view in one dispatch.
+//!
+//! Each chunk owns a range of instances, placed best-fit among the free ranges
+//! ([`Ranges`]). The buffer grows by doubling (copied on the GPU) up to what one storage
+//! binding may hold; a chunk that does not fit then gets a buffer of its own and is drawn
+//! whole.
+
+use crate::instancing::{GPU_BYTES_PER_INSTANCE, GpuInstance};
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::render::render_resource::*;
+use bevy::render::renderer::{RenderDevice, RenderQueue};
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+/// Bytes of one instance.
+const INSTANCE_BYTES: u64 = GPU_BYTES_PER_INSTANCE as u64;
+/// The smallest buffer made (instances).
+const FIRST_CAPACITY: u32 = 1 << 16;
+
+/// Free ranges of a run of `capacity` slots, handed out best-fit and merged when freed.
+#[derive(Debug, Default)]
+pub(super) struct Ranges {
+    capacity: u32,
+    /// Free ranges, start to length, never adjacent.
+    free: BTreeMap<u32, u32>,
+}
+
+impl Ranges {
+    /// A range of `len` slots (`len` > 0), the smallest free one that holds it (the lowest
+    /// of equals); `None` when none does.
+    pub fn take(&mut self, len: u32) -> Option<Range<u32>> {
+        let (&start, &free) = self
+            .free
+            .iter()
+            .filter(|&(_, &free)| free >= len)
+            .min_by_key(|&(&start, &free)| (free, start))?;
+        self.free.remove(&start);
+        if free > len {
+            self.free.insert(start + len, free - len);
+        }
+        Some(start..start + len)
+    }
+
+    /// Gives `range` back, merged with the free ranges beside it.
+    pub fn give(&mut self, range: Range<u32>) {
+        let (mut start, mut len) = (range.start, range.len() as u32);
+        if let Some((&before, &before_len)) = self.free.range(..start).next_back()
+            && before + before_len == start
+        {
+            self.free.remove(&before);
+            start = before;
+            len += before_len;
+        }
+        if let Some(after_len) = self.free.remove(&(start + len)) {
+            len += after_len;
+        }
+        self.free.insert(start, len);
+    }
+
+    /// Grows the run to `capacity` slots, the new ones free.
+    pub fn grow(&mut self, capacity: u32) {
+        if capacity > self.capacity {
+            let old = std::mem::replace(&mut self.capacity, capacity);
+            self.give(old..capacity);
+        }
+    }
+
+    /// The largest free range's length.
+    fn largest(&self) -> u32 {
+        self.free.values().copied().max().unwrap_or(0)
+    }
+}
+
+/// Every chunk's instances in one buffer, by chunk render entity.
+#[derive(Resource, Default)]
+pub(in crate::instancing) struct InstanceSlab {
+    buffer: Option<Buffer>,
+    ranges: Ranges,
+    owners: HashMap<Entity, Range<u32>>,
+}
+
+impl InstanceSlab {
+    /// The buffer, once a chunk was placed.
+    pub fn buffer(&self) -> Option<&Buffer> {
+        self.buffer.as_ref()
+    }
+
+    /// The instances `chunk` owns.
+    pub fn range(&self, chunk: Entity) -> Option<Range<u32>> {
+        self.owners.get(&chunk).cloned()
+    }
+
+    /// The bytes of `chunk`'s instances, and the buffer.
+    pub fn slice(&self, chunk: Entity) -> Option<(&Buffer, Range<u64>)> {
+        let range = self.owners.get(&chunk)?;
+        let bytes = u64::from(range.start) * INSTANCE_BYTES..u64::from(range.end) * INSTANCE_BYTES;
+        Some((self.buffer.as_ref()?, bytes))
+    }
+
+    /// Places `instances` (at least one) as `chunk`'s, in place of any it owned; `false`
+    /// when the buffer cannot grow to hold them (nothing owned then).
+    pub fn place(
+        &mut self,
+        chunk: Entity,
+        instances: &[GpuInstance],
+        device: &RenderDevice,
+        queue: &RenderQueue,
+    ) -> bool {
+        self.free(chunk);
+        let Ok(len) = u32::try_from(instances.len()) else {
+            return false;
+        };
+        if len == 0 {
+            return false;
+        }
+        if self.ranges.largest() < len && !self.grow(len, device, queue) {
+            return false;
+        }
+        let Some(range) = self.ranges.take(len) else {
+            return false;
+        };
+        if let Some(buffer) = &self.buffer {
+            let at = u64::from(range.start) * INSTANCE_BYTES;
+            queue.write_buffer(buffer, at, bytemuck::cast_slice(instances));
+        }
+        self.owners.insert(chunk, range);
+        true
+    }
+
+    /// Frees the ranges of the chunks `live` no longer holds.
+    pub fn keep_only(&mut self, live: impl Fn(Entity) -> bool) {
+        let gone: Vec<Entity> = self.owners.keys().copied().filter(|&e| !live(e)).collect();
+        for chunk in gone {
+            self.free(chunk);
+        }
+    }
+
+    fn free(&mut self, chunk: Entity) {
+        if let Some(range) = self.owners.remove(&chunk) {
+            self.ranges.give(range);
+        }
+    }
+
+    /// Makes the buffer anew with room for `len` more instances in one range (doubling),
+    /// the old one's instances copied over; `false` past one binding's limit.
+    fn grow(&mut self, len: u32, device: &RenderDevice, queue: &RenderQueue) -> bool {
+        let limit = most_instances(device);
+        let old = self.ranges.capacity;
+        // The free range at the end, if any, grows with the buffer.
+        let tail = self
+            .ranges
+            .free
+            .last_key_value()
+            .filter(|&(&start, &free)| start + free == old)
+            .map_or(0, |(_, &free)| free);
+        let need = u64::from(old) + u64::from(len - tail);
+        let capacity = need
+            .max(2 * u64::from(old))
+            .max(u64::from(FIRST_CAPACITY))
+            .min(limit);
+        if capacity < need {
+            warn_once!("rwt: instances pass what one GPU binding holds; drawing some chunks whole");
+            return false;
+        }
+        let capacity = capacity as u32;
+        let buffer = device.create_buffer(&BufferDescriptor {
+            label: Some("rwt_instance_slab"),
+            size: u64::from(capacity) * INSTANCE_BYTES,
+            usage: BufferUsages::VERTEX
+                | BufferUsages::STORAGE
+                | BufferUsages::COPY_DST
+                | BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        if let Some(old_buffer) = &self.buffer {
+            // Submitted now: writes queued before it land in the old buffer first, those
+            // queued after in the new one.
+            let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor {
+                label: Some("rwt_instance_slab_grow"),
+            });
+            encoder.copy_buffer_to_buffer(old_buffer, 0, &buffer, 0, old_buffer.size());
+            queue.submit([encoder.finish()]);
+        }
+        self.buffer = Some(buffer);
+        self.ranges.grow(capacity);
+        true
+    }
+}
+
+/// The most instances one buffer may hold: what one storage binding and one buffer may.
+fn most_instances(device: &RenderDevice) -> u64 {
+    let limits = device.limits();
+    let bytes = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
+    (bytes / INSTANCE_BYTES).min(u64::from(u32::MAX))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Ranges;
+
+    fn ranges(capacity: u32) -> Ranges {
+        let mut r = Ranges::default();
+        r.grow(capacity);
+        r
+    }
+
+    #[test]
+    fn ranges_are_taken_best_fit_and_merged_when_given_back() {
+        let mut r = ranges(100);
+        let a = r.take(10).unwrap();
+        let b = r.take(20).unwrap();
+        let c = r.take(30).unwrap();
+        assert_eq!((a.clone(), b.clone(), c.clone()), (0..10, 10..30, 30..60));
+        r.give(a);
+        r.give(c);
+        // Free: 0..10 and 30..100. Five fit best in the ten at the start.
+        assert_eq!(r.take(5), Some(0..5));
+        assert_eq!(r.take(50), Some(30..80));
+        assert_eq!(r.take(30), None);
+        r.give(b);
+        // 5..30 is free again, one range with 5..10 (merged on both sides of 10).
+        assert_eq!(r.take(25), Some(5..30));
+        assert_eq!(r.take(21), None);
+        assert_eq!(r.take(20), Some(80..100));
+    }
+
+    #[test]
+    fn growing_frees_the_new_slots_merged_with_the_tail() {
+        let mut r = ranges(10);
+        let a = r.take(6).unwrap();
+        assert_eq!(r.largest(), 4);
+        r.grow(20);
+        assert_eq!(r.largest(), 14);
+        assert_eq!(r.take(14), Some(6..20));
+        r.give(a);
+        assert_eq!(r.take(6), Some(0..6));
+        assert_eq!(r.take(1), None);
+    }
+}
