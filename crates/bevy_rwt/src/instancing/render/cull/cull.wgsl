@@ -1,6 +1,6 @@
 // Culling per instance: one dispatch per view, over every chunk the CPU kept in it (a
-// record each, their instances in one slab). Each workgroup finds its record; each
-// invocation tests one instance against the view and, when it may be seen, copies it into
+// record each, their instances in one slab). Each invocation finds its record and
+// tests one instance against the view and, when it may be seen, copies it into
 // the chunk's kept instances in the view and counts it in the chunk's indirect draw
 // arguments.
 //
@@ -88,9 +88,6 @@ struct Record {
 // Words of one instance (`GpuInstance`: offset and scale, yaw and appearance, tint and
 // tilt).
 const WORDS: u32 = 6u;
-
-// The workgroup's record, found by its first invocation.
-var<workgroup> workgroup_record: u32;
 
 // The record of the view's workgroup `group`: the last whose first workgroup is not after
 // it.
@@ -210,14 +207,12 @@ fn cull_instances(
     @builtin(local_invocation_index) lane: u32,
 ) {
     let group = workgroup.x + workgroup.y * view.workgroups_x;
-    if lane == 0u && group < view.workgroups {
-        workgroup_record = record_of(group);
-    }
-    let record = workgroupUniformLoad(&workgroup_record);
     if group >= view.workgroups {
         return;
     }
-    let r = records[record];
+    // Each invocation searches (no workgroup barrier: lavapipe runs a shader with one as
+    // coroutines, several times slower).
+    let r = records[record_of(group)];
     let i = (group - r.first_workgroup) * 64u + lane;
     if i >= r.instances {
         return;

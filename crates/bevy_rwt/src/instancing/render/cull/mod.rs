@@ -99,13 +99,14 @@ pub(in crate::instancing) struct InstanceCuller {
     fresh_pool: bool,
     /// Every draw's indirect arguments: the early block, then the late block.
     args: Option<Buffer>,
-    /// One bit per instance of an occluding dispatch: hidden in the early phase.
+    /// One bit per instance of a chunk in an occluding view: hidden in the early phase.
     marks: Option<Buffer>,
     /// The early block put aside during the late prepass, then the early block with no
     /// instances ([`occlusion`]).
     phases: Option<Buffer>,
     /// The pyramids views occlude with.
     pyramids: occlusion::Pyramids,
+    /// The bind group every dispatch of the frame uses.
     bind: Option<FrameBind>,
     /// This frame's culled draws, by (view, chunk) render entity.
     draws: HashMap<(Entity, Entity), CulledDraw>,
@@ -115,7 +116,7 @@ pub(in crate::instancing) struct InstanceCuller {
     late: HashMap<Entity, occlusion::LateWork>,
     /// This frame's draws (records in each block of the arguments).
     draw_count: u32,
-    /// This frame's dispatches, in the order of their arguments, for the check.
+    /// This frame's culled draws, in the order of their arguments, for the check.
     #[cfg(feature = "testing")]
     checked: Vec<super::cull_check::Checked>,
 }
@@ -127,8 +128,8 @@ impl InstanceCuller {
         Some((draw, self.kept.as_ref()?, self.args.as_ref()?))
     }
 
-    /// This frame's dispatches (uniform, instances, whether it occludes), in the order of
-    /// their arguments.
+    /// This frame's culled draws (view, record, instances, whether it occludes), in the
+    /// order of their arguments.
     #[cfg(feature = "testing")]
     pub(super) fn checked(&self) -> &[super::cull_check::Checked] {
         &self.checked
@@ -315,6 +316,10 @@ pub(in crate::instancing) fn cull_instances(
     };
     culler.write(&dispatches, &mut plan, &device, &queue);
     culler.bind(slab, plan.pool_binding, &device, &cache);
+    if culler.bind.is_none() {
+        culler.late.clear();
+        return;
+    }
     let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor {
         label: Some("rwt_cull"),
     });
