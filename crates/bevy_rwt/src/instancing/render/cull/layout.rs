@@ -3,7 +3,6 @@
 
 use super::{
     ARGS_WORDS, CullRecord, CullView, Dispatch, INSTANCE_BYTES, InstanceCuller, WORKGROUP,
-    occlusion,
 };
 use crate::look::InstancedShadows;
 use bevy::prelude::*;
@@ -11,12 +10,12 @@ use bevy::render::render_resource::*;
 use bevy::render::renderer::RenderDevice;
 use std::ops::Range;
 
-/// Where one chunk's data in a view lies: its kept instances (bytes into the pool), its
-/// draw; and its late phase's, where the view occludes.
+/// Where one chunk's data in a view lies: where it keeps its instances (bytes into the
+/// pool), its draw; and where its late phase keeps them, where the view occludes.
 pub(super) struct Offsets {
     pub kept: u64,
     pub draw: u32,
-    pub late: Option<occlusion::LateOffsets>,
+    pub late: Option<u64>,
 }
 
 /// One view's early dispatch: its records, its workgroups, where its kept instances lie in
@@ -73,7 +72,7 @@ impl InstanceCuller {
                 .iter()
                 .zip(&dispatches[first..last])
                 .map(|(o, d)| {
-                    let range_end = o.late.as_ref().map_or(o.kept, |l| l.kept);
+                    let range_end = o.late.unwrap_or(o.kept);
                     range_end + u64::from(d.gpu.count) * INSTANCE_BYTES - pool
                 })
                 .max()
@@ -137,9 +136,7 @@ impl InstanceCuller {
                 r.late_kept = place(d.gpu.count);
                 r.first_mark = *marks;
                 *marks += d.gpu.count.div_ceil(32);
-                occlusion::LateOffsets {
-                    kept: at(r.late_kept),
-                }
+                at(r.late_kept)
             });
             let draw = first_draw + i as u32;
             r.count_word = draw * ARGS_WORDS + 1;

@@ -373,7 +373,7 @@ impl InstanceCuller {
                 instances: d.extracted.buffer.clone(),
                 occludes: o.late.is_some(),
                 kept: o.kept..o.kept + bytes(d),
-                late: o.late.as_ref().map(|l| l.kept..l.kept + bytes(d)),
+                late: o.late.map(|l| l..l + bytes(d)),
             });
         }
         #[cfg(not(feature = "testing"))]
@@ -383,9 +383,9 @@ impl InstanceCuller {
                 args: u64::from(o.draw * ARGS_WORDS * 4),
                 kept: o.kept..o.kept + bytes(d),
             };
-            let late = o.late.as_ref().map(|late| CulledRange {
+            let late = o.late.map(|late| CulledRange {
                 args: u64::from((self.draw_count + o.draw) * ARGS_WORDS * 4),
-                kept: late.kept..late.kept + bytes(d),
+                kept: late..late + bytes(d),
             });
             self.draws
                 .insert((d.view.entity, d.chunk), CulledDraw { early, late });

@@ -144,11 +144,6 @@ impl Pyramids {
     }
 }
 
-/// Where one chunk's late phase keeps its instances (bytes into the pool).
-pub(super) struct LateOffsets {
-    pub kept: u64,
-}
-
 /// One view's late phase this frame: its draws (records of the early block), its settings'
 /// dynamic offset, its binding of the pool and its workgroups.
 pub(super) struct LateWork {
