@@ -336,7 +336,7 @@ pub(in crate::instancing) fn cull_instances(
     culler.early = plan.early;
     culler.dispatch_early(&mut encoder, pipeline);
     queue.submit([encoder.finish()]);
-    culler.record(&dispatches, &plan.offsets, &plan.records);
+    culler.record(&dispatches, &plan.offsets);
 }
 
 impl InstanceCuller {
@@ -360,12 +360,12 @@ impl InstanceCuller {
         }
     }
 
-    /// Records this frame's culled draws and each occluding view's late phase.
-    fn record(&mut self, dispatches: &[Dispatch], offsets: &[Offsets], records: &[CullRecord]) {
+    /// Records this frame's culled draws (and, for the check, what culled each).
+    fn record(&mut self, dispatches: &[Dispatch], offsets: &[Offsets]) {
         self.draw_count = dispatches.len() as u32;
         let bytes = |d: &Dispatch| u64::from(d.gpu.count) * INSTANCE_BYTES;
         #[cfg(feature = "testing")]
-        for ((d, o), record) in dispatches.iter().zip(offsets).zip(records) {
+        for ((d, o), record) in dispatches.iter().zip(offsets).zip(self.records.get()) {
             let view = self.early.iter().find(|v| v.entity == d.view.entity);
             self.checked.push(super::cull_check::Checked {
                 view: view.map(|v| v.params_value).unwrap_or_default(),
@@ -376,8 +376,6 @@ impl InstanceCuller {
                 late: o.late.map(|l| l..l + bytes(d)),
             });
         }
-        #[cfg(not(feature = "testing"))]
-        let _ = records;
         for (d, o) in dispatches.iter().zip(offsets) {
             let early = CulledRange {
                 args: u64::from(o.draw * ARGS_WORDS * 4),
@@ -489,7 +487,7 @@ impl InstanceCuller {
         for r in &mut plan.records {
             r.late_count_word = late_block + r.count_word;
         }
-        self.records.set(plan.records.clone());
+        self.records.set(std::mem::take(&mut plan.records));
         self.records.write_buffer(device, queue);
         self.views.clear();
         for work in &mut plan.early {
