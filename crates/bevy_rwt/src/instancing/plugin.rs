@@ -18,6 +18,7 @@ use bevy::render::extract_component::ExtractComponentPlugin;
 use bevy::render::extract_resource::ExtractResourcePlugin;
 use bevy::render::render_phase::AddRenderCommand;
 use bevy::render::render_resource::SpecializedMeshPipelines;
+use bevy::render::renderer::{RenderGraph, RenderGraphSystems};
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
 /// Draws instanced classes (part of [`crate::RwtPlugins`]) and reports classes it cannot
@@ -123,6 +124,10 @@ fn build_render(app: &mut App) {
                     .in_set(RenderSystems::QueueMeshes),
                 render::cull_instances.in_set(RenderSystems::PrepareBindGroups),
             ),
+        )
+        .add_systems(
+            RenderGraph,
+            render::encode_cull.in_set(RenderGraphSystems::Begin),
         )
         .add_systems(
             Core3d,

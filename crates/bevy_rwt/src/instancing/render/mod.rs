@@ -21,7 +21,9 @@ mod shader_check;
 mod slab;
 mod uniforms;
 
-pub(super) use cull::{InstanceCuller, cull_instances, cull_late, init_culler, restore_early};
+pub(super) use cull::{
+    InstanceCuller, cull_instances, cull_late, encode_cull, init_culler, restore_early,
+};
 #[cfg(feature = "testing")]
 pub use cull_check::{CullingCheck, CullingReport};
 #[cfg(feature = "testing")]

@@ -162,10 +162,15 @@ fn hidden(center: vec3<f32>, radius: f32, clip_from_world: mat4x4<f32>) -> bool 
     var lo = vec2<f32>(1.0);
     var hi = vec2<f32>(0.0);
     var nearest = 0.0;
+    // A corner's clip position is the center's plus or minus each axis's column times the
+    // radius: one product with the matrix rather than eight.
+    let middle = clip_from_world * vec4<f32>(center, 1.0);
+    let x = clip_from_world[0] * radius;
+    let y = clip_from_world[1] * radius;
+    let z = clip_from_world[2] * radius;
     for (var i = 0u; i < 8u; i++) {
-        let side = vec3<bool>((i & 1u) != 0u, (i & 2u) != 0u, (i & 4u) != 0u);
-        let corner = center + select(vec3<f32>(-radius), vec3<f32>(radius), side);
-        let clip = clip_from_world * vec4<f32>(corner, 1.0);
+        let clip = middle + select(-x, x, (i & 1u) != 0u) + select(-y, y, (i & 2u) != 0u)
+            + select(-z, z, (i & 4u) != 0u);
         if clip.w <= 0.0 {
             return false;
         }

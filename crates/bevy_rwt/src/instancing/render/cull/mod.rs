@@ -5,9 +5,9 @@
 //! buffer ([`InstanceSlab`]): each instance is tested against the view and, when it may be
 //! seen, copied into the frame's pool of kept instances, and counted in its draw's indirect
 //! arguments. The chunk's draws in that view then read their instances from the pool and
-//! their count from the arguments ([`CulledDraw`]). The compute work is submitted before
-//! the frame's passes, so every pass of the view (prepasses, main pass, shadow map) reads
-//! what it wrote. A chunk without a culled draw (culling off, the adapter unable, the pool
+//! their count from the arguments ([`CulledDraw`]). The compute work is encoded at the start
+//! of the frame's render graph ([`encode_cull`]), before every view's passes, so each pass
+//! of the view (prepasses, main pass, shadow map) reads what it wrote. A chunk without a culled draw (culling off, the adapter unable, the pool
 //! full, or nothing culling could drop: [`whole`]) is drawn directly, whole.
 //!
 //! A camera with Bevy's `OcclusionCulling` and `DepthPrepass` also culls what its depth
@@ -43,7 +43,7 @@ use bevy::render::render_resource::binding_types::{
     storage_buffer_read_only, storage_buffer_read_only_sized, storage_buffer_sized,
 };
 use bevy::render::render_resource::*;
-use bevy::render::renderer::{RenderAdapter, RenderDevice, RenderQueue};
+use bevy::render::renderer::{RenderAdapter, RenderContext, RenderDevice, RenderQueue};
 use bevy::render::sync_world::MainEntity;
 use bevy::render::view::{ExtractedView, RetainedViewEntity};
 use std::num::NonZero;
@@ -277,8 +277,8 @@ pub(in crate::instancing) struct CullInputs<'w, 's> {
     slab: Res<'w, InstanceSlab>,
 }
 
-/// Culls the instances of every chunk binned into every view, and submits the work before
-/// the frame's passes.
+/// Lays out and writes the culling of every chunk binned into every view, and records the
+/// culled draws ([`encode_cull`] encodes the work).
 pub(in crate::instancing) fn cull_instances(
     mut culler: ResMut<InstanceCuller>,
     inputs: CullInputs,
@@ -292,12 +292,10 @@ pub(in crate::instancing) fn cull_instances(
     #[cfg(feature = "testing")]
     culler.checked.clear();
     let on = inputs.setting.as_deref().copied().unwrap_or_default() != InstanceCulling::PerChunk;
-    let Some(pipeline) = culler.pipeline.filter(|_| on) else {
+    let ready = culler.pipeline.filter(|_| on);
+    if ready.and_then(|p| cache.get_compute_pipeline(p)).is_none() {
         return;
-    };
-    let Some(pipeline) = cache.get_compute_pipeline(pipeline) else {
-        return;
-    };
+    }
     let culler = culler.as_mut();
     let views = inputs
         .views
@@ -320,9 +318,25 @@ pub(in crate::instancing) fn cull_instances(
         culler.late.clear();
         return;
     }
-    let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor {
-        label: Some("rwt_cull"),
-    });
+    culler.early = plan.early;
+    culler.record(&dispatches, &plan.offsets);
+}
+
+/// At the start of the frame's render graph, before any view's passes: encodes the early
+/// phase (clearing the marks, and the pool where it is new). Encoded with the frame's
+/// commands, as Bevy's own preprocessing is, rather than submitted apart from them.
+pub(in crate::instancing) fn encode_cull(
+    mut culler: ResMut<InstanceCuller>,
+    cache: Res<PipelineCache>,
+    mut ctx: RenderContext,
+) {
+    if culler.early.is_empty() {
+        return;
+    }
+    let Some(pipeline) = culler.pipeline.and_then(|p| cache.get_compute_pipeline(p)) else {
+        return;
+    };
+    let encoder = ctx.command_encoder();
     if let Some(marks) = &culler.marks {
         encoder.clear_buffer(marks, 0, None);
     }
@@ -333,10 +347,7 @@ pub(in crate::instancing) fn cull_instances(
         encoder.clear_buffer(kept, 0, None);
         culler.fresh_pool = false;
     }
-    culler.early = plan.early;
-    culler.dispatch_early(&mut encoder, pipeline);
-    queue.submit([encoder.finish()]);
-    culler.record(&dispatches, &plan.offsets);
+    culler.dispatch_early(encoder, pipeline);
 }
 
 impl InstanceCuller {
