@@ -102,11 +102,13 @@ impl<K: Clone + PartialEq> Binned<K> {
         done
     }
 
-    /// The items binned into each view (by main entity).
-    pub fn binned(&self) -> impl Iterator<Item = (&RetainedViewEntity, Vec<MainEntity>)> {
+    /// The items binned into each view (their render entities).
+    pub fn binned(
+        &self,
+    ) -> impl Iterator<Item = (&RetainedViewEntity, impl Iterator<Item = Entity> + '_)> {
         self.views
             .iter()
-            .map(|(view, items)| (view, items.keys().copied().collect()))
+            .map(|(view, items)| (view, items.values().map(|(_, entity)| *entity)))
     }
 
     /// Forgets the views not binned this frame (their phases are gone with them).
@@ -184,8 +186,8 @@ mod tests {
         assert_eq!(log.0, ["add 11 3", "add 13 1", "remove 11", "remove 12"]);
         let mut now: Vec<u32> = binned
             .binned()
-            .flat_map(|(_, m)| m)
-            .map(|m| m.index_u32())
+            .flat_map(|(_, entities)| entities)
+            .map(|e| e.index_u32())
             .collect();
         now.sort();
         assert_eq!(now, [10, 11, 13]);

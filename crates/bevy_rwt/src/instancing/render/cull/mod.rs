@@ -44,7 +44,6 @@ use bevy::render::render_resource::binding_types::{
 };
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderAdapter, RenderContext, RenderDevice, RenderQueue};
-use bevy::render::sync_world::MainEntity;
 use bevy::render::view::{ExtractedView, RetainedViewEntity};
 use std::num::NonZero;
 use std::ops::Range;
@@ -261,16 +260,7 @@ pub(in crate::instancing) struct CullInputs<'w, 's> {
     prepass: Res<'w, Queued<Opaque3dPrepass>>,
     shadow: Res<'w, Queued<Shadow>>,
     views: Query<'w, 's, ViewData>,
-    chunks: Query<
-        'w,
-        's,
-        (
-            Entity,
-            &'static MainEntity,
-            &'static ExtractedChunk,
-            &'static GpuChunk,
-        ),
-    >,
+    chunks: Query<'w, 's, (&'static ExtractedChunk, &'static GpuChunk)>,
     meshes: Res<'w, RenderAssets<RenderMesh>>,
     allocator: Res<'w, MeshAllocator>,
     viewer: Res<'w, MainViewer>,
@@ -433,27 +423,22 @@ impl CullInputs<'_, '_> {
                 (view.retained_view_entity, cull)
             })
             .collect();
-        let chunks: HashMap<MainEntity, _> = self
-            .chunks
-            .iter()
-            .map(|(entity, main, extracted, gpu)| (*main, (entity, extracted, gpu)))
-            .collect();
-        let mut pairs: Vec<(ViewCull, Entity, &ExtractedChunk, &GpuChunk)> = Vec::new();
-        let binned = self
-            .main
-            .binned()
-            .chain(self.prepass.binned())
-            .chain(self.shadow.binned());
-        for (retained, binned) in binned {
+        // The view by reference: sorting moves each pair, and a view is some 250 bytes.
+        let mut pairs: Vec<(&ViewCull, Entity, &ExtractedChunk, &GpuChunk)> = Vec::new();
+        let mut add = |retained: &RetainedViewEntity,
+                       entities: &mut dyn Iterator<Item = Entity>| {
             let Some(view) = views.get(retained) else {
-                continue;
+                return;
             };
-            for main in binned {
-                if let Some(&(entity, extracted, gpu)) = chunks.get(&main) {
-                    pairs.push((*view, entity, extracted, gpu));
+            for entity in entities {
+                if let Ok((extracted, gpu)) = self.chunks.get(entity) {
+                    pairs.push((view, entity, extracted, gpu));
                 }
             }
-        }
+        };
+        self.main.binned().for_each(|(r, mut e)| add(r, &mut e));
+        self.prepass.binned().for_each(|(r, mut e)| add(r, &mut e));
+        self.shadow.binned().for_each(|(r, mut e)| add(r, &mut e));
         pairs.sort_by_key(|(view, chunk, ..)| (view.entity, *chunk));
         pairs.dedup_by_key(|(view, chunk, ..)| (view.entity, *chunk));
         pairs
@@ -466,7 +451,7 @@ impl CullInputs<'_, '_> {
                 let args = self.args(extracted)?;
                 let first_instance = self.slab.range(chunk).filter(|_| gpu.own.is_none())?.start;
                 Some(Dispatch {
-                    view,
+                    view: *view,
                     chunk,
                     extracted,
                     gpu,
