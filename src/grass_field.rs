@@ -2,7 +2,7 @@
 //! streamed around a camera 2 m above it, under a sun with cascaded shadow maps.
 
 use bevy::prelude::*;
-use bevy_rwt::look::blade_mesh;
+use bevy_rwt::look::{blade_mesh, blade_mesh_with_rows};
 use bevy_rwt::prelude::*;
 
 /// Streaming radius of the field, metres.
@@ -37,6 +37,12 @@ pub fn spawn_sun_and_ground(
 /// The grass blade every field draws.
 pub fn blade() -> Mesh {
     blade_mesh(0.09, 0.72, 0.12)
+}
+
+/// [`blade`] with three rows of vertices instead of five (6 vertices instead of 10), for far
+/// chunks ([`ScatterClass::with_instanced_far`]).
+pub fn far_blade() -> Mesh {
+    blade_mesh_with_rows(0.09, 0.72, 0.12, 3)
 }
 
 /// About `count` blades a square metre spread over the field's streamed disc (the loaded

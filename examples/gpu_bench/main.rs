@@ -2,7 +2,8 @@
 //!
 //! `scripts/gpu_bench.sh` runs it (built on any machine, run on one with a GPU), or
 //! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
-//! [--thin 25] [--shadow-distance 0] [--forest thinned|impostors] [--shots DIR] [--detail]`;
+//! [--thin 25] [--shadow-distance 0] [--far-blade 0] [--forest thinned|impostors] [--shots DIR]
+//! [--detail]`;
 //! `--shots` saves one
 //! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
@@ -13,7 +14,9 @@
 //! from `--thin` metres (25 by default, as a game sets it; 0: never), see
 //! [`InstancedThinning`]. With shadows on, every blade casts, or with `--shadow-distance`
 //! those within that many metres of the camera (open_world's grass casts within 25 m,
-//! [`InstancedShadows::Within`]). For each blade count
+//! [`InstancedShadows::Within`]). With `--far-blade`, chunks farther than that many metres
+//! draw a blade of 6 vertices instead of 10 ([`grass_field::far_blade`]; 0, the default:
+//! none). For each blade count
 //! (millions of live blades) with the grass's shadows off, then on, each with culling per
 //! instance on the GPU off, then on ([`InstanceCulling`]), it waits for streaming to settle,
 //! warms up for 2 s, times `--frames` frames and prints exactly one line:
@@ -70,7 +73,7 @@ fn main() {
         Err(message) => {
             eprintln!("gpu_bench: {message}");
             eprintln!(
-                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--forest thinned|impostors] (M: millions)"
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--forest thinned|impostors] (M: millions)"
             );
             std::process::exit(2);
         }
@@ -132,6 +135,8 @@ struct Options {
     thin: f32,
     /// Distance from the camera within which blades cast shadows (metres; 0: all do).
     shadow_distance: f32,
+    /// Distance from which chunks draw the far blade (metres; 0: none do).
+    far_blade: f32,
     /// Forests around the field, and how far trees are drawn.
     forest: Option<FarTrees>,
 }
@@ -146,6 +151,7 @@ impl Options {
             detail: false,
             thin: THIN_FROM,
             shadow_distance: 0.0,
+            far_blade: 0.0,
             forest: None,
         };
         while let Some(flag) = args.next() {
@@ -181,16 +187,16 @@ impl Options {
                     options.size = UVec2::new(side(w).ok_or_else(bad)?, side(h).ok_or_else(bad)?);
                 }
                 "--shots" => options.shots = Some(value.into()),
-                "--thin" | "--shadow-distance" => {
+                "--thin" | "--shadow-distance" | "--far-blade" => {
                     let metres = value
                         .parse()
                         .ok()
                         .filter(|m: &f32| (0.0..=1e4).contains(m))
                         .ok_or_else(bad)?;
-                    if flag == "--thin" {
-                        options.thin = metres;
-                    } else {
-                        options.shadow_distance = metres;
+                    match flag.as_str() {
+                        "--thin" => options.thin = metres,
+                        "--shadow-distance" => options.shadow_distance = metres,
+                        _ => options.far_blade = metres,
                     }
                 }
                 "--forest" => {
@@ -327,7 +333,11 @@ fn setup(
         ..default()
     };
     let blade = meshes.add(grass_field::blade());
-    let grass = ScatterClass::instanced(LayerDensity::Constant(density), blade, material);
+    let mut grass = ScatterClass::instanced(LayerDensity::Constant(density), blade, material);
+    if bench.options.far_blade > 0.0 {
+        let far = meshes.add(grass_field::far_blade());
+        grass = grass.with_instanced_far(far, bench.options.far_blade);
+    }
     commands.spawn((Grass, field_layer(grass)));
     if let Some(far) = bench.options.forest {
         let material = materials.add(StandardMaterial {

@@ -4,7 +4,7 @@ use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 
-/// Rows of vertices along the blade, root to tip.
+/// Rows of vertices along [`blade_mesh`]'s blade, root to tip.
 const ROWS: usize = 5;
 
 /// A grass blade standing on its root at the origin: `width` at the root, tapering to a tip
@@ -12,10 +12,18 @@ const ROWS: usize = 5;
 /// instanced pipeline does not cull back faces); normals lean up a little so that a meadow
 /// catches the sun like grass rather than like a field of cards.
 pub fn blade_mesh(width: f32, height: f32, bend: f32) -> Mesh {
-    let mut positions = Vec::with_capacity(2 * ROWS);
-    let mut normals = Vec::with_capacity(2 * ROWS);
-    for row in 0..ROWS {
-        let t = row as f32 / (ROWS - 1) as f32;
+    blade_mesh_with_rows(width, height, bend, ROWS)
+}
+
+/// [`blade_mesh`]'s blade with `rows` rows of two vertices (at least 2), root to tip: fewer
+/// for a far level of detail ([`InstancedFar`](crate::look::InstancedFar)), where the
+/// curve's few pixels do not need five.
+pub fn blade_mesh_with_rows(width: f32, height: f32, bend: f32, rows: usize) -> Mesh {
+    let rows = rows.max(2);
+    let mut positions = Vec::with_capacity(2 * rows);
+    let mut normals = Vec::with_capacity(2 * rows);
+    for row in 0..rows {
+        let t = row as f32 / (rows - 1) as f32;
         // Full width to about halfway, then a pointed tip.
         let half = 0.5 * width * (1.0 - t.powf(2.5));
         let forward = bend * t * t;
@@ -27,8 +35,8 @@ pub fn blade_mesh(width: f32, height: f32, bend: f32) -> Mesh {
             normals.push(normal.normalize().to_array());
         }
     }
-    let mut indices = Vec::with_capacity(6 * (ROWS - 1));
-    for r in 0..ROWS as u32 - 1 {
+    let mut indices = Vec::with_capacity(6 * (rows - 1));
+    for r in 0..rows as u32 - 1 {
         let (a, b, c, d) = (2 * r, 2 * r + 1, 2 * r + 2, 2 * r + 3);
         indices.extend([a, b, d, a, d, c]);
     }
@@ -59,5 +67,16 @@ mod tests {
             panic!("normals");
         };
         assert!(n.iter().all(|n| n[2] > 0.5 && n[1] > 0.0), "{n:?}");
+    }
+
+    #[test]
+    fn a_far_blade_has_the_same_bounds_with_fewer_vertices() {
+        let near = blade_mesh(0.1, 0.7, 0.12);
+        let far = blade_mesh_with_rows(0.1, 0.7, 0.12, 3);
+        let bounds = |m: &Mesh| check_instanced_mesh(m).unwrap().unwrap();
+        assert_eq!(bounds(&near), bounds(&far));
+        assert_eq!((near.count_vertices(), far.count_vertices()), (10, 6));
+        // Fewer than two rows would be no strip at all.
+        assert_eq!(blade_mesh_with_rows(0.1, 0.7, 0.12, 0).count_vertices(), 4);
     }
 }

@@ -9,7 +9,7 @@ mod check;
 mod impostor;
 mod instanced;
 
-pub use blade::blade_mesh;
+pub use blade::{blade_mesh, blade_mesh_with_rows};
 pub use check::{InstancedClassError, check_instanced_mesh};
 pub(crate) use check::{check_texture, check_topology};
 pub use impostor::Impostor;
