@@ -3,7 +3,7 @@
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::layers::file::NamedAssets;
-use bevy_rwt::look::blade_mesh;
+use bevy_rwt::look::{blade_mesh, blade_mesh_with_rows};
 use bevy_rwt::prelude::*;
 use glam::DVec2;
 use noise::{NoiseFn, Perlin};
@@ -19,6 +19,9 @@ const MAP_TEXELS: u32 = 2048;
 const GRASS_SHADOWS: f32 = 25.0;
 /// Grass thins out from this far from the camera (metres).
 const GRASS_THINNING: f32 = 25.0;
+/// Grass chunks farther than this from the camera draw a blade of 6 vertices instead of 10
+/// (metres).
+const GRASS_FAR_BLADE: f32 = 30.0;
 const MAP_SIZE: f32 = 4096.0;
 
 /// Flower colours (petals), one painted map and instanced class each.
@@ -204,6 +207,8 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
         },
     );
     class.scale_variation = 0.35;
+    let far = meshes.add(blade_mesh_with_rows(0.085, 0.6, 0.11, 3));
+    let class = class.with_instanced_far(far, GRASS_FAR_BLADE);
     ScatterLayer::new(vec![class])
         .with_seed(3)
         .with_tile_size(4.0)
