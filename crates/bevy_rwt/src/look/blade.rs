@@ -15,11 +15,11 @@ pub fn blade_mesh(width: f32, height: f32, bend: f32) -> Mesh {
     blade_mesh_with_rows(width, height, bend, ROWS)
 }
 
-/// [`blade_mesh`]'s blade with `rows` rows of two vertices (at least 2), root to tip: fewer
+/// [`blade_mesh`]'s blade with `rows` rows of two vertices (2 to 64), root to tip: fewer
 /// for a far level of detail ([`InstancedFar`](crate::look::InstancedFar)), where the
 /// curve's few pixels do not need five.
 pub fn blade_mesh_with_rows(width: f32, height: f32, bend: f32, rows: usize) -> Mesh {
-    let rows = rows.max(2);
+    let rows = rows.clamp(2, 64);
     let mut positions = Vec::with_capacity(2 * rows);
     let mut normals = Vec::with_capacity(2 * rows);
     for row in 0..rows {
@@ -76,7 +76,9 @@ mod tests {
         let bounds = |m: &Mesh| check_instanced_mesh(m).unwrap().unwrap();
         assert_eq!(bounds(&near), bounds(&far));
         assert_eq!((near.count_vertices(), far.count_vertices()), (10, 6));
-        // Fewer than two rows would be no strip at all.
+        // Fewer than two rows would be no strip at all; more than 64 nothing a blade needs.
         assert_eq!(blade_mesh_with_rows(0.1, 0.7, 0.12, 0).count_vertices(), 4);
+        let most = blade_mesh_with_rows(0.1, 0.7, 0.12, usize::MAX);
+        assert_eq!(most.count_vertices(), 128);
     }
 }

@@ -7,8 +7,9 @@
 //! arguments. The chunk's draws in that view then read their instances from the pool and
 //! their count from the arguments ([`CulledDraw`]). The compute work is encoded at the start
 //! of the frame's render graph ([`encode_cull`]), before every view's passes, so each pass
-//! of the view (prepasses, main pass, shadow map) reads what it wrote. A chunk without a culled draw (culling off, the adapter unable, the pool
-//! full, or nothing culling could drop: [`whole`]) is drawn directly, whole.
+//! of the view (prepasses, main pass, shadow map) reads what it wrote. A chunk without a
+//! culled draw (culling off, the adapter unable, the pool full, or nothing culling could
+//! drop: [`whole`]) is drawn directly, whole.
 //!
 //! A camera with Bevy's `OcclusionCulling` and `DepthPrepass` also culls what its depth
 //! pyramid hides, in two phases ([`occlusion`]): what last frame's depth hid is tested again
