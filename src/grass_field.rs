@@ -34,15 +34,18 @@ pub fn spawn_sun_and_ground(
     ));
 }
 
+/// The field's blade: width at the root, height and forward bend (metres).
+const BLADE: (f32, f32, f32) = (0.09, 0.72, 0.12);
+
 /// The grass blade every field draws.
 pub fn blade() -> Mesh {
-    blade_mesh(0.09, 0.72, 0.12)
+    blade_mesh(BLADE.0, BLADE.1, BLADE.2)
 }
 
 /// [`blade`] with three rows of vertices instead of five (6 vertices instead of 10), for far
 /// chunks ([`ScatterClass::with_instanced_far`]).
 pub fn far_blade() -> Mesh {
-    blade_mesh_with_rows(0.09, 0.72, 0.12, 3)
+    blade_mesh_with_rows(BLADE.0, BLADE.1, BLADE.2, 3)
 }
 
 /// About `count` blades a square metre spread over the field's streamed disc (the loaded

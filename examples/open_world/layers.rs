@@ -185,6 +185,8 @@ fn bushes(
 /// Grass blades, up to 140 per square metre, drawn from per-chunk instance buffers (no
 /// entity per blade), growing in and out with the level of detail.
 fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
+    // A blade's width at the root, height and forward bend (metres).
+    let (width, height, bend) = (0.085, 0.6, 0.11);
     let mut class = ScatterClass::instanced(
         LayerDensity::Noise(NoiseDensity::new(NoiseParams {
             seed: 3,
@@ -194,7 +196,7 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
             amplitude: 0.9,
             scale: 140.0,
         })),
-        meshes.add(blade_mesh(0.085, 0.6, 0.11)),
+        meshes.add(blade_mesh(width, height, bend)),
         InstancedShading {
             base_color: Color::srgb(0.05, 0.13, 0.025),
             tip_color: Color::srgb(0.33, 0.47, 0.12),
@@ -207,7 +209,8 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
         },
     );
     class.scale_variation = 0.35;
-    let far = meshes.add(blade_mesh_with_rows(0.085, 0.6, 0.11, 3));
+    // The same blade with three rows of vertices: same bounds, no pop but in its curve.
+    let far = meshes.add(blade_mesh_with_rows(width, height, bend, 3));
     let class = class.with_instanced_far(far, GRASS_FAR_BLADE);
     ScatterLayer::new(vec![class])
         .with_seed(3)
