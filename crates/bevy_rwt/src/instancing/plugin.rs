@@ -14,6 +14,7 @@ use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::ecs::schedule::InternedScheduleLabel;
 use bevy::pbr::{MeshPipelineSystems, Shadow, init_prepass_pipeline};
 use bevy::prelude::*;
+use bevy::render::diagnostic::begin_diagnostics_frame;
 use bevy::render::extract_component::ExtractComponentPlugin;
 use bevy::render::extract_resource::ExtractResourcePlugin;
 use bevy::render::render_phase::AddRenderCommand;
@@ -127,7 +128,10 @@ fn build_render(app: &mut App) {
         )
         .add_systems(
             RenderGraph,
-            render::encode_cull.in_set(RenderGraphSystems::Begin),
+            // After the diagnostics' frame begins, so the culling's GPU time is this frame's.
+            render::encode_cull
+                .in_set(RenderGraphSystems::Begin)
+                .after(begin_diagnostics_frame),
         )
         .add_systems(
             Core3d,

@@ -37,6 +37,7 @@ use bevy::core_pipeline::prepass::Opaque3dPrepass;
 use bevy::pbr::{LightEntity, Shadow};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
+use bevy::render::diagnostic::{DiagnosticsRecorder, RecordDiagnostics};
 use bevy::render::mesh::RenderMesh;
 use bevy::render::mesh::allocator::MeshAllocator;
 use bevy::render::render_asset::RenderAssets;
@@ -327,6 +328,7 @@ pub(in crate::instancing) fn encode_cull(
     let Some(pipeline) = culler.pipeline.and_then(|p| cache.get_compute_pipeline(p)) else {
         return;
     };
+    let diagnostics = ctx.diagnostic_recorder();
     let encoder = ctx.command_encoder();
     if let Some(marks) = &culler.marks {
         encoder.clear_buffer(marks, 0, None);
@@ -338,18 +340,24 @@ pub(in crate::instancing) fn encode_cull(
         encoder.clear_buffer(kept, 0, None);
         culler.fresh_pool = false;
     }
-    culler.dispatch_early(encoder, pipeline);
+    culler.dispatch_early(encoder, pipeline, diagnostics.as_deref());
 }
 
 impl InstanceCuller {
     /// Encodes the early phase (the only one, where the view does not occlude): one
-    /// dispatch per view.
-    fn dispatch_early(&self, encoder: &mut CommandEncoder, pipeline: &ComputePipeline) {
+    /// dispatch per view. Its GPU time is the render diagnostic `rwt_cull`.
+    fn dispatch_early(
+        &self,
+        encoder: &mut CommandEncoder,
+        pipeline: &ComputePipeline,
+        diagnostics: Option<&DiagnosticsRecorder>,
+    ) {
         let Some(bind) = &self.bind else { return };
         let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor {
             label: Some("rwt_cull"),
             timestamp_writes: None,
         });
+        let span = diagnostics.pass_span(&mut pass, "rwt_cull");
         pass.set_pipeline(pipeline);
         for view in &self.early {
             let Some(pyramid) = self.pyramids.bind_group(view.entity) else {
@@ -360,6 +368,7 @@ impl InstanceCuller {
             let (x, y) = grid(view.workgroups);
             pass.dispatch_workgroups(x, y, 1);
         }
+        span.end(&mut pass);
     }
 
     /// Records this frame's culled draws (and, for the check, what culled each).

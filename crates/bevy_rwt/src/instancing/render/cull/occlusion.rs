@@ -15,6 +15,7 @@ use bevy::core_pipeline::mip_generation::experimental::depth::ViewDepthPyramid;
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
+use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::render_resource::binding_types::texture_2d;
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
@@ -208,18 +209,22 @@ pub(in crate::instancing) fn cull_late(
     let Some(late) = culler.late_frame(view.entity(), &cache) else {
         return;
     };
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
     let encoder = ctx.command_encoder();
     {
         let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor {
             label: Some("rwt_cull_late"),
             timestamp_writes: None,
         });
+        let span = diagnostics.pass_span(&mut pass, "rwt_cull_late");
         pass.set_pipeline(late.pipeline);
         pass.set_bind_group(1, late.pyramid, &[]);
         let offsets = [late.work.params, late.work.pool as u32];
         pass.set_bind_group(0, late.bind_group, &offsets);
         let (x, y) = grid(late.work.workgroups);
         pass.dispatch_workgroups(x, y, 1);
+        span.end(&mut pass);
     }
     let bytes = late.work.bytes();
     let block = u64::from(culler.draw_count * ARGS_WORDS * 4);
