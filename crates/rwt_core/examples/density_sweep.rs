@@ -1,13 +1,17 @@
 //! Quality of uniform queries across densities, beside dart throwing computed in the same
-//! run: the normalized minimum distance (several windows of >= 24 000 points) and the
-//! low-frequency power of averaged spectra, both per multiple of the base tile capacity N.
+//! run: the normalized minimum distance (several windows of >= 24 000 points), the
+//! low-frequency power of averaged spectra and their worst anisotropy ring, all per multiple
+//! of the base tile capacity N.
 //!
 //! `cargo run --release -p rwt_core --example density_sweep [TILESET.ron]`
-//! (`MULT=0.3,4,6` picks the multiples; the default spans levels 0 to 2).
+//! (`MULT=0.3,4,6` picks the multiples; `MULT=quarter` every quarter octave from 0.3 N to
+//! 64 N; the default spans levels 0 to 2). The anisotropy column is the worst ring from the
+//! fourth on, in dB (12 spectra averaged: isotropic noise near -10.8 dB), with the
+//! frequency of that ring's strongest cell in cycles per base tile, `(u, v)`.
 use glam::DVec2;
 use rwt_core::analysis::{Spectrum, reference, rho};
 use rwt_core::density::Constant;
-use rwt_core::query::{Rect, Sampler};
+use rwt_core::query::{Lattice, Rect, Sampler};
 use rwt_core::tileset::TileSet;
 
 fn main() {
@@ -18,11 +22,25 @@ fn main() {
     };
     let n = set.points_per_tile as f64;
     let multiples: Vec<f64> = std::env::var("MULT")
-        .map(|s| s.split(',').filter_map(|v| v.parse().ok()).collect())
+        .map(|s| match s.as_str() {
+            "quarter" => (0..=31).map(|k| 0.3 * 2f64.powf(k as f64 / 4.0)).collect(),
+            _ => s.split(',').filter_map(|v| v.parse().ok()).collect(),
+        })
         .unwrap_or(vec![
             0.3, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.5, 12.0, 16.0, 24.0, 64.0, 96.0,
         ]);
-    println!("density   rho min (6 windows)   low-frequency power: ours / dart throwing");
+    // `SEED=S` and `LATTICE=aligned` change the spectra's query (to tell structure from chance).
+    let spectrum_seed: u64 = std::env::var("SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3);
+    let lattice = match std::env::var("LATTICE").as_deref() {
+        Ok("aligned") => Lattice::Aligned,
+        _ => Lattice::Seeded,
+    };
+    println!(
+        "density   rho min (6 windows)   low-frequency power: ours / dart throwing   worst anisotropy ring: ours (at) / dart throwing"
+    );
     for m in multiples {
         let density = m * n;
         let side = (24_000.0 / density).sqrt();
@@ -43,7 +61,7 @@ fn main() {
         // Spectra: 12 windows of about 2 500 points each.
         let side = (2_500.0 / density).sqrt();
         let count = (density * side * side) as usize;
-        let sampler = Sampler::new(&set, 3);
+        let sampler = Sampler::new(&set, spectrum_seed).with_lattice(lattice);
         let windows: Vec<(DVec2, Vec<DVec2>)> = (0..12)
             .map(|w| {
                 let origin = DVec2::new(w as f64 * side * 1.37, -(w as f64) * side * 0.71);
@@ -69,11 +87,36 @@ fn main() {
             .collect();
         let dart = Spectrum::averaged(&dart, side, 96);
         let low = |s: &Spectrum| s.low_frequency_power(side, density, 0.5);
+        let (ring, peak) = worst_ring(&ours);
         println!(
-            "{m:>6} N   {worst:.3}                 {:.3} / {:.3} = {:.2}x",
+            "{m:>6.2} N   {worst:.3}                 {:.3} / {:.3} = {:.2}x          {:.1} dB (r {ring}, {:.2}, {:.2}) / {:.1} dB",
             low(&ours),
             low(&dart),
-            low(&ours) / low(&dart)
+            low(&ours) / low(&dart),
+            ours.max_anisotropy(4),
+            peak.x / side,
+            peak.y / side,
+            dart.max_anisotropy(4),
         );
     }
+}
+
+/// The worst anisotropy ring from the fourth on, and its strongest cell's frequency
+/// (cycles per window side).
+fn worst_ring(s: &Spectrum) -> (usize, DVec2) {
+    let ring = (4..s.anisotropy_db.len())
+        .filter(|&r| s.anisotropy_db[r].is_finite())
+        .max_by(|&a, &b| s.anisotropy_db[a].total_cmp(&s.anisotropy_db[b]))
+        .unwrap_or(4);
+    let half = (s.size / 2) as f64;
+    let mut best = (f64::NEG_INFINITY, DVec2::ZERO);
+    for v in 0..s.size {
+        for u in 0..s.size {
+            let f = DVec2::new(u as f64 - half, v as f64 - half);
+            if f.length() as usize == ring && s.power[v * s.size + u] > best.0 {
+                best = (s.power[v * s.size + u], f);
+            }
+        }
+    }
+    (ring, best.1)
 }
