@@ -6,7 +6,8 @@
 //! `cargo run --release -p rwt_core --example density_sweep [TILESET.ron]`
 //! (`MULT=0.3,4,6` picks the multiples; `MULT=quarter` every quarter octave from 0.3 N to
 //! 64 N; the default spans levels 0 to 2). The anisotropy column is the worst ring from the
-//! fourth on, in dB (12 spectra averaged: isotropic noise near -10.8 dB), with the
+//! fourth on, in dB (12 spectra averaged, or `WINDOWS=W` for both ours and dart throwing:
+//! isotropic noise near -10 log10(W) dB, -10.8 for 12), with the
 //! frequency of that ring's strongest cell in cycles per base tile, `(u, v)`.
 use glam::DVec2;
 use rwt_core::analysis::{Spectrum, reference, rho};
@@ -34,6 +35,11 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(3);
+    let spectra: u64 = std::env::var("WINDOWS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|&w| w > 0)
+        .unwrap_or(12);
     let lattice = match std::env::var("LATTICE").as_deref() {
         Ok("aligned") => Lattice::Aligned,
         _ => Lattice::Seeded,
@@ -58,11 +64,11 @@ fn main() {
             let pos: Vec<DVec2> = out.iter().map(|p| p.position).collect();
             worst = worst.min(rho(&pos, out.len() as f64 / (side * side)).unwrap_or(0.0));
         }
-        // Spectra: 12 windows of about 2 500 points each.
+        // Spectra: `spectra` windows of about 2 500 points each.
         let side = (2_500.0 / density).sqrt();
         let count = (density * side * side) as usize;
         let sampler = Sampler::new(&set, spectrum_seed).with_lattice(lattice);
-        let windows: Vec<(DVec2, Vec<DVec2>)> = (0..12)
+        let windows: Vec<(DVec2, Vec<DVec2>)> = (0..spectra)
             .map(|w| {
                 let origin = DVec2::new(w as f64 * side * 1.37, -(w as f64) * side * 0.71);
                 let mut out = Vec::new();
@@ -77,7 +83,7 @@ fn main() {
             })
             .collect();
         let ours = Spectrum::averaged(&windows, side, 96);
-        let dart: Vec<(DVec2, Vec<DVec2>)> = (0..12)
+        let dart: Vec<(DVec2, Vec<DVec2>)> = (0..spectra)
             .map(|i| {
                 (
                     DVec2::ZERO,
