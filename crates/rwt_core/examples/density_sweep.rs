@@ -13,23 +13,15 @@ use glam::DVec2;
 use rwt_core::analysis::{Spectrum, reference, rho};
 use rwt_core::density::Constant;
 use rwt_core::query::{Lattice, Rect, Sampler};
-use rwt_core::tileset::TileSet;
+
+mod probe_args;
 
 fn main() {
-    let set = match std::env::args().nth(1) {
-        Some(path) => TileSet::from_ron_bytes(&std::fs::read(&path).expect("readable file"))
-            .expect("a valid tile set"),
-        None => TileSet::embedded(),
-    };
+    let set = probe_args::tile_set();
     let n = set.points_per_tile as f64;
-    let multiples: Vec<f64> = std::env::var("MULT")
-        .map(|s| match s.as_str() {
-            "quarter" => (0..=31).map(|k| 0.3 * 2f64.powf(k as f64 / 4.0)).collect(),
-            _ => s.split(',').filter_map(|v| v.parse().ok()).collect(),
-        })
-        .unwrap_or(vec![
-            0.3, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.5, 12.0, 16.0, 24.0, 64.0, 96.0,
-        ]);
+    let multiples = probe_args::multiples(&[
+        0.3, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.5, 12.0, 16.0, 24.0, 64.0, 96.0,
+    ]);
     // `SEED=S` and `LATTICE=aligned` change the spectra's query (to tell structure from chance).
     let spectrum_seed: u64 = std::env::var("SEED")
         .ok()

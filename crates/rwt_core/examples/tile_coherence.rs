@@ -11,7 +11,8 @@
 //! `cargo run --release -p rwt_core --example tile_coherence [TILESET.ron]`
 //! (`MULT=0.1,0.3,1` picks how many ranks, in multiples of N).
 use glam::DVec2;
-use rwt_core::tileset::TileSet;
+
+mod probe_args;
 
 /// Largest frequency per axis, cycles per tile.
 const K_MAX: i32 = 24;
@@ -27,15 +28,9 @@ enum Part {
 }
 
 fn main() {
-    let set = match std::env::args().nth(1) {
-        Some(path) => TileSet::from_ron_bytes(&std::fs::read(&path).expect("readable file"))
-            .expect("a valid tile set"),
-        None => TileSet::embedded(),
-    };
+    let set = probe_args::tile_set();
     let n = set.points_per_tile as f64;
-    let multiples: Vec<f64> = std::env::var("MULT")
-        .map(|s| s.split(',').filter_map(|v| v.parse().ok()).collect())
-        .unwrap_or(vec![0.1, 0.3, 0.6, 1.0]);
+    let multiples = probe_args::multiples(&[0.1, 0.3, 0.6, 1.0]);
     println!("ranks      part       share of points   coherent / incoherent power = ratio");
     for m in multiples {
         let take = ((m * n) as usize).clamp(1, set.points_per_tile as usize);
