@@ -9,11 +9,16 @@
 //! [`CullingCheck`]: every culled draw's instances, read back from its indirect arguments
 //! and the pool of kept instances, must be those the same test keeps on the CPU.
 //!
+//! Then the buffer of every chunk's instances is made to grow and shrink under the field: a
+//! denser second layer comes and goes, and the field's instances, moved to a smaller buffer,
+//! must draw the same frame and pass the same check.
+//!
 //! It prints `rwt-culling: draws D instances N kept G (gpu) C (cpu) mismatched M, pixel
-//! difference P` and exits with an error unless the counts agree, culling kept fewer
-//! instances than it was given, and the frames differ by less than [`MOST_DIFFERENCE`] in
-//! the mean (0..255 a channel). Screenshots go to `RWT_CULLING_DIR` (default
-//! `target/culling`).
+//! difference P`, then `rwt-culling: slab grown to G, shrunk to S instances: draws D kept G
+//! (gpu) C (cpu) mismatched M, pixel difference P`, and exits with an error unless the
+//! counts agree, culling kept fewer instances than it was given, the slab shrank, and the
+//! frames differ by less than [`MOST_DIFFERENCE`] in the mean (0..255 a channel).
+//! Screenshots go to `RWT_CULLING_DIR` (default `target/culling`).
 
 use bevy::app::AppExit;
 use bevy::prelude::*;
@@ -30,7 +35,7 @@ const MOST_DIFFERENCE: f64 = 1.0;
 /// Frames each step waits once streaming has settled (pipelines compile on the CPU).
 const WAIT: u32 = 12;
 /// Most frames the check may take.
-const PATIENCE: u32 = 600;
+const PATIENCE: u32 = 900;
 
 fn main() -> AppExit {
     culling_check_app("rwt gpu_culling")
@@ -55,32 +60,56 @@ fn setup(
         Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
     ));
     spawn_shadow_sun(&mut commands);
+    let blade = meshes.add(grass_field::blade());
+    commands.spawn(grass_layer(blade, FIELD_DENSITY));
+}
+
+/// Blades per square metre of the field.
+const FIELD_DENSITY: f64 = 12.0;
+/// Of the layer that makes the slab grow: enough that the field alone then uses a quarter of
+/// the slab or less.
+const DENSE_DENSITY: f64 = 36.0;
+
+/// A field of grass thinning out from 10 m, streamed to 40 m.
+fn grass_layer(blade: Handle<Mesh>, density: f64) -> ScatterLayer {
     let material = InstancedShading {
         thinning: Some(InstancedThinning::from(10.0)),
         ..default()
     };
-    let blade = meshes.add(grass_field::blade());
-    let grass = ScatterClass::instanced(LayerDensity::Constant(12.0), blade, material);
-    commands.spawn(
-        ScatterLayer::new(vec![grass])
-            .with_tile_size(2.0)
-            .with_streaming(StreamingConfig {
-                chunk_size: 8.0,
-                load_distance: 40.0,
-                unload_distance: 48.0,
-                near_distance: 40.0,
-            }),
-    );
+    let grass = ScatterClass::instanced(LayerDensity::Constant(density), blade, material);
+    ScatterLayer::new(vec![grass])
+        .with_tile_size(2.0)
+        .with_streaming(StreamingConfig {
+            chunk_size: 8.0,
+            load_distance: 40.0,
+            unload_distance: 48.0,
+            near_distance: 40.0,
+        })
 }
 
-/// The check's progress: frames since streaming settled, the report.
+/// The check's progress: frames since streaming settled, whether a report was asked and
+/// the report, and for the slab's part the dense layer while it lives and the slab's size
+/// with it.
 #[derive(Resource, Default)]
 struct Check {
     settled_at: Option<u32>,
     frame: u32,
     report: Option<CullingReport>,
+    dense: Option<Entity>,
+    grown: Option<u64>,
+    asked: bool,
 }
 
+impl Check {
+    /// Waits for streaming to settle again, then asks for a new report.
+    fn restart(&mut self) {
+        self.settled_at = None;
+        self.report = None;
+        self.asked = false;
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn run_check(
     mut check: ResMut<Check>,
     mut captures: ResMut<Captures>,
@@ -88,6 +117,7 @@ fn run_check(
     mut culling: ResMut<InstanceCulling>,
     culling_check: Res<CullingCheck>,
     mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
     mut exit: MessageWriter<AppExit>,
 ) {
     if out_of_patience(&mut check.frame, PATIENCE, "rwt-culling", &mut exit) {
@@ -100,24 +130,59 @@ fn run_check(
         }
         return;
     };
-    if check.report.is_none() {
+    if check.asked && check.report.is_none() {
         check.report = culling_check.report();
     }
     if captures.pending() || check.frame < since + WAIT {
         return;
     }
     let dir = output_dir("RWT_CULLING_DIR", "target/culling");
-    match (captures.get("whole"), captures.get("culled")) {
-        (None, _) => captures.capture(&mut commands, "whole", dir),
-        (Some(_), None) if *culling == InstanceCulling::PerChunk => {
+    let shots = (
+        captures.get("whole"),
+        captures.get("culled"),
+        captures.get("shrunk"),
+    );
+    match shots {
+        (None, ..) => captures.capture(&mut commands, "whole", dir),
+        (Some(_), None, _) if *culling == InstanceCulling::PerChunk => {
             *culling = InstanceCulling::PerInstance;
             culling_check.request();
+            check.asked = true;
             check.settled_at = Some(check.frame);
         }
-        (Some(_), None) => captures.capture(&mut commands, "culled", dir),
-        (Some(whole), Some(culled)) => {
+        (Some(_), None, _) => captures.capture(&mut commands, "culled", dir),
+        (Some(whole), Some(culled), None) if check.dense.is_none() && check.grown.is_none() => {
             let Some(report) = check.report else { return };
-            let passed = conclude(&report, whole, culled);
+            if !conclude(&report, whole, culled) {
+                exit.write(AppExit::error());
+                return;
+            }
+            let blade = meshes.add(grass_field::blade());
+            check.dense = Some(commands.spawn(grass_layer(blade, DENSE_DENSITY)).id());
+            check.restart();
+        }
+        (Some(_), Some(_), None) if !check.asked => {
+            // Once settled, a report of the slab's size with the dense layer, or of the
+            // field's instances moved; asked in the frame the screenshot shows.
+            culling_check.request();
+            check.asked = true;
+            if check.dense.is_none() {
+                captures.capture(&mut commands, "shrunk", dir);
+            }
+        }
+        (Some(_), Some(_), None) => {
+            if let (Some(report), Some(dense)) = (check.report, check.dense) {
+                check.grown = Some(report.slab_capacity);
+                commands.entity(dense).despawn();
+                check.dense = None;
+                check.restart();
+            }
+        }
+        (Some(_), Some(culled), Some(shrunk)) => {
+            let (Some(report), Some(grown)) = (check.report, check.grown) else {
+                return;
+            };
+            let passed = conclude_shrunk(&report, grown, culled, shrunk);
             exit.write(if passed {
                 AppExit::Success
             } else {
@@ -147,6 +212,37 @@ fn conclude(report: &CullingReport, whole: &image::RgbImage, culled: &image::Rgb
         (
             difference >= MOST_DIFFERENCE,
             "the culled frame differs from the whole one",
+        ),
+    ];
+    passed("rwt-culling", &failures)
+}
+
+/// Prints the line of the slab's part; whether it passed: the slab shrank below the size
+/// the dense layer made it grow to, and the field drew and culled as before.
+fn conclude_shrunk(
+    report: &CullingReport,
+    grown: u64,
+    culled: &image::RgbImage,
+    shrunk: &image::RgbImage,
+) -> bool {
+    let difference = mean_difference(culled, shrunk);
+    println!(
+        "rwt-culling: slab grown to {grown}, shrunk to {} instances: draws {} kept {} (gpu) {} (cpu) mismatched {}, pixel difference {difference:.3}",
+        report.slab_capacity, report.draws, report.gpu_kept, report.cpu_kept, report.mismatched
+    );
+    let failures = [
+        (
+            report.slab_capacity >= grown,
+            "the slab did not shrink once the dense layer went",
+        ),
+        (report.draws == 0, "no culled draw after shrinking"),
+        (
+            report.mismatched > 0 || report.gpu_kept != report.cpu_kept,
+            "after shrinking, the GPU's kept instances differ from the CPU's",
+        ),
+        (
+            difference >= MOST_DIFFERENCE,
+            "after shrinking, the frame differs from the first culled one",
         ),
     ];
     passed("rwt-culling", &failures)

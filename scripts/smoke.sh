@@ -88,8 +88,8 @@ for run in "${runs[@]}"; do
     fi
     if [ "$ex" = gpu_culling ]; then
         # Culling per instance: the frame matches the whole chunks' and the GPU's counts
-        # the CPU's.
-        self_checked RWT_CULLING_DIR=$out/culling rwt-culling 'draws'
+        # the CPU's, again once the slab grew and shrank under the field.
+        self_checked RWT_CULLING_DIR=$out/culling rwt-culling '(draws|slab)'
         continue
     fi
     if [ "$ex" = gpu_occlusion ]; then

@@ -2,7 +2,7 @@
 //! streamed around a camera 2 m above it, under a sun with cascaded shadow maps.
 
 use bevy::prelude::*;
-use bevy_rwt::look::{blade_mesh, blade_mesh_with_rows};
+use bevy_rwt::look::{blade_mesh, far_blade_mesh};
 use bevy_rwt::prelude::*;
 
 /// Streaming radius of the field, metres.
@@ -42,10 +42,9 @@ pub fn blade() -> Mesh {
     blade_mesh(BLADE.0, BLADE.1, BLADE.2)
 }
 
-/// [`blade`] with three rows of vertices instead of five (6 vertices instead of 10), for far
-/// chunks ([`ScatterClass::with_instanced_far`]).
+/// [`blade`] for far chunks ([`ScatterClass::with_instanced_far`]).
 pub fn far_blade() -> Mesh {
-    blade_mesh_with_rows(BLADE.0, BLADE.1, BLADE.2, 3)
+    far_blade_mesh(BLADE.0, BLADE.1, BLADE.2)
 }
 
 /// About `count` blades a square metre spread over the field's streamed disc (the loaded

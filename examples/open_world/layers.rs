@@ -3,7 +3,7 @@
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::layers::file::NamedAssets;
-use bevy_rwt::look::{blade_mesh, blade_mesh_with_rows};
+use bevy_rwt::look::{blade_mesh, far_blade_mesh};
 use bevy_rwt::prelude::*;
 use glam::DVec2;
 use noise::{NoiseFn, Perlin};
@@ -209,8 +209,7 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
         },
     );
     class.scale_variation = 0.35;
-    // The same blade with three rows of vertices: same bounds, no pop but in its curve.
-    let far = meshes.add(blade_mesh_with_rows(width, height, bend, 3));
+    let far = meshes.add(far_blade_mesh(width, height, bend));
     let class = class.with_instanced_far(far, GRASS_FAR_BLADE);
     ScatterLayer::new(vec![class])
         .with_seed(3)

@@ -9,7 +9,7 @@ mod check;
 mod impostor;
 mod instanced;
 
-pub use blade::{blade_mesh, blade_mesh_with_rows};
+pub use blade::{blade_mesh, blade_mesh_with_rows, far_blade_mesh};
 pub use check::{InstancedClassError, check_instanced_mesh};
 pub(crate) use check::{check_texture, check_topology};
 pub use impostor::Impostor;

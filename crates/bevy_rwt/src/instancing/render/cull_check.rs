@@ -3,6 +3,7 @@
 //! for every culled draw, the instances it draws with those the same test keeps on the CPU
 //! ([`CullingCheck`]).
 
+use super::InstanceSlab;
 use super::cull::{ARGS_WORDS, CullRecord, CullView, InstanceCuller};
 use crate::instancing::InstanceBuffer;
 use bevy::prelude::*;
@@ -44,6 +45,8 @@ pub struct CullingReport {
     /// Instances the late phase of occlusion kept: hidden by last frame's depth, not by
     /// this frame's.
     pub late_kept: u64,
+    /// Instances the buffer of every chunk's instances holds (its size, not its use).
+    pub slab_capacity: u64,
 }
 
 impl CullingCheck {
@@ -104,6 +107,7 @@ pub(super) struct Checked {
 pub(in crate::instancing) fn check_culling(
     frame: Res<FrameCheck>,
     culler: Res<InstanceCuller>,
+    slab: Res<InstanceSlab>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
 ) {
@@ -135,7 +139,10 @@ pub(in crate::instancing) fn check_culling(
         return;
     };
     let count = |draw: usize| words[draw * ARGS_WORDS as usize + 1];
-    let mut report = CullingReport::default();
+    let mut report = CullingReport {
+        slab_capacity: u64::from(slab.capacity()),
+        ..default()
+    };
     for (i, c) in checked.iter().enumerate() {
         let (early, late) = (count(i), count(checked.len() + i));
         let mut gpu = kept_words(&pool, &c.kept, early);

@@ -448,6 +448,7 @@ pub(super) fn prepare_chunks(
             }
         }
     }
+    slab.shrink_to_fit(&device, &queue);
 }
 
 /// A buffer of `chunk`'s instances alone, where the slab cannot hold them.

@@ -4,7 +4,8 @@
 //! Each chunk owns a range of instances, placed best-fit among the free ranges
 //! ([`Ranges`]). The buffer grows by doubling (copied on the GPU) up to what one storage
 //! binding may hold; a chunk that does not fit then gets a buffer of its own and is drawn
-//! whole.
+//! whole. When the chunks hold a quarter of it or less (the camera left a dense area), it
+//! shrinks by halving, the chunks' ranges packed from the start.
 
 use crate::instancing::{GPU_BYTES_PER_INSTANCE, GpuInstance};
 use bevy::platform::collections::HashMap;
@@ -71,6 +72,38 @@ impl Ranges {
     fn largest(&self) -> u32 {
         self.free.values().copied().max().unwrap_or(0)
     }
+
+    /// Slots in use.
+    fn used(&self) -> u32 {
+        self.capacity - self.free.values().sum::<u32>()
+    }
+
+    /// The capacity to shrink to, halving while `used` slots are a quarter of it or less
+    /// and it stays at least `floor`; `None` when it would not shrink.
+    fn shrunk(&self, floor: u32) -> Option<u32> {
+        let used = u64::from(self.used());
+        let mut capacity = self.capacity;
+        while capacity / 2 >= floor && used * 4 <= u64::from(capacity) {
+            capacity /= 2;
+        }
+        (capacity < self.capacity).then_some(capacity)
+    }
+}
+
+/// Where each of `ranges` goes when they are packed from slot 0 in order of their start:
+/// `(owner, from, to start)`.
+fn packed<K: Copy>(ranges: impl IntoIterator<Item = (K, Range<u32>)>) -> Vec<(K, Range<u32>, u32)> {
+    let mut ranges: Vec<(K, Range<u32>)> = ranges.into_iter().collect();
+    ranges.sort_by_key(|(_, r)| r.start);
+    let mut next = 0;
+    ranges
+        .into_iter()
+        .map(|(owner, from)| {
+            let to = next;
+            next += from.len() as u32;
+            (owner, from, to)
+        })
+        .collect()
 }
 
 /// Every chunk's instances in one buffer, by chunk render entity.
@@ -85,6 +118,11 @@ impl InstanceSlab {
     /// The buffer, once a chunk was placed.
     pub fn buffer(&self) -> Option<&Buffer> {
         self.buffer.as_ref()
+    }
+
+    /// Instances the buffer holds (0 before the first chunk).
+    pub fn capacity(&self) -> u32 {
+        self.buffer.as_ref().map_or(0, |_| self.ranges.capacity)
     }
 
     /// The instances `chunk` owns.
@@ -137,6 +175,40 @@ impl InstanceSlab {
         }
     }
 
+    /// Makes the buffer anew at a half, a quarter... of its size when the chunks use a
+    /// quarter of it or less, their instances copied to ranges packed from the start. Call
+    /// it after the frame's placements, so that it does not shrink what they then regrow.
+    pub fn shrink_to_fit(&mut self, device: &RenderDevice, queue: &RenderQueue) {
+        let (Some(old_buffer), Some(capacity)) = (&self.buffer, self.ranges.shrunk(FIRST_CAPACITY))
+        else {
+            return;
+        };
+        let buffer = slab_buffer(device, capacity);
+        let moves = packed(self.owners.iter().map(|(&e, r)| (e, r.clone())));
+        let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor {
+            label: Some("rwt_instance_slab_shrink"),
+        });
+        let mut ranges = Ranges::default();
+        ranges.grow(capacity);
+        for (chunk, from, to) in moves {
+            let len = from.len() as u32;
+            encoder.copy_buffer_to_buffer(
+                old_buffer,
+                u64::from(from.start) * INSTANCE_BYTES,
+                &buffer,
+                u64::from(to) * INSTANCE_BYTES,
+                u64::from(len) * INSTANCE_BYTES,
+            );
+            let taken = ranges.take(len);
+            debug_assert_eq!(taken, Some(to..to + len), "packing takes ranges in order");
+            self.owners.insert(chunk, to..to + len);
+        }
+        // Submitted now, as when growing: writes queued before land in the old buffer first.
+        queue.submit([encoder.finish()]);
+        self.buffer = Some(buffer);
+        self.ranges = ranges;
+    }
+
     fn free(&mut self, chunk: Entity) {
         if let Some(range) = self.owners.remove(&chunk) {
             self.ranges.give(range);
@@ -165,15 +237,7 @@ impl InstanceSlab {
             return false;
         }
         let capacity = capacity as u32;
-        let buffer = device.create_buffer(&BufferDescriptor {
-            label: Some("rwt_instance_slab"),
-            size: u64::from(capacity) * INSTANCE_BYTES,
-            usage: BufferUsages::VERTEX
-                | BufferUsages::STORAGE
-                | BufferUsages::COPY_DST
-                | BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        let buffer = slab_buffer(device, capacity);
         if let Some(old_buffer) = &self.buffer {
             // Submitted now: writes queued before it land in the old buffer first, those
             // queued after in the new one.
@@ -189,6 +253,19 @@ impl InstanceSlab {
     }
 }
 
+/// A slab buffer of `capacity` instances.
+fn slab_buffer(device: &RenderDevice, capacity: u32) -> Buffer {
+    device.create_buffer(&BufferDescriptor {
+        label: Some("rwt_instance_slab"),
+        size: u64::from(capacity) * INSTANCE_BYTES,
+        usage: BufferUsages::VERTEX
+            | BufferUsages::STORAGE
+            | BufferUsages::COPY_DST
+            | BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
 /// The most instances one buffer may hold: what one storage binding and one buffer may.
 fn most_instances(device: &RenderDevice) -> u64 {
     let limits = device.limits();
@@ -200,7 +277,7 @@ fn most_instances(device: &RenderDevice) -> u64 {
 
 #[cfg(test)]
 mod tests {
-    use super::Ranges;
+    use super::{Ranges, packed};
 
     fn ranges(capacity: u32) -> Ranges {
         let mut r = Ranges::default();
@@ -239,5 +316,33 @@ mod tests {
         r.give(a);
         assert_eq!(r.take(6), Some(0..6));
         assert_eq!(r.take(1), None);
+    }
+
+    #[test]
+    fn shrinks_by_halving_while_a_quarter_or_less_is_used() {
+        let mut r = ranges(1024);
+        let a = r.take(100).unwrap();
+        // 100 of 1024: 512 (a fifth), 256 (two fifths); 128 would leave 28 free.
+        assert_eq!(r.shrunk(16), Some(256));
+        // Never under the floor.
+        assert_eq!(r.shrunk(512), Some(512));
+        assert_eq!(r.shrunk(1024), None);
+        let _b = r.take(200).unwrap();
+        // 300 of 1024 is more than a quarter: it stays.
+        assert_eq!(r.shrunk(16), None);
+        r.give(a);
+        // 200 of 1024: half (a quarter is not more than 200 / 512).
+        assert_eq!(r.shrunk(16), Some(512));
+        assert_eq!(ranges(64).shrunk(16), Some(16));
+    }
+
+    #[test]
+    fn packing_keeps_the_order_of_the_ranges_and_leaves_no_gaps() {
+        let moves = packed([('c', 70..90), ('a', 5..15), ('b', 40..41)]);
+        assert_eq!(
+            moves,
+            vec![('a', 5..15, 0), ('b', 40..41, 10), ('c', 70..90, 11)]
+        );
+        assert!(packed::<u8>([]).is_empty());
     }
 }
