@@ -2,8 +2,8 @@
 //!
 //! `scripts/gpu_bench.sh` runs it (built on any machine, run on one with a GPU), or
 //! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
-//! [--thin 25] [--shadow-distance 0] [--far-blade 0] [--forest thinned|impostors] [--shots DIR]
-//! [--detail]`;
+//! [--thin 25] [--shadow-distance 0] [--far-blade 0] [--msaa 4] [--forest thinned|impostors]
+//! [--shots DIR] [--detail]`;
 //! `--shots` saves one
 //! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
@@ -16,7 +16,8 @@
 //! those within that many metres of the camera (open_world's grass casts within 25 m,
 //! [`InstancedShadows::Within`]). With `--far-blade`, chunks farther than that many metres
 //! draw a blade of 6 vertices instead of 10 ([`grass_field::far_blade`]; 0, the default:
-//! none). For each blade count
+//! none). `--msaa` sets the samples per pixel (1, 2 or 4; Bevy's default 4), to tell the
+//! pixels' share of a frame. For each blade count
 //! (millions of live blades) with the grass's shadows off, then on, each with culling per
 //! instance on the GPU off, then on ([`InstanceCulling`]), it waits for streaming to settle,
 //! warms up for 2 s, times `--frames` frames and prints exactly one line:
@@ -73,7 +74,7 @@ fn main() {
         Err(message) => {
             eprintln!("gpu_bench: {message}");
             eprintln!(
-                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--forest thinned|impostors] (M: millions)"
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--forest thinned|impostors] (M: millions)"
             );
             std::process::exit(2);
         }
@@ -137,6 +138,8 @@ struct Options {
     shadow_distance: f32,
     /// Distance from which chunks draw the far blade (metres; 0: none do).
     far_blade: f32,
+    /// Samples per pixel.
+    msaa: Msaa,
     /// Forests around the field, and how far trees are drawn.
     forest: Option<FarTrees>,
 }
@@ -152,6 +155,7 @@ impl Options {
             thin: THIN_FROM,
             shadow_distance: 0.0,
             far_blade: 0.0,
+            msaa: Msaa::Sample4,
             forest: None,
         };
         while let Some(flag) = args.next() {
@@ -198,6 +202,14 @@ impl Options {
                         "--shadow-distance" => options.shadow_distance = metres,
                         _ => options.far_blade = metres,
                     }
+                }
+                "--msaa" => {
+                    options.msaa = match value.as_str() {
+                        "1" => Msaa::Off,
+                        "2" => Msaa::Sample2,
+                        "4" => Msaa::Sample4,
+                        _ => return Err(bad()),
+                    };
                 }
                 "--forest" => {
                     options.forest = Some(match value.as_str() {
@@ -321,6 +333,7 @@ fn setup(
     commands.insert_resource(Target(target.clone()));
     commands.spawn((
         Camera3d::default(),
+        bench.options.msaa,
         RenderTarget::Image(target.into()),
         RwtViewer::all_around(),
         grass_field::camera_transform(),
