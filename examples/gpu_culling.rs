@@ -88,8 +88,8 @@ fn grass_layer(blade: Handle<Mesh>, density: f64) -> ScatterLayer {
 }
 
 /// The check's progress: frames since streaming settled, whether a report was asked and
-/// the report, and for the slab's part the dense layer while it lives and the slab's size
-/// with it.
+/// the report, and for the slab's part the dense layer while it lives, the slab's size with
+/// it and the field's blades without it.
 #[derive(Resource, Default)]
 struct Check {
     settled_at: Option<u32>,
@@ -98,6 +98,8 @@ struct Check {
     dense: Option<Entity>,
     grown: Option<u64>,
     asked: bool,
+    /// The field's live blades, alone.
+    field_live: Option<usize>,
 }
 
 impl Check {
@@ -123,7 +125,16 @@ fn run_check(
     if out_of_patience(&mut check.frame, PATIENCE, "rwt-culling", &mut exit) {
         return;
     }
-    let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && stats.live_instanced > 0;
+    let live = stats.live_instanced;
+    // Once the field was checked: settled only with the dense layer fully in (it has three
+    // times the field's blades), then fully gone.
+    let layers_as_meant = match (check.field_live, check.dense) {
+        (Some(field), Some(_)) => live > 2 * field,
+        (Some(field), None) => live <= field,
+        (None, _) => true,
+    };
+    let settled =
+        stats.pending_tasks == 0 && stats.queued_spawns == 0 && live > 0 && layers_as_meant;
     let Some(since) = check.settled_at else {
         if settled {
             check.settled_at = Some(check.frame);
@@ -157,6 +168,7 @@ fn run_check(
                 exit.write(AppExit::error());
                 return;
             }
+            check.field_live = Some(live);
             let blade = meshes.add(grass_field::blade());
             check.dense = Some(commands.spawn(grass_layer(blade, DENSE_DENSITY)).id());
             check.restart();
