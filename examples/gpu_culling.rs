@@ -49,6 +49,7 @@ fn setup(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    mut check: ResMut<Check>,
 ) {
     commands.spawn((
         Mesh3d(meshes.add(Plane3d::default().mesh().size(120.0, 120.0))),
@@ -60,8 +61,8 @@ fn setup(
         Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
     ));
     spawn_shadow_sun(&mut commands);
-    let blade = meshes.add(grass_field::blade());
-    commands.spawn(grass_layer(blade, FIELD_DENSITY));
+    check.blade = meshes.add(grass_field::blade());
+    commands.spawn(grass_layer(check.blade.clone(), FIELD_DENSITY));
 }
 
 /// Blades per square metre of the field.
@@ -89,9 +90,10 @@ fn grass_layer(blade: Handle<Mesh>, density: f64) -> ScatterLayer {
 
 /// The check's progress: frames since streaming settled, whether a report was asked and
 /// the report, and for the slab's part the dense layer while it lives, the slab's size with
-/// it and the field's blades without it.
+/// it and the field's blades without it; the blade both layers draw.
 #[derive(Resource, Default)]
 struct Check {
+    blade: Handle<Mesh>,
     settled_at: Option<u32>,
     frame: u32,
     report: Option<CullingReport>,
@@ -111,7 +113,6 @@ impl Check {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
 fn run_check(
     mut check: ResMut<Check>,
     mut captures: ResMut<Captures>,
@@ -119,7 +120,6 @@ fn run_check(
     mut culling: ResMut<InstanceCulling>,
     culling_check: Res<CullingCheck>,
     mut commands: Commands,
-    mut meshes: ResMut<Assets<Mesh>>,
     mut exit: MessageWriter<AppExit>,
 ) {
     if out_of_patience(&mut check.frame, PATIENCE, "rwt-culling", &mut exit) {
@@ -169,8 +169,8 @@ fn run_check(
                 return;
             }
             check.field_live = Some(live);
-            let blade = meshes.add(grass_field::blade());
-            check.dense = Some(commands.spawn(grass_layer(blade, DENSE_DENSITY)).id());
+            let dense = grass_layer(check.blade.clone(), DENSE_DENSITY);
+            check.dense = Some(commands.spawn(dense).id());
             check.restart();
         }
         (Some(_), Some(_), None) if !check.asked => {
