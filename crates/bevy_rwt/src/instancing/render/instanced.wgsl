@@ -16,7 +16,7 @@
 #import bevy_pbr::mesh_types::MESH_FLAGS_SHADOW_RECEIVER_BIT
 #endif
 #import bevy_pbr::view_transformations::position_world_to_clip
-#import rwt::fade::{Fade, kept_fraction, growth}
+#import rwt::fade::{Lod, kept_fraction, growth}
 
 struct Chunk {
     // The chunk's corner, and the mesh's top (its height at scale 1).
@@ -27,28 +27,19 @@ struct Chunk {
     color_variation: f32,
     roughness: f32,
     wind_response: f32,
-    // The band of ranks an instance grows over.
-    fade_band: f32,
-    // The level of detail's fall-off: near, far, the factor's floor; 1 when on.
-    falloff_near: f32,
-    falloff_far: f32,
-    falloff_floor: f32,
-    falloff_on: u32,
+    // Height fraction where the tip colour starts.
+    tip_from: f32,
+    // The level of detail: fall-off, growth and far thinning.
+    lod: Lod,
     // The wind: its direction (x, z), strength, frequency and speed.
     wind_direction: vec2<f32>,
     wind_strength: f32,
     wind_frequency: f32,
     wind_speed: f32,
-    // Height fraction where the tip colour starts.
-    tip_from: f32,
     bend_response: f32,
     alpha_cutoff: f32,
     // 1 when the class has a texture.
     textured: u32,
-    // Far thinning: its distance, its floor; 1 when on.
-    thinning_from: f32,
-    thinning_floor: f32,
-    thinning_on: u32,
     // The crossfade band (distance from the eye to a root) impostors fade in over, and the
     // one a class's mesh fades out over where impostors take over.
     fade_in_from: f32,
@@ -159,21 +150,6 @@ fn eye_xz() -> vec2<f32> {
 #endif
 }
 
-// The chunk's level of detail, seen from `eye_xz()`.
-fn chunk_fade() -> Fade {
-    return Fade(
-        eye_xz(),
-        chunk.falloff_near,
-        chunk.falloff_far,
-        chunk.falloff_floor,
-        chunk.falloff_on != 0u,
-        chunk.fade_band,
-        chunk.thinning_from,
-        chunk.thinning_floor,
-        chunk.thinning_on != 0u,
-    );
-}
-
 // Sideways displacement of a point at height fraction `t` (0 root, 1 tip) of an instance
 // rooted at `root`: gusts travelling with the wind plus a small per-instance flutter.
 fn sway(root: vec3<f32>, t: f32, tint: f32, height: f32, time: f32) -> vec3<f32> {
@@ -213,11 +189,17 @@ fn fall(v: vec3<f32>, dir: vec2<f32>, s: f32, c: f32) -> vec3<f32> {
     return vec3<f32>(v.x + dir.x * (turned - along), up, v.z + dir.y * (turned - along));
 }
 
-// An instance's vertex: where it is at `time`, its normal and its height fraction.
+// An instance's vertex: where it is at `time`, its normal and its height fraction; the
+// wind's part of `world` and what it was computed from, for the previous frame's position.
 struct Placed {
     world: vec3<f32>,
     normal: vec3<f32>,
     t: f32,
+    wind: vec3<f32>,
+    root: vec3<f32>,
+    tint: f32,
+    height: f32,
+    calm: f32,
 };
 
 // The instance's up axis from its packed tilt (0: straight up).
@@ -289,11 +271,11 @@ fn place(in: Vertex, time: f32) -> Placed {
     let root = chunk.origin + in.offset_scale.xyz;
     let yaw = in.yaw_appear_tint.x * 6.2831853;
     let tint = in.yaw_appear_tint.z;
-    let fade = chunk_fade();
-    let kept = kept_fraction(fade, root);
+    let eye = eye_xz();
+    let kept = kept_fraction(chunk.lod, eye, root);
     // A mesh its impostor replaced collapses to its root.
     let shown = select(1.0, 0.0, fade_out_level(root) >= 16.0);
-    let scale = in.offset_scale.w * growth(fade, root, in.yaw_appear_tint.y, kept) * shown;
+    let scale = in.offset_scale.w * growth(chunk.lod, eye, root, in.yaw_appear_tint.y, kept) * shown;
     let c = cos(yaw);
     let s = sin(yaw);
     // A thinned field's instances are widened to cover as the whole field did (seen from
@@ -322,11 +304,22 @@ fn place(in: Vertex, time: f32) -> Placed {
     }
     var out: Placed;
     out.t = clamp(in.position.y / chunk.mesh_top, 0.0, 1.0);
-    let wind = sway(root, out.t, tint, chunk.mesh_top * scale, time) * (1.0 - amount);
-    out.world = root + turned + wind;
+    out.root = root;
+    out.tint = tint;
+    out.height = chunk.mesh_top * scale;
+    out.calm = 1.0 - amount;
+    out.wind = sway(root, out.t, tint, out.height, time) * out.calm;
+    out.world = root + turned + out.wind;
     // Blades read as blades when their normals lean towards the sky.
     out.normal = normalize(mix(normal, vec3<f32>(0.0, 1.0, 0.0), 0.45));
     return out;
+}
+
+// Where `placed` was at `time`: only the wind moves an instance from frame to frame (the
+// bend field is this frame's in both), so the rest of `place` is not computed twice.
+fn placed_at(placed: Placed, time: f32) -> vec3<f32> {
+    let wind = sway(placed.root, placed.t, placed.tint, placed.height, time) * placed.calm;
+    return placed.world - placed.wind + wind;
 }
 
 #ifdef RWT_IMPOSTOR
@@ -348,8 +341,9 @@ fn card(in: Vertex) -> VertexOutput {
     let yaw = in.yaw_appear_tint.x * 6.2831853;
     let c = cos(yaw);
     let s = sin(yaw);
-    let fade = chunk_fade();
-    let scale = in.offset_scale.w * growth(fade, root, in.yaw_appear_tint.y, kept_fraction(fade, root));
+    let xz = eye_xz();
+    let kept = kept_fraction(chunk.lod, xz, root);
+    let scale = in.offset_scale.w * growth(chunk.lod, xz, root, in.yaw_appear_tint.y, kept);
     let eye = lod_eye();
     let level = fade_in_level(distance(eye, root));
     let m = chunk.impostor_center * scale;
@@ -412,7 +406,7 @@ fn vertex(in: Vertex) -> VertexOutput {
     out.world_normal = placed.normal;
     out.color = vec4<f32>(shade.rgb * (1.0 + variation) + vec3<f32>(variation * 0.15, variation * 0.05, 0.0), 1.0);
 #ifdef MOTION_VECTOR_PREPASS
-    out.previous_world_position = vec4<f32>(place(in, globals.time - globals.delta_time).world, 1.0);
+    out.previous_world_position = vec4<f32>(placed_at(placed, globals.time - globals.delta_time), 1.0);
 #endif
 #ifdef RWT_TEXTURE
     out.uv = in.uv;

@@ -422,7 +422,7 @@ pub(super) fn prepare_chunks(
         uniform.wind_frequency = wind.frequency;
         uniform.wind_speed = wind.speed;
         if !fade.0 {
-            uniform.falloff_on = 0;
+            uniform.lod.falloff_on = 0;
         }
         let texture = textures.of(chunk);
         match gpu {

@@ -3,13 +3,14 @@
 //! definitions the pipelines set, as Bevy's `ShaderCache` composes it (validating in test
 //! builds), and its uniform structs' layouts against the Rust structs that fill them.
 
+use super::uniforms::LodUniform;
 use super::{ChunkUniform, FrameUniform};
 use bevy::asset::AssetId;
 use bevy::asset::uuid::Uuid;
 use bevy::math::{Vec2, Vec3, Vec4};
 use bevy::render::render_resource::ShaderType;
-use bevy::render::render_resource::encase::UniformBuffer;
 use bevy::render::render_resource::encase::internal::WriteInto;
+use bevy::render::render_resource::encase::{StorageBuffer, UniformBuffer};
 use bevy::render::render_resource::{DownlevelFlags, WgpuFeatures};
 use bevy::shader::{Shader, ShaderCache, ShaderCacheSource, ShaderDefVal};
 use std::path::{Path, PathBuf};
@@ -170,15 +171,34 @@ fn permutations() -> Vec<Vec<ShaderDefVal>> {
     all
 }
 
-/// The members (name, offset) and size of `value` as encase writes it into a uniform
-/// buffer: each member's first word holds its own marker (`markers`, in member order).
+/// The address space a struct is read from: a uniform's rules are stricter (a struct
+/// member starts on 16 bytes), and encase checks them when it writes one.
+#[derive(Clone, Copy)]
+pub(super) enum Space {
+    Uniform,
+    Storage,
+}
+
+/// The members (name, offset) and size of `value` as encase writes it into a buffer of
+/// `space`: each member's first word holds its own marker (`markers`, in member order).
 pub(super) fn encase_layout<T: ShaderType + WriteInto>(
     value: &T,
+    space: Space,
     markers: &[(&str, u32)],
 ) -> (Vec<(String, usize)>, usize) {
-    let mut bytes = UniformBuffer::new(Vec::<u8>::new());
-    bytes.write(value).expect("encase writes it");
-    let words: Vec<u32> = bytemuck::pod_collect_to_vec(bytes.as_ref());
+    let bytes = match space {
+        Space::Uniform => {
+            let mut bytes = UniformBuffer::new(Vec::<u8>::new());
+            bytes.write(value).expect("encase writes it");
+            bytes.into_inner()
+        }
+        Space::Storage => {
+            let mut bytes = StorageBuffer::new(Vec::<u8>::new());
+            bytes.write(value).expect("encase writes it");
+            bytes.into_inner()
+        }
+    };
+    let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
     let members = markers.iter().map(|&(name, marker)| {
         let word = words.iter().position(|w| *w == marker);
         (
@@ -189,41 +209,81 @@ pub(super) fn encase_layout<T: ShaderType + WriteInto>(
     (members.collect(), T::min_size().get() as usize)
 }
 
-/// `ChunkUniform`'s layout, each member marked by its own value.
+/// The layout encase writes of `value` for `space`, each of `names` marked in order by its
+/// index `k`: the float [`mark`]`(k)`, or the word `k` where `word(k)`.
+pub(super) fn marked_layout<T: ShaderType + WriteInto>(
+    value: &T,
+    space: Space,
+    names: &[&str],
+    word: impl Fn(u32) -> bool,
+) -> (Vec<(String, usize)>, usize) {
+    let markers: Vec<(&str, u32)> = (0u32..)
+        .zip(names.iter().copied())
+        .map(|(k, n)| (n, if word(k) { k } else { mark(k).to_bits() }))
+        .collect();
+    encase_layout(value, space, &markers)
+}
+
+/// The float marking member `k`.
+pub(super) fn mark(k: u32) -> f32 {
+    100.0 + k as f32
+}
+
+/// `LodUniform`'s layout, each member marked.
+pub(super) fn marked_lod() -> (Vec<(String, usize)>, usize) {
+    let lod = LodUniform {
+        falloff_near: mark(0),
+        falloff_far: mark(1),
+        falloff_floor: mark(2),
+        falloff_on: 3,
+        fade_band: mark(4),
+        thinning_from: mark(5),
+        thinning_floor: mark(6),
+        thinning_on: 7,
+    };
+    let names = [
+        "falloff_near",
+        "falloff_far",
+        "falloff_floor",
+        "falloff_on",
+        "fade_band",
+        "thinning_from",
+        "thinning_floor",
+        "thinning_on",
+    ];
+    marked_layout(&lod, Space::Storage, &names, |k| k == 3 || k == 7)
+}
+
+/// `ChunkUniform`'s layout, each member marked (`lod` by its first member).
 fn marked_chunk() -> (Vec<(String, usize)>, usize) {
-    let f = |k: u32| 100.0 + k as f32;
     let marked = ChunkUniform {
-        origin: Vec3::splat(f(0)),
-        mesh_top: f(1),
-        base_color: Vec4::splat(f(2)),
-        tip_color: Vec4::splat(f(3)),
-        color_variation: f(4),
-        roughness: f(5),
-        wind_response: f(6),
-        fade_band: f(7),
-        falloff_near: f(8),
-        falloff_far: f(9),
-        falloff_floor: f(10),
-        falloff_on: 11,
-        wind_direction: Vec2::splat(f(12)),
-        wind_strength: f(13),
-        wind_frequency: f(14),
-        wind_speed: f(15),
-        tip_from: f(16),
-        bend_response: f(17),
-        alpha_cutoff: f(18),
-        textured: 19,
-        thinning_from: f(20),
-        thinning_floor: f(21),
-        thinning_on: 22,
-        fade_in_from: f(23),
-        fade_in_to: f(24),
-        fade_out_from: f(25),
-        fade_out_to: f(26),
-        impostor_half: Vec2::splat(f(27)),
-        impostor_center: Vec3::splat(f(28)),
-        impostor_views: 29,
-        impostor_rows: 30,
+        origin: Vec3::splat(mark(0)),
+        mesh_top: mark(1),
+        base_color: Vec4::splat(mark(2)),
+        tip_color: Vec4::splat(mark(3)),
+        color_variation: mark(4),
+        roughness: mark(5),
+        wind_response: mark(6),
+        tip_from: mark(7),
+        lod: LodUniform {
+            falloff_near: mark(8),
+            ..Default::default()
+        },
+        wind_direction: Vec2::splat(mark(9)),
+        wind_strength: mark(10),
+        wind_frequency: mark(11),
+        wind_speed: mark(12),
+        bend_response: mark(13),
+        alpha_cutoff: mark(14),
+        textured: 15,
+        fade_in_from: mark(16),
+        fade_in_to: mark(17),
+        fade_out_from: mark(18),
+        fade_out_to: mark(19),
+        impostor_half: Vec2::splat(mark(20)),
+        impostor_center: Vec3::splat(mark(21)),
+        impostor_views: 22,
+        impostor_rows: 23,
     };
     let names = [
         "origin",
@@ -233,22 +293,15 @@ fn marked_chunk() -> (Vec<(String, usize)>, usize) {
         "color_variation",
         "roughness",
         "wind_response",
-        "fade_band",
-        "falloff_near",
-        "falloff_far",
-        "falloff_floor",
-        "falloff_on",
+        "tip_from",
+        "lod",
         "wind_direction",
         "wind_strength",
         "wind_frequency",
         "wind_speed",
-        "tip_from",
         "bend_response",
         "alpha_cutoff",
         "textured",
-        "thinning_from",
-        "thinning_floor",
-        "thinning_on",
         "fade_in_from",
         "fade_in_to",
         "fade_out_from",
@@ -258,21 +311,9 @@ fn marked_chunk() -> (Vec<(String, usize)>, usize) {
         "impostor_views",
         "impostor_rows",
     ];
-    let words = [11, 19, 22, 29, 30];
-    let markers: Vec<(&str, u32)> = (0u32..)
-        .zip(names)
-        .map(|(k, n)| {
-            (
-                n,
-                if words.contains(&k) {
-                    k
-                } else {
-                    f(k).to_bits()
-                },
-            )
-        })
-        .collect();
-    encase_layout(&marked, &markers)
+    marked_layout(&marked, Space::Uniform, &names, |k| {
+        matches!(k, 15 | 22 | 23)
+    })
 }
 
 /// `FrameUniform`'s layout, each member marked by its own value.
@@ -289,13 +330,21 @@ fn marked_frame() -> (Vec<(String, usize)>, usize) {
         ("bend_min", 2.0f32.to_bits()),
         ("bend_scale", 3.0f32.to_bits()),
     ];
-    encase_layout(&marked, &markers)
+    encase_layout(&marked, Space::Uniform, &markers)
 }
 
 /// The members (name, offset) and size of struct `name` in a module's types' `Debug` text.
 pub(super) fn struct_layout(types: &str, name: &str) -> (Vec<(String, usize)>, usize) {
-    let start = types
-        .find(&format!("name: Some(\"{name}\"), inner: Struct"))
+    // An imported struct's name is mangled (`NameX_naga_oil_mod_X...`).
+    let start = [format!("\"{name}\""), format!("\"{name}X_naga_oil_mod_")]
+        .iter()
+        .find_map(|n| types.find(&format!("name: Some({n}")))
+        .filter(|&at| {
+            types[at..]
+                .split("inner: ")
+                .nth(1)
+                .is_some_and(|t| t.starts_with("Struct"))
+        })
         .unwrap_or_else(|| panic!("no struct {name}"));
     let body = &types[start..];
     let end = body.find("span: ").expect("a struct's span");
@@ -342,5 +391,6 @@ fn every_permutation_composes_and_validates_with_the_uniform_layouts() {
     for types in &composed {
         assert_eq!(struct_layout(types, "Chunk"), chunk);
         assert_eq!(struct_layout(types, "Frame"), frame);
+        assert_eq!(struct_layout(types, "Lod"), marked_lod());
     }
 }

@@ -20,29 +20,20 @@ pub(super) struct ChunkUniform {
     pub color_variation: f32,
     pub roughness: f32,
     pub wind_response: f32,
-    /// The band of ranks an instance grows over (never 0).
-    pub fade_band: f32,
-    /// The level of detail's fall-off: near, far, the factor's floor; 1 when the layer has
-    /// one (and the fade is on).
-    pub falloff_near: f32,
-    pub falloff_far: f32,
-    pub falloff_floor: f32,
-    pub falloff_on: u32,
+    /// Height fraction where the tip colour starts.
+    pub tip_from: f32,
+    /// The level of detail (at an offset of 64 bytes: a uniform's struct member starts on
+    /// 16).
+    pub lod: LodUniform,
     /// The wind (`RwtWind`): its direction (x, z), strength, frequency and speed.
     pub wind_direction: Vec2,
     pub wind_strength: f32,
     pub wind_frequency: f32,
     pub wind_speed: f32,
-    /// Height fraction where the tip colour starts.
-    pub tip_from: f32,
     pub bend_response: f32,
     pub alpha_cutoff: f32,
     /// 1 when the class has a texture.
     pub textured: u32,
-    /// Far thinning: its distance, its floor; 1 when on.
-    pub thinning_from: f32,
-    pub thinning_floor: f32,
-    pub thinning_on: u32,
     /// The crossfade band (distance from the eye to a root) impostors fade in over; both 0
     /// for other chunks.
     pub fade_in_from: f32,
@@ -68,10 +59,6 @@ impl ChunkUniform {
         m: &InstancedShading,
         falloff: Option<(f32, f32, f32)>,
     ) -> Self {
-        let (falloff_near, falloff_far, falloff_floor) = falloff.unwrap_or((0.0, 1.0, 0.0));
-        let thinning = m
-            .thinning
-            .map(|t| (t.from.max(0.0), t.floor.clamp(1e-3, 1.0)));
         Self {
             origin,
             mesh_top,
@@ -80,18 +67,11 @@ impl ChunkUniform {
             color_variation: m.color_variation,
             roughness: m.roughness,
             wind_response: m.wind_response,
-            fade_band: m.fade_band.max(1e-3),
-            falloff_near,
-            falloff_far,
-            falloff_floor,
-            falloff_on: u32::from(falloff.is_some()),
+            lod: LodUniform::new(m, falloff),
             tip_from: m.tip_from.clamp(0.0, 0.99),
             bend_response: m.bend_response,
             alpha_cutoff: m.alpha_cutoff,
             textured: u32::from(m.texture.is_some()),
-            thinning_from: thinning.map_or(0.0, |t| t.0),
-            thinning_floor: thinning.map_or(0.0, |t| t.1),
-            thinning_on: u32::from(thinning.is_some()),
             ..default()
         }
     }
@@ -115,6 +95,68 @@ impl ChunkUniform {
             impostor_rows: d.frames.rows,
             ..this
         }
+    }
+}
+
+/// A class's level of detail as both `instanced.wgsl` and culling read it (`Lod` in
+/// `fade.wgsl`): the fall-off by distance, the band instances grow over, far thinning.
+#[derive(Clone, Copy, Debug, Default, PartialEq, ShaderType)]
+pub(super) struct LodUniform {
+    /// The fall-off: near, far, the factor's floor; 1 when the layer has one (and the fade
+    /// is on).
+    pub falloff_near: f32,
+    pub falloff_far: f32,
+    pub falloff_floor: f32,
+    pub falloff_on: u32,
+    /// The band of ranks an instance grows over (never 0).
+    pub fade_band: f32,
+    /// Far thinning: its distance, its floor; 1 when on.
+    pub thinning_from: f32,
+    pub thinning_floor: f32,
+    pub thinning_on: u32,
+}
+
+impl LodUniform {
+    /// The level of detail of a class drawn with `m` and the fall-off `(near, far, floor)`.
+    fn new(m: &InstancedShading, falloff: Option<(f32, f32, f32)>) -> Self {
+        let (falloff_near, falloff_far, falloff_floor) = falloff.unwrap_or((0.0, 1.0, 0.0));
+        let thinning = m
+            .thinning
+            .map(|t| (t.from.max(0.0), t.floor.clamp(1e-3, 1.0)));
+        Self {
+            falloff_near,
+            falloff_far,
+            falloff_floor,
+            falloff_on: u32::from(falloff.is_some()),
+            fade_band: m.fade_band.max(1e-3),
+            thinning_from: thinning.map_or(0.0, |t| t.0),
+            thinning_floor: thinning.map_or(0.0, |t| t.1),
+            thinning_on: u32::from(thinning.is_some()),
+        }
+    }
+
+    /// `fade.wgsl`'s fraction kept by far thinning, `from_eye` from the eye across.
+    #[cfg(any(test, feature = "testing"))]
+    pub fn kept_fraction(&self, from_eye: f32) -> f32 {
+        if self.thinning_on == 0 {
+            return 1.0;
+        }
+        let ratio = self.thinning_from / from_eye.max(1e-3);
+        (ratio * ratio).clamp(self.thinning_floor, 1.0)
+    }
+
+    /// `fade.wgsl`'s growth, `from_eye` from the eye across.
+    #[cfg(any(test, feature = "testing"))]
+    pub fn growth(&self, from_eye: f32, appear: f32, kept: f32) -> f32 {
+        let band = self.fade_band;
+        let thinned = ((kept * (1.0 + band) - appear) / band).clamp(0.0, 1.0);
+        if self.falloff_on == 0 {
+            return thinned;
+        }
+        let span = (self.falloff_far - self.falloff_near).max(1e-3);
+        let near = (1.0 - (from_eye - self.falloff_near) / span).clamp(0.0, 1.0);
+        let factor = self.falloff_floor.max(near);
+        ((factor - appear) / band).clamp(0.0, 1.0) * thinned
     }
 }
 

@@ -11,7 +11,7 @@
 // it and keeps those it does not hide, into the draw's second range. A blade seen this
 // frame is kept by one of the two: what the early depth holds, the frame holds too.
 
-#import rwt::fade::{Fade, kept_fraction, growth}
+#import rwt::fade::{Lod, kept_fraction, growth}
 
 // The view's dispatch (`CullView`).
 struct View {
@@ -40,22 +40,13 @@ struct Record {
     reach: f32,
     // The class's shadow distance from the eye in a shadow view (negative: none).
     shadow_distance: f32,
-    // The fall-off: near, far, the factor's floor; 1 when on.
-    falloff_near: f32,
-    falloff_far: f32,
-    falloff_floor: f32,
-    falloff_on: u32,
-    // The band of ranks an instance grows over; distance from the eye within which
-    // instances are not drawn (the start of an impostor's crossfade; 0 for other chunks)
-    // and beyond which they are not (the end of a mesh's crossfade with its impostors; 0:
-    // none).
-    fade_band: f32,
+    // Distance from the eye within which instances are not drawn (the start of an
+    // impostor's crossfade; 0 for other chunks) and beyond which they are not (the end of a
+    // mesh's crossfade with its impostors; 0: none).
     fade_in_from: f32,
     fade_out_to: f32,
-    // Far thinning: its distance, its floor, 1 when on.
-    thinning_from: f32,
-    thinning_floor: f32,
-    thinning_on: u32,
+    // The chunk's level of detail: fall-off, growth and far thinning.
+    lod: Lod,
     // Instances in the chunk, the first in the slab; the view's first workgroup testing it.
     instances: u32,
     first_instance: u32,
@@ -103,21 +94,6 @@ fn record_of(group: u32) -> u32 {
         }
     }
     return lo;
-}
-
-// The chunk's level of detail, seen from the view's eye.
-fn cull_fade(r: Record) -> Fade {
-    return Fade(
-        view.eye.xz,
-        r.falloff_near,
-        r.falloff_far,
-        r.falloff_floor,
-        r.falloff_on != 0u,
-        r.fade_band,
-        r.thinning_from,
-        r.thinning_floor,
-        r.thinning_on != 0u,
-    );
 }
 
 // Whether the instance may be seen: grown, within the shadow distance, and its sphere
@@ -238,9 +214,8 @@ fn cull_instances(
     let root = r.origin + offset;
     // The appearance factor is the high half of the fifth word (the yaw is the low half).
     let appear = f32(instances[w + 4u] >> 16u) / 65535.0;
-    let fade = cull_fade(r);
-    let kept = kept_fraction(fade, root);
-    let scale = bitcast<f32>(instances[w + 3u]) * growth(fade, root, appear, kept);
+    let kept = kept_fraction(r.lod, view.eye.xz, root);
+    let scale = bitcast<f32>(instances[w + 3u]) * growth(r.lod, view.eye.xz, root, appear, kept);
     if !seen(r, root, scale, 1.0 / kept) {
         return;
     }

@@ -3,6 +3,7 @@
 
 #[cfg(any(test, feature = "testing"))]
 use crate::instancing::GpuInstance;
+use crate::instancing::render::uniforms::LodUniform;
 use bevy::prelude::*;
 use bevy::render::render_resource::ShaderType;
 
@@ -39,23 +40,14 @@ pub(in crate::instancing) struct CullRecord {
     pub reach: f32,
     /// In a shadow view, the class's shadow distance from the eye; negative: none.
     pub shadow_distance: f32,
-    /// The level of detail's fall-off: near, far, the factor's floor; 1 when on.
-    pub falloff_near: f32,
-    pub falloff_far: f32,
-    pub falloff_floor: f32,
-    pub falloff_on: u32,
-    /// The band of ranks an instance grows over.
-    pub fade_band: f32,
     /// Distance from the eye within which instances are not drawn (the start of an
     /// impostor's crossfade; 0 for other chunks).
     pub fade_in_from: f32,
     /// Distance from the eye beyond which instances are not drawn (the end of a mesh's
     /// crossfade with its impostors; 0: none).
     pub fade_out_to: f32,
-    /// Far thinning: its distance, its floor; 1 when on.
-    pub thinning_from: f32,
-    pub thinning_floor: f32,
-    pub thinning_on: u32,
+    /// The chunk's level of detail, as its uniform has it.
+    pub lod: LodUniform,
     /// Instances in the chunk, and the first of them in the slab.
     pub instances: u32,
     pub first_instance: u32,
@@ -80,8 +72,8 @@ impl CullRecord {
         let root = self.origin + Vec3::from(instance.offset);
         let appear = f32::from(instance.appear) / 65535.0;
         let from_eye = (root.xz() - view.eye.xz()).length();
-        let kept = self.kept_fraction(from_eye);
-        let scale = instance.scale * self.growth(from_eye, appear, kept);
+        let kept = self.lod.kept_fraction(from_eye);
+        let scale = instance.scale * self.lod.growth(from_eye, appear, kept);
         if scale <= 0.0 {
             return false;
         }
@@ -97,27 +89,5 @@ impl CullRecord {
         view.planes
             .iter()
             .all(|p| p.truncate().dot(root) + p.w + radius > 0.0)
-    }
-
-    /// `cull.wgsl`'s fraction kept by far thinning, `from_eye` from the eye across.
-    fn kept_fraction(&self, from_eye: f32) -> f32 {
-        if self.thinning_on == 0 {
-            return 1.0;
-        }
-        let ratio = self.thinning_from / from_eye.max(1e-3);
-        (ratio * ratio).clamp(self.thinning_floor, 1.0)
-    }
-
-    /// `cull.wgsl`'s growth, `from_eye` from the eye across.
-    fn growth(&self, from_eye: f32, appear: f32, kept: f32) -> f32 {
-        let band = self.fade_band;
-        let thinned = ((kept * (1.0 + band) - appear) / band).clamp(0.0, 1.0);
-        if self.falloff_on == 0 {
-            return thinned;
-        }
-        let span = (self.falloff_far - self.falloff_near).max(1e-3);
-        let near = (1.0 - (from_eye - self.falloff_near) / span).clamp(0.0, 1.0);
-        let factor = self.falloff_floor.max(near);
-        ((factor - appear) / band).clamp(0.0, 1.0) * thinned
     }
 }

@@ -1,30 +1,14 @@
 //! The culling shader's layout, its keep rules on the CPU, and the reach it tests.
 
 use super::super::reach;
-use super::super::shader_check::{cache_with_fade, encase_layout, struct_layout};
+use super::super::shader_check::{
+    Space, cache_with_fade, mark, marked_layout, marked_lod, struct_layout,
+};
+use super::super::uniforms::LodUniform;
 use super::*;
 use bevy::asset::uuid::Uuid;
 use bevy::camera::primitives::Aabb;
 use bevy::shader::Shader;
-
-/// The layout encase writes of `value`, each of `names` marked in order by `marked(k)`
-/// (floats 100 + k, or the word k where `word(k)`).
-fn marked_layout<T: ShaderType + bevy::render::render_resource::encase::internal::WriteInto>(
-    value: &T,
-    names: &[&str],
-    word: impl Fn(u32) -> bool,
-) -> (Vec<(String, usize)>, usize) {
-    let markers: Vec<(&str, u32)> = (0u32..)
-        .zip(names.iter().copied())
-        .map(|(k, n)| (n, if word(k) { k } else { mark(k).to_bits() }))
-        .collect();
-    encase_layout(value, &markers)
-}
-
-/// The float marking member `k`.
-fn mark(k: u32) -> f32 {
-    100.0 + k as f32
-}
 
 #[test]
 fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
@@ -60,45 +44,34 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
     ];
     assert_eq!(
         struct_layout(&types, "View"),
-        marked_layout(&view, &names, |k| k >= 3)
+        marked_layout(&view, Space::Storage, &names, |k| k >= 3)
     );
     let record = CullRecord {
         origin: Vec3::splat(mark(0)),
         reach: mark(1),
         shadow_distance: mark(2),
-        falloff_near: mark(3),
-        falloff_far: mark(4),
-        falloff_floor: mark(5),
-        falloff_on: 6,
-        fade_band: mark(7),
-        fade_in_from: mark(8),
-        fade_out_to: mark(9),
-        thinning_from: mark(10),
-        thinning_floor: mark(11),
-        thinning_on: 12,
-        instances: 13,
-        first_instance: 14,
-        first_workgroup: 15,
-        kept: 16,
-        late_kept: 17,
-        count_word: 18,
-        late_count_word: 19,
-        first_mark: 20,
+        fade_in_from: mark(3),
+        fade_out_to: mark(4),
+        lod: LodUniform {
+            falloff_near: mark(5),
+            ..default()
+        },
+        instances: 6,
+        first_instance: 7,
+        first_workgroup: 8,
+        kept: 9,
+        late_kept: 10,
+        count_word: 11,
+        late_count_word: 12,
+        first_mark: 13,
     };
     let names = [
         "origin",
         "reach",
         "shadow_distance",
-        "falloff_near",
-        "falloff_far",
-        "falloff_floor",
-        "falloff_on",
-        "fade_band",
         "fade_in_from",
         "fade_out_to",
-        "thinning_from",
-        "thinning_floor",
-        "thinning_on",
+        "lod",
         "instances",
         "first_instance",
         "first_workgroup",
@@ -110,8 +83,9 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
     ];
     assert_eq!(
         struct_layout(&types, "Record"),
-        marked_layout(&record, &names, |k| matches!(k, 6 | 12..))
+        marked_layout(&record, Space::Storage, &names, |k| k >= 6)
     );
+    assert_eq!(struct_layout(&types, "Lod"), marked_lod());
 }
 
 /// The half-spaces of a view looking down +x from the origin: x > 0 and |z| < x (no near
@@ -146,10 +120,13 @@ fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
     let params = CullRecord {
         reach: 0.5,
         shadow_distance: -1.0,
-        falloff_near: 10.0,
-        falloff_far: 20.0,
-        falloff_on: 1,
-        fade_band: 0.1,
+        lod: LodUniform {
+            falloff_near: 10.0,
+            falloff_far: 20.0,
+            falloff_on: 1,
+            fade_band: 0.1,
+            ..default()
+        },
         ..default()
     };
     assert!(params.keeps(&view, &at(Vec3::new(5.0, 0.0, 0.0), 0.5)));
@@ -163,7 +140,10 @@ fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
     assert!(!params.keeps(&view, &at(Vec3::new(15.0, 0.0, 0.0), 0.55)));
     // Without the fade every rank is drawn.
     let no_fade = CullRecord {
-        falloff_on: 0,
+        lod: LodUniform {
+            falloff_on: 0,
+            ..params.lod
+        },
         ..params
     };
     assert!(no_fade.keeps(&view, &at(Vec3::new(15.0, 0.0, 0.0), 0.95)));
@@ -176,9 +156,12 @@ fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
     assert!(!shadow.keeps(&view, &at(Vec3::new(8.6, 0.0, 0.0), 0.0)));
     // Thinned from 20 m: at 40 m a quarter is kept, the lowest ranks; nearer, all.
     let thinned = CullRecord {
-        thinning_from: 20.0,
-        thinning_floor: 0.1,
-        thinning_on: 1,
+        lod: LodUniform {
+            thinning_from: 20.0,
+            thinning_floor: 0.1,
+            thinning_on: 1,
+            ..no_fade.lod
+        },
         ..no_fade
     };
     assert!(thinned.keeps(&view, &at(Vec3::new(40.0, 0.0, 0.0), 0.2)));

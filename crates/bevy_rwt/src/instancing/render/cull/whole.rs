@@ -35,8 +35,9 @@ pub(super) fn may_drop(
     let far = farthest.distance(eye);
     let far_xz = farthest.xz().distance(eye.xz());
     let near = eye.clamp(min, max).distance(eye);
-    let grows = chunk.falloff_on != 0 && far_xz > chunk.falloff_near;
-    let thins = chunk.thinning_on != 0 && far_xz > chunk.thinning_from;
+    let lod = &chunk.lod;
+    let grows = lod.falloff_on != 0 && far_xz > lod.falloff_near;
+    let thins = lod.thinning_on != 0 && far_xz > lod.thinning_from;
     let casts_beyond = view.shadow && matches!(shadows, InstancedShadows::Within(d) if far > d);
     let fades = near < chunk.fade_in_from || (chunk.fade_out_to > 0.0 && far >= chunk.fade_out_to);
     grows || thins || casts_beyond || fades
@@ -46,6 +47,7 @@ pub(super) fn may_drop(
 mod tests {
     use super::super::tests::looking_down_x;
     use super::*;
+    use crate::instancing::render::uniforms::LodUniform;
 
     /// A camera at the origin looking down +x (x > 0, |z| < x, no far plane).
     fn view() -> ViewCull {
@@ -72,15 +74,21 @@ mod tests {
         assert!(may_drop(&view(), &chunk(-6.0, -2.0), &plain, off));
         // A fall-off from 12 m: its farther corner (14.1 m) is in it.
         let falloff = ChunkUniform {
-            falloff_near: 12.0,
-            falloff_on: 1,
+            lod: LodUniform {
+                falloff_near: 12.0,
+                falloff_on: 1,
+                ..plain.lod
+            },
             ..plain
         };
         assert!(may_drop(&view(), &chunk(10.0, -2.0), &falloff, off));
         assert!(!may_drop(&view(), &chunk(5.0, -2.0), &falloff, off));
         let thinning = ChunkUniform {
-            thinning_from: 12.0,
-            thinning_on: 1,
+            lod: LodUniform {
+                thinning_from: 12.0,
+                thinning_on: 1,
+                ..plain.lod
+            },
             ..plain
         };
         assert!(may_drop(&view(), &chunk(10.0, -2.0), &thinning, off));
