@@ -8,7 +8,7 @@
 #   scripts/gpu_bench.sh run [ARGS]   run it (a Linux x86-64 machine with a GPU, its driver and
 #                                     the Vulkan loader; no network, no display); ARGS go to the
 #                                     example (--blades 1,5,10 --frames 240 --size 1920x1080
-#                                     --msaa 1|2|4 --forest thinned|impostors ...)
+#                                     --msaa 1|2|4 --tuft K --forest thinned|impostors ...)
 #
 # Built once, target/gpu-bench/ (about 20 MB) is all the run needs beside the driver: copy
 # it (or the working tree with it) to the GPU machine. The run stops after 470 s, inside 8

@@ -18,6 +18,7 @@ pub mod grass_field;
 pub mod hud;
 pub mod smoke;
 pub mod terrain;
+pub mod tuft;
 
 use bevy::prelude::*;
 use bevy::window::{PresentMode, WindowResolution};

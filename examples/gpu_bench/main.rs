@@ -2,8 +2,8 @@
 //!
 //! `scripts/gpu_bench.sh` runs it (built on any machine, run on one with a GPU), or
 //! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
-//! [--thin 25] [--shadow-distance 0] [--far-blade 0] [--msaa 4] [--forest thinned|impostors]
-//! [--shots DIR] [--detail]`;
+//! [--thin 25] [--shadow-distance 0] [--far-blade 0] [--msaa 4] [--tuft 1]
+//! [--forest thinned|impostors] [--shots DIR] [--detail]`;
 //! `--shots` saves one
 //! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
@@ -17,15 +17,17 @@
 //! [`InstancedShadows::Within`]). With `--far-blade`, chunks farther than that many metres
 //! draw a blade of 6 vertices instead of 10 ([`grass_field::far_blade`]; 0, the default:
 //! none). `--msaa` sets the samples per pixel (1, 2 or 4; Bevy's default 4), to tell the
-//! pixels' share of a frame. For each blade count
+//! pixels' share of a frame. `--tuft K` draws K blades a mesh ([`tuft`]) at a K-th of the
+//! density: as many blades, a K-th of the instances (1, the default: one blade a mesh).
+//! For each blade count
 //! (millions of live blades) with the grass's shadows off, then on, each with culling per
 //! instance on the GPU off, then on ([`InstanceCulling`]), it waits for streaming to settle,
 //! warms up for 2 s, times `--frames` frames and prints exactly one line:
 //!
 //! `gpu-bench: blades=B shadows=S cull=C fps_median=F frame_ms_p95=P adapter=NAME`
 //!
-//! `B` is the live count measured (a first pass measures the streamed area, so the densities
-//! meet the counts asked for). A frame is the time from one main-world frame to the next, with
+//! `B` is the live count measured (with `--tuft`, instances times K; a first pass measures
+//! the streamed area, so the densities meet the counts asked for). A frame is the time from one main-world frame to the next, with
 //! Bevy's pipelined rendering on as in a game, and the render world waits for the GPU to finish
 //! each frame: the time is that of the slower of the main world and render world plus GPU.
 //! `cull=off` culls whole chunks on the CPU and draws every blade of those kept; `cull=on`
@@ -50,6 +52,7 @@ use bevy::winit::WinitPlugin;
 use bevy_rwt::prelude::*;
 use rwt_examples::forest::{FarTrees, tree_layer};
 use rwt_examples::grass_field::{self, field_layer, set_instanced_shadows};
+use rwt_examples::tuft::tuft;
 use std::time::{Duration, Instant};
 
 mod detail;
@@ -74,7 +77,7 @@ fn main() {
         Err(message) => {
             eprintln!("gpu_bench: {message}");
             eprintln!(
-                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--forest thinned|impostors] (M: millions)"
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--tuft K] [--forest thinned|impostors] (M: millions)"
             );
             std::process::exit(2);
         }
@@ -140,6 +143,8 @@ struct Options {
     far_blade: f32,
     /// Samples per pixel.
     msaa: Msaa,
+    /// Blades a mesh, drawn once per instance.
+    tuft: u32,
     /// Forests around the field, and how far trees are drawn.
     forest: Option<FarTrees>,
 }
@@ -156,6 +161,7 @@ impl Options {
             shadow_distance: 0.0,
             far_blade: 0.0,
             msaa: Msaa::Sample4,
+            tuft: 1,
             forest: None,
         };
         while let Some(flag) = args.next() {
@@ -178,13 +184,7 @@ impl Options {
                         .collect::<Option<_>>()
                         .ok_or_else(bad)?;
                 }
-                "--frames" => {
-                    options.frames = value
-                        .parse()
-                        .ok()
-                        .filter(|n| (10..=10_000).contains(n))
-                        .ok_or_else(bad)?;
-                }
+                "--frames" => options.frames = within(&value, 10..=10_000).ok_or_else(bad)?,
                 "--size" => {
                     let (w, h) = value.split_once('x').ok_or_else(bad)?;
                     let side = |v: &str| v.parse::<u32>().ok().filter(|v| (64..=8192).contains(v));
@@ -211,6 +211,7 @@ impl Options {
                         _ => return Err(bad()),
                     };
                 }
+                "--tuft" => options.tuft = within(&value, 1..=64).ok_or_else(bad)?,
                 "--forest" => {
                     options.forest = Some(match value.as_str() {
                         "thinned" => FarTrees::Thinned,
@@ -223,6 +224,14 @@ impl Options {
         }
         Ok(options)
     }
+}
+
+/// `value` as a number in `range`.
+fn within<T: std::str::FromStr + PartialOrd>(
+    value: &str,
+    range: std::ops::RangeInclusive<T>,
+) -> Option<T> {
+    value.parse().ok().filter(|v| range.contains(v))
 }
 
 /// One timed case.
@@ -313,7 +322,7 @@ impl Bench {
                     (true, false) => InstancedShadows::On,
                     (true, true) => InstancedShadows::Within(within),
                 };
-                (case.blades / area, shadows)
+                (case.blades / area / f64::from(self.options.tuft), shadows)
             }
             _ => (CALIBRATION_DENSITY, InstancedShadows::Off),
         }
@@ -345,10 +354,14 @@ fn setup(
         thinning: (bench.options.thin > 0.0).then(|| InstancedThinning::from(bench.options.thin)),
         ..default()
     };
-    let blade = meshes.add(grass_field::blade());
+    let tufted = |blade: Mesh| match bench.options.tuft {
+        1 => blade,
+        k => tuft(&blade, k),
+    };
+    let blade = meshes.add(tufted(grass_field::blade()));
     let mut grass = ScatterClass::instanced(LayerDensity::Constant(density), blade, material);
     if bench.options.far_blade > 0.0 {
-        let far = meshes.add(grass_field::far_blade());
+        let far = meshes.add(tufted(grass_field::far_blade()));
         grass = grass.with_instanced_far(far, bench.options.far_blade);
     }
     commands.spawn((Grass, field_layer(grass)));
@@ -396,7 +409,8 @@ fn step(
 ) {
     let now = Instant::now();
     let frames = bench.options.frames;
-    let live = grass.live_instanced;
+    // Blades: each instance draws a tuft's.
+    let live = grass.live_instanced * bench.options.tuft as usize;
     match bench.phase {
         Phase::Streaming {
             since,
