@@ -8,7 +8,13 @@
 #   scripts/gpu_bench.sh run [ARGS]   run it (a Linux x86-64 machine with a GPU, its driver and
 #                                     the Vulkan loader; no network, no display); ARGS go to the
 #                                     example (--blades 1,5,10 --frames 240 --size 1920x1080
-#                                     --msaa 1|2|4 --tuft K --forest thinned|impostors ...)
+#                                     --msaa 1|2|4 --tuft K --shadows on|off --cull on|off
+#                                     --forest thinned|impostors ...)
+#   scripts/gpu_bench.sh split [ARGS] the 10 M case as open_world draws its grass (shadows
+#                                     within 25 m, far blade from 30 m, culled, shadows on,
+#                                     --detail) three times: as is, with --msaa 1 (the pixels'
+#                                     share) and with --tuft 8 (a cost per instance); about
+#                                     4 minutes
 #
 # Built once, target/gpu-bench/ (about 20 MB) is all the run needs beside the driver: copy
 # it (or the working tree with it) to the GPU machine. The run stops after 470 s, inside 8
@@ -59,8 +65,18 @@ run)
     fi
     exec timeout 470 "$bin" "$@"
     ;;
+split)
+    shift || true
+    case_args=(--blades 10 --frames 120 --shadow-distance 25 --far-blade 30 --detail
+        --shadows on --cull on)
+    for variant in "" "--msaa 1" "--tuft 8"; do
+        echo "gpu-bench-split: ${variant:-as open_world draws it}"
+        # shellcheck disable=SC2086 # the variant is two words or none
+        "$0" run "${case_args[@]}" $variant "$@" || echo "gpu-bench-split: failed ($?)"
+    done
+    ;;
 *)
-    echo "usage: scripts/gpu_bench.sh build | run [--blades M,M,..] [--frames N] [--size WxH]" >&2
+    echo "usage: scripts/gpu_bench.sh build | run [--blades M,M,..] [--frames N] [--size WxH] | split" >&2
     exit 2
     ;;
 esac

@@ -3,7 +3,7 @@
 //! `scripts/gpu_bench.sh` runs it (built on any machine, run on one with a GPU), or
 //! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
 //! [--thin 25] [--shadow-distance 0] [--far-blade 0] [--msaa 4] [--tuft 1]
-//! [--forest thinned|impostors] [--shots DIR] [--detail]`;
+//! [--shadows on|off] [--cull on|off] [--forest thinned|impostors] [--shots DIR] [--detail]`;
 //! `--shots` saves one
 //! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
@@ -22,7 +22,8 @@
 //! For each blade count
 //! (millions of live blades) with the grass's shadows off, then on, each with culling per
 //! instance on the GPU off, then on ([`InstanceCulling`]), it waits for streaming to settle,
-//! warms up for 2 s, times `--frames` frames and prints exactly one line:
+//! warms up for 2 s, times `--frames` frames and prints exactly one line (`--shadows on|off`
+//! and `--cull on|off` time only those cases):
 //!
 //! `gpu-bench: blades=B shadows=S cull=C fps_median=F frame_ms_p95=P adapter=NAME`
 //!
@@ -77,7 +78,7 @@ fn main() {
         Err(message) => {
             eprintln!("gpu_bench: {message}");
             eprintln!(
-                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--tuft K] [--forest thinned|impostors] (M: millions)"
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--tuft K] [--shadows on|off] [--cull on|off] [--forest thinned|impostors] (M: millions)"
             );
             std::process::exit(2);
         }
@@ -147,11 +148,14 @@ struct Options {
     tuft: u32,
     /// Forests around the field, and how far trees are drawn.
     forest: Option<FarTrees>,
+    /// The only shadows and culling timed (`None`: off, then on).
+    shadows: Option<bool>,
+    cull: Option<bool>,
 }
 
-impl Options {
-    fn parse(mut args: impl Iterator<Item = String>) -> Result<Self, String> {
-        let mut options = Options {
+impl Default for Options {
+    fn default() -> Self {
+        Options {
             blades: vec![1.0, 5.0, 10.0],
             frames: 240,
             size: UVec2::new(1920, 1080),
@@ -163,7 +167,15 @@ impl Options {
             msaa: Msaa::Sample4,
             tuft: 1,
             forest: None,
-        };
+            shadows: None,
+            cull: None,
+        }
+    }
+}
+
+impl Options {
+    fn parse(mut args: impl Iterator<Item = String>) -> Result<Self, String> {
+        let mut options = Options::default();
         while let Some(flag) = args.next() {
             if flag == "--detail" {
                 options.detail = true;
@@ -212,6 +224,17 @@ impl Options {
                     };
                 }
                 "--tuft" => options.tuft = within(&value, 1..=64).ok_or_else(bad)?,
+                "--shadows" | "--cull" => {
+                    let on = match value.as_str() {
+                        "on" => true,
+                        "off" => false,
+                        _ => return Err(bad()),
+                    };
+                    match flag.as_str() {
+                        "--shadows" => options.shadows = Some(on),
+                        _ => options.cull = Some(on),
+                    }
+                }
                 "--forest" => {
                     options.forest = Some(match value.as_str() {
                         "thinned" => FarTrees::Thinned,
@@ -295,6 +318,8 @@ impl Bench {
                     },
                 )
             })
+            .filter(|c| options.shadows.is_none_or(|s| s == c.shadows))
+            .filter(|c| options.cull.is_none_or(|on| on == c.cull))
             .collect();
         Self {
             options,
@@ -408,6 +433,13 @@ fn step(
     mut exit: MessageWriter<AppExit>,
 ) {
     let now = Instant::now();
+    if let Some(case) = bench.case.map(|i| bench.cases[i]) {
+        culling.set_if_neq(if case.cull {
+            InstanceCulling::PerInstance
+        } else {
+            InstanceCulling::PerChunk
+        });
+    }
     let frames = bench.options.frames;
     // Blades: each instance draws a tuft's.
     let live = grass.live_instanced * bench.options.tuft as usize;
@@ -440,19 +472,7 @@ fn step(
         }
         Phase::WarmingUp { since, shot: false } if since.elapsed() >= WARM_UP / 2 => {
             bench.phase = Phase::WarmingUp { since, shot: true };
-            if let (Some(dir), Some(case)) = (&bench.options.shots, bench.case) {
-                let case = bench.cases[case];
-                let on_off = |on| if on { "on" } else { "off" };
-                let name = format!(
-                    "blades-{}-shadows-{}-cull-{}.png",
-                    case.blades / 1e6,
-                    on_off(case.shadows),
-                    on_off(case.cull)
-                );
-                commands
-                    .spawn(Screenshot::image(report.target.0.clone()))
-                    .observe(save_to_disk(dir.join(name)));
-            }
+            save_shot(&bench, &report, &mut commands);
         }
         Phase::Timing { since }
             if bench.frame_ms.len() >= frames
@@ -460,14 +480,7 @@ fn step(
         {
             print_case(&bench, live, &report);
             if let (Some(far), Some(forest)) = (bench.options.forest, &forest) {
-                let far = match far {
-                    FarTrees::Thinned => "thinned",
-                    FarTrees::Impostors => "impostors",
-                };
-                println!(
-                    "gpu-bench: forest={far} tree_entities={} impostors={}",
-                    forest.live_entities, forest.live_instanced
-                );
+                print_forest(far, forest);
             }
             let (this, next) = bench.case.map_or((0, 0), |i| (i, i + 1));
             let Some(&case) = bench.cases.get(next) else {
@@ -476,11 +489,6 @@ fn step(
             };
             let same_field = |a: Case, b: Case| a.blades == b.blades && a.shadows == b.shadows;
             bench.case = Some(next);
-            *culling = if case.cull {
-                InstanceCulling::PerInstance
-            } else {
-                InstanceCulling::PerChunk
-            };
             if same_field(bench.cases[this], case) {
                 bench.phase = Phase::WarmingUp {
                     since: now,
@@ -492,6 +500,36 @@ fn step(
         }
         _ => {}
     }
+}
+
+/// Saves a frame of the case warming up (with `--shots`).
+fn save_shot(bench: &Bench, report: &Report, commands: &mut Commands) {
+    let (Some(dir), Some(case)) = (&bench.options.shots, bench.case) else {
+        return;
+    };
+    let case = bench.cases[case];
+    let on_off = |on| if on { "on" } else { "off" };
+    let name = format!(
+        "blades-{}-shadows-{}-cull-{}.png",
+        case.blades / 1e6,
+        on_off(case.shadows),
+        on_off(case.cull)
+    );
+    commands
+        .spawn(Screenshot::image(report.target.0.clone()))
+        .observe(save_to_disk(dir.join(name)));
+}
+
+/// The forests' line after a case's (`--forest`).
+fn print_forest(far: FarTrees, forest: &ScatterLayerStatus) {
+    let far = match far {
+        FarTrees::Thinned => "thinned",
+        FarTrees::Impostors => "impostors",
+    };
+    println!(
+        "gpu-bench: forest={far} tree_entities={} impostors={}",
+        forest.live_entities, forest.live_instanced
+    );
 }
 
 /// Streaming has settled with `live` blades: measure the area (the first time), or warm up.
