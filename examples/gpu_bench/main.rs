@@ -28,9 +28,10 @@
 //! `gpu-bench: blades=B shadows=S cull=C fps_median=F frame_ms_p95=P adapter=NAME`
 //!
 //! `B` is the live count measured (with `--tuft`, instances times K; a first pass measures
-//! the streamed area, so the densities meet the counts asked for). A frame is the time from one main-world frame to the next, with
-//! Bevy's pipelined rendering on as in a game, and the render world waits for the GPU to finish
-//! each frame: the time is that of the slower of the main world and render world plus GPU.
+//! the streamed area, so the densities meet the counts asked for). A frame is the time from
+//! one main-world frame to the next, with Bevy's pipelined rendering on as in a game, and the
+//! render world waits for the GPU to finish each frame: the time is that of the slower of the
+//! main world and render world plus GPU.
 //! `cull=off` culls whole chunks on the CPU and draws every blade of those kept; `cull=on`
 //! also culls each blade on the GPU and draws indirectly.
 //!
@@ -199,16 +200,12 @@ impl Options {
                 "--frames" => options.frames = within(&value, 10..=10_000).ok_or_else(bad)?,
                 "--size" => {
                     let (w, h) = value.split_once('x').ok_or_else(bad)?;
-                    let side = |v: &str| v.parse::<u32>().ok().filter(|v| (64..=8192).contains(v));
+                    let side = |v: &str| within(v, 64..=8192u32);
                     options.size = UVec2::new(side(w).ok_or_else(bad)?, side(h).ok_or_else(bad)?);
                 }
                 "--shots" => options.shots = Some(value.into()),
                 "--thin" | "--shadow-distance" | "--far-blade" => {
-                    let metres = value
-                        .parse()
-                        .ok()
-                        .filter(|m: &f32| (0.0..=1e4).contains(m))
-                        .ok_or_else(bad)?;
+                    let metres = within(&value, 0.0..=1e4f32).ok_or_else(bad)?;
                     match flag.as_str() {
                         "--thin" => options.thin = metres,
                         "--shadow-distance" => options.shadow_distance = metres,
