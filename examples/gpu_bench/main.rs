@@ -505,7 +505,6 @@ fn save_shot(bench: &Bench, report: &Report, commands: &mut Commands) {
         return;
     };
     let case = bench.cases[case];
-    let on_off = |on| if on { "on" } else { "off" };
     let name = format!(
         "blades-{}-shadows-{}-cull-{}.png",
         case.blades / 1e6,
@@ -515,6 +514,11 @@ fn save_shot(bench: &Bench, report: &Report, commands: &mut Commands) {
     commands
         .spawn(Screenshot::image(report.target.0.clone()))
         .observe(save_to_disk(dir.join(name)));
+}
+
+/// A setting as the case lines and shots name it.
+fn on_off(on: bool) -> &'static str {
+    if on { "on" } else { "off" }
 }
 
 /// The forests' line after a case's (`--forest`).
@@ -577,7 +581,6 @@ fn print_case(bench: &Bench, live: usize, report: &Report) {
     ms.sort_by(f64::total_cmp);
     let median = ms[ms.len() / 2];
     let p95 = ms[(ms.len() * 95 / 100).min(ms.len() - 1)];
-    let on_off = |on| if on { "on" } else { "off" };
     let (shadows, cull) = (on_off(case.shadows), on_off(case.cull));
     println!(
         "gpu-bench: blades={live} shadows={shadows} cull={cull} fps_median={:.1} frame_ms_p95={p95:.2} adapter={}",
