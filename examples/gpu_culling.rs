@@ -3,7 +3,10 @@
 //!
 //! A field of grass that thins out with distance ([`InstancedThinning`]), no wind (so that
 //! two frames can match), a sun with shadows, and a camera at the field's edge looking
-//! across it, so that many chunks are cut by the view's sides. Two screenshots: chunks
+//! across it, so that many chunks are cut by the view's sides. The blades have a far mesh
+//! from 20 m, the same blade made again: drawn whole, a chunk draws the mesh its nearest
+//! point calls for, culled, each blade the one its own distance calls for; the same
+//! pixels either way, and the check counts each mesh's draw. Two screenshots: chunks
 //! drawn whole ([`InstanceCulling::PerChunk`]), then culled per instance
 //! ([`InstanceCulling::PerInstance`]), whose frame is also checked by
 //! [`CullingCheck`]: every culled draw's instances, read back from its indirect arguments
@@ -13,10 +16,11 @@
 //! denser second layer comes and goes, and the field's instances, moved to a smaller buffer,
 //! must draw the same frame and pass the same check.
 //!
-//! It prints `rwt-culling: draws D instances N kept G (gpu) C (cpu) mismatched M, pixel
-//! difference P`, then `rwt-culling: slab grown to G, shrunk to S instances: draws D kept G
+//! It prints `rwt-culling: draws D (far F) instances N kept G (gpu) C (cpu) mismatched M,
+//! pixel difference P`, then `rwt-culling: slab grown to G, shrunk to S instances: draws D kept G
 //! (gpu) C (cpu) mismatched M, pixel difference P`, and exits with an error unless the
-//! counts agree, culling kept fewer instances than it was given, the slab shrank, and the
+//! counts agree, culling kept fewer instances than it was given, some blades drew the far
+//! mesh and some the near one, the slab shrank, and the
 //! frames differ by less than [`MOST_DIFFERENCE`] in the mean (0..255 a channel).
 //! Screenshots go to `RWT_CULLING_DIR` (default `target/culling`).
 
@@ -61,8 +65,11 @@ fn setup(
         Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
     ));
     spawn_shadow_sun(&mut commands);
-    check.blade = meshes.add(grass_field::blade());
-    commands.spawn(grass_layer(check.blade.clone(), FIELD_DENSITY));
+    check.blades = Blades {
+        near: meshes.add(grass_field::blade()),
+        far: meshes.add(grass_field::blade()),
+    };
+    commands.spawn(grass_layer(&check.blades, FIELD_DENSITY));
 }
 
 /// Blades per square metre of the field.
@@ -71,13 +78,25 @@ const FIELD_DENSITY: f64 = 12.0;
 /// the slab or less.
 const DENSE_DENSITY: f64 = 36.0;
 
+/// Where the blades turn to their far mesh (metres from the camera).
+const FAR_BLADE: f32 = 20.0;
+
+/// The blade both layers draw, near and far: two meshes of the same blade.
+#[derive(Default)]
+struct Blades {
+    near: Handle<Mesh>,
+    far: Handle<Mesh>,
+}
+
 /// A field of grass thinning out from 10 m, streamed to 40 m.
-fn grass_layer(blade: Handle<Mesh>, density: f64) -> ScatterLayer {
+fn grass_layer(blades: &Blades, density: f64) -> ScatterLayer {
     let material = InstancedShading {
         thinning: Some(InstancedThinning::from(10.0)),
         ..default()
     };
-    let grass = ScatterClass::instanced(LayerDensity::Constant(density), blade, material);
+    let near = blades.near.clone();
+    let grass = ScatterClass::instanced(LayerDensity::Constant(density), near, material)
+        .with_instanced_far(blades.far.clone(), FAR_BLADE);
     ScatterLayer::new(vec![grass])
         .with_tile_size(2.0)
         .with_streaming(StreamingConfig {
@@ -93,7 +112,7 @@ fn grass_layer(blade: Handle<Mesh>, density: f64) -> ScatterLayer {
 /// it and the field's blades without it; the blade both layers draw.
 #[derive(Resource, Default)]
 struct Check {
-    blade: Handle<Mesh>,
+    blades: Blades,
     settled_at: Option<u32>,
     frame: u32,
     report: Option<CullingReport>,
@@ -169,7 +188,7 @@ fn run_check(
                 return;
             }
             check.field_live = Some(live);
-            let dense = grass_layer(check.blade.clone(), DENSE_DENSITY);
+            let dense = grass_layer(&check.blades, DENSE_DENSITY);
             check.dense = Some(commands.spawn(dense).id());
             check.restart();
         }
@@ -208,11 +227,21 @@ fn run_check(
 fn conclude(report: &CullingReport, whole: &image::RgbImage, culled: &image::RgbImage) -> bool {
     let difference = mean_difference(whole, culled);
     println!(
-        "rwt-culling: draws {} instances {} kept {} (gpu) {} (cpu) mismatched {}, pixel difference {difference:.3}",
-        report.draws, report.instances, report.gpu_kept, report.cpu_kept, report.mismatched
+        "rwt-culling: draws {} (far {}) instances {} kept {} (gpu) {} (cpu) mismatched {}, pixel difference {difference:.3}",
+        report.draws,
+        report.far_draws,
+        report.instances,
+        report.gpu_kept,
+        report.cpu_kept,
+        report.mismatched
     );
     let failures = [
         (report.draws == 0, "no culled draw"),
+        (report.far_draws == 0, "no blade drew the far mesh"),
+        (
+            report.far_draws >= report.draws,
+            "no chunk drew its near mesh",
+        ),
         (
             report.mismatched > 0 || report.gpu_kept != report.cpu_kept,
             "the GPU's kept instances differ from the CPU's",

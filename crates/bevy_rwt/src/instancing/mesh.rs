@@ -51,6 +51,26 @@ impl InstancedMeshes {
         }
     }
 
+    /// Whether a class has a far mesh as tall as its near one (within a thousandth), both
+    /// checked: then a chunk may draw either under the same uniform.
+    pub fn far_as_tall(
+        &mut self,
+        (near, far): &(Handle<Mesh>, Option<InstancedFar>),
+        meshes: Option<&Assets<Mesh>>,
+    ) -> bool {
+        let Some(far) = far else {
+            return false;
+        };
+        let mut top = |mesh| match self.check(mesh, meshes) {
+            Some(Ok((_, hi))) => Some(hi.y),
+            _ => None,
+        };
+        let (Some(near), Some(far)) = (top(near), top(&far.mesh)) else {
+            return false;
+        };
+        (near - far).abs() <= 1e-3 * near.abs().max(1e-3)
+    }
+
     /// Bounds of `mesh` (a unit box standing on the ground while it is not loaded or cannot
     /// be drawn).
     pub fn bounds(&mut self, mesh: &Handle<Mesh>, meshes: Option<&Assets<Mesh>>) -> (Vec3, Vec3) {
@@ -99,6 +119,7 @@ pub(super) fn refit_changed_meshes(
             chunk.mesh_top = top.max(1e-3);
             let bounds = checked.class_bounds(&chunk.meshes, meshes.as_deref());
             *aabb = chunk.aabb(bounds);
+            chunk.far_per_instance = checked.far_as_tall(&chunk.meshes, meshes.as_deref());
         }
     }
 }

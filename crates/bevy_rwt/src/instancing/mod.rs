@@ -184,6 +184,10 @@ pub struct InstancedChunk {
     pub mesh: Handle<Mesh>,
     /// The class's meshes: near, and far with its distance.
     pub meshes: (Handle<Mesh>, Option<crate::look::InstancedFar>),
+    /// Whether culling per instance may choose between the near and the far mesh by each
+    /// instance's own distance rather than the chunk's: the class has a far mesh as tall
+    /// as its near one (the shader's reference for the colours' gradient and the sway).
+    pub far_per_instance: bool,
     /// The shading.
     pub material: InstancedShading,
     /// Height of the mesh's top above its origin (the tip, which sways most).

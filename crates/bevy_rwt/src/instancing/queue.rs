@@ -361,6 +361,7 @@ impl<'a> Upload<'a> {
             class,
             mesh: look.mesh.clone(),
             meshes: (look.mesh.clone(), look.far.clone()),
+            far_per_instance: false,
             material: look.material.clone(),
             mesh_top: mesh_bounds.1.y.max(1e-3),
             max_scale: c.scale * (1.0 + c.scale_variation.abs()),
@@ -370,6 +371,11 @@ impl<'a> Upload<'a> {
             fade_out,
         };
         let aabb = component.aabb(self.checked.class_bounds(&component.meshes, self.meshes));
+        let far_per_instance = self.checked.far_as_tall(&component.meshes, self.meshes);
+        let component = InstancedChunk {
+            far_per_instance,
+            ..component
+        };
         Some((component, aabb))
     }
 }
@@ -415,6 +421,7 @@ fn impostor_chunk(
         class,
         mesh: atlas.card.clone(),
         meshes: (atlas.card.clone(), None),
+        far_per_instance: false,
         material,
         mesh_top: (frames.center.y + frames.half.y).max(1e-3),
         max_scale: c.scale * (1.0 + c.scale_variation.abs()),

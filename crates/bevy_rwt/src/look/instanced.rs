@@ -144,12 +144,20 @@ pub struct InstancedLook {
 /// `distance` from every camera draw `mesh` instead of the class's (chosen per chunk, with
 /// [`InstancedFar::HYSTERESIS`] against flicker at the boundary). The fade-in by rank keeps
 /// growing and shrinking instances across the change.
+///
+/// Culled per instance on the GPU, each instance draws the mesh its own distance from the
+/// view's eye calls for (a chunk across the distance draws both meshes), where the far mesh
+/// is as tall as the class's (the shader's reference for colour and sway) and draws under
+/// the same pipeline (the same vertex attributes, topology and index format), as
+/// [`far_blade_mesh`](crate::look::far_blade_mesh) and [`blade_mesh`](crate::look::blade_mesh)
+/// do.
 #[derive(Clone, Debug, PartialEq, Reflect)]
 #[reflect(Clone, Debug, PartialEq)]
 pub struct InstancedFar {
     /// The far mesh (same conventions as the class's: y up, root at its lowest point).
     pub mesh: Handle<Mesh>,
-    /// Distance from the camera to a chunk's bounds from which it draws the far mesh.
+    /// Distance from the camera to a chunk's bounds (culled per instance: to an instance's
+    /// root) from which it draws the far mesh.
     pub distance: f32,
 }
 

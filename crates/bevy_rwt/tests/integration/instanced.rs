@@ -428,4 +428,19 @@ fn far_chunks_draw_the_far_mesh_and_near_ones_the_class_mesh() {
     move_viewer(&mut app, viewer, eye);
     tick_app(&mut app, 4_000);
     check(&mut app, eye);
+    // The far mesh is lower than the class's (the shader's reference for colour and sway):
+    // culling per instance may not choose between them per instance. Once as tall, it may.
+    let per_instance = |app: &mut App| {
+        let mut q = app.world_mut().query::<&InstancedChunk>();
+        let chunks: Vec<bool> = q.iter(app.world()).map(|c| c.far_per_instance).collect();
+        assert!(!chunks.is_empty());
+        assert!(chunks.iter().all(|&p| p == chunks[0]), "every chunk alike");
+        chunks[0]
+    };
+    assert!(!per_instance(&mut app));
+    let mut meshes = app.world_mut().resource_mut::<Assets<Mesh>>();
+    *meshes.get_mut(&far).unwrap() = small(6);
+    app.update();
+    app.update();
+    assert!(per_instance(&mut app));
 }

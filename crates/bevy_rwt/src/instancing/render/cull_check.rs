@@ -28,7 +28,7 @@ struct CheckState {
 /// What a check found in one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct CullingReport {
-    /// Culled draws (a chunk in a view).
+    /// Culled draws (a mesh of a chunk in a view).
     pub draws: usize,
     /// Instances of the chunks drawn, summed over the draws.
     pub instances: u64,
@@ -40,6 +40,9 @@ pub struct CullingReport {
     /// as its arguments count) are not those the CPU keeps, or in a view that occludes, not
     /// among them (the CPU tests no depth, so occlusion may only drop instances).
     pub mismatched: usize,
+    /// Culled draws of a class's far mesh, chosen by each instance's distance (a chunk
+    /// across the far distance draws its near mesh too, in another draw).
+    pub far_draws: usize,
     /// Culled draws in views that occlude.
     pub occluding_draws: usize,
     /// Instances the late phase of occlusion kept: hidden by last frame's depth, not by
@@ -97,6 +100,8 @@ pub(super) struct Checked {
     pub record: CullRecord,
     pub instances: Arc<InstanceBuffer>,
     pub occludes: bool,
+    /// Whether it draws its class's far mesh (chosen per instance).
+    pub far: bool,
     /// The byte ranges of the pool its early and late phases keep into.
     pub kept: Range<u64>,
     pub late: Option<Range<u64>>,
@@ -159,6 +164,7 @@ pub(in crate::instancing) fn check_culling(
         gpu.sort_unstable();
         cpu.sort_unstable();
         report.draws += 1;
+        report.far_draws += usize::from(c.far);
         report.instances += c.instances.instances.len() as u64;
         report.gpu_kept += gpu.len() as u64;
         report.cpu_kept += cpu.len() as u64;

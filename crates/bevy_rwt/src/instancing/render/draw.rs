@@ -45,8 +45,8 @@ impl<P: PhaseItem, const I: usize> RenderCommand<P> for SetChunkBindGroup<I> {
     }
 }
 
-/// Draws a chunk's mesh once per instance: those culling kept for the view (in each of
-/// its ranges), or all.
+/// Draws a chunk's mesh once per instance: those culling kept for the view (for each mesh
+/// it chose, in each of its ranges), or all.
 pub(in crate::instancing) struct DrawChunkInstances;
 
 impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
@@ -71,40 +71,40 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
         let Some((chunk, gpu)) = item else {
             return RenderCommandResult::Skip;
         };
-        let Some(slices) = MeshSlices::of(meshes, allocator, chunk.mesh) else {
-            return RenderCommandResult::Skip;
-        };
-        pass.set_vertex_buffer(0, slices.vertices.slice(..));
-        if let Some((buffer, format)) = slices.indices {
-            pass.set_index_buffer(buffer.slice(..), format);
-        }
-        let [count, _, first, base, _] = slices.args;
-        match (culled, slices.indices.is_some()) {
-            (Some((draw, kept, args)), indexed) => {
+        if let Some((draws, kept, args)) = culled {
+            for draw in draws.iter() {
+                let Some(slices) = MeshSlices::of(meshes, allocator, draw.mesh) else {
+                    return RenderCommandResult::Skip;
+                };
+                slices.bind(pass);
                 for range in std::iter::once(&draw.early).chain(&draw.late) {
                     pass.set_vertex_buffer(1, kept.slice(range.kept.clone()));
-                    if indexed {
+                    if slices.indices.is_some() {
                         pass.draw_indexed_indirect(args, range.args);
                     } else {
                         pass.draw_indirect(args, range.args);
                     }
                 }
             }
-            (None, indexed) => {
-                let instances = match &gpu.own {
-                    Some(own) => own.slice(..),
-                    None => match slab.into_inner().slice(item_of.entity()) {
-                        Some((buffer, bytes)) => buffer.slice(bytes),
-                        None => return RenderCommandResult::Skip,
-                    },
-                };
-                pass.set_vertex_buffer(1, instances);
-                if indexed {
-                    pass.draw_indexed(first..first + count, base as i32, 0..gpu.count);
-                } else {
-                    pass.draw(first..first + count, 0..gpu.count);
-                }
-            }
+            return RenderCommandResult::Success;
+        }
+        let Some(slices) = MeshSlices::of(meshes, allocator, chunk.mesh) else {
+            return RenderCommandResult::Skip;
+        };
+        let instances = match &gpu.own {
+            Some(own) => own.slice(..),
+            None => match slab.into_inner().slice(item_of.entity()) {
+                Some((buffer, bytes)) => buffer.slice(bytes),
+                None => return RenderCommandResult::Skip,
+            },
+        };
+        slices.bind(pass);
+        pass.set_vertex_buffer(1, instances);
+        let [count, _, first, base, _] = slices.args;
+        if slices.indices.is_some() {
+            pass.draw_indexed(first..first + count, base as i32, 0..gpu.count);
+        } else {
+            pass.draw(first..first + count, 0..gpu.count);
         }
         RenderCommandResult::Success
     }
@@ -121,6 +121,14 @@ pub(super) struct MeshSlices<'a> {
 }
 
 impl<'a> MeshSlices<'a> {
+    /// Binds the mesh's vertices (slot 0) and indices.
+    fn bind(&self, pass: &mut TrackedRenderPass<'a>) {
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        if let Some((buffer, format)) = self.indices {
+            pass.set_index_buffer(buffer.slice(..), format);
+        }
+    }
+
     /// The slices of `mesh`, once it is prepared and allocated.
     pub fn of(
         meshes: &'a RenderAssets<RenderMesh>,

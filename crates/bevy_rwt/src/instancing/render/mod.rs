@@ -79,6 +79,9 @@ pub(super) fn embed_shader(app: &mut App) {
 pub struct ExtractedChunk {
     buffer: Arc<InstanceBuffer>,
     mesh: AssetId<Mesh>,
+    /// The class's near and far meshes, where culling per instance may choose between them
+    /// by each instance's distance.
+    lods: Option<MeshLods>,
     uniform: ChunkUniform,
     /// World-space bounds of the drawn instances, for culling shadow views.
     bounds: Aabb,
@@ -99,6 +102,27 @@ impl ExtractedChunk {
             impostor: self.uniform.impostor_views != 0 && self.texture.is_some(),
             fades_out: self.uniform.fade_out_to > 0.0,
         }
+    }
+}
+
+/// A class's near and far meshes, and the distance from the eye from which an instance
+/// draws the far one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct MeshLods {
+    near: AssetId<Mesh>,
+    far: AssetId<Mesh>,
+    distance: f32,
+}
+
+impl MeshLods {
+    /// The meshes of `chunk`'s class, where it may choose by each instance's distance.
+    fn of(chunk: &InstancedChunk) -> Option<Self> {
+        let far = chunk.meshes.1.as_ref().filter(|_| chunk.far_per_instance)?;
+        Some(Self {
+            near: chunk.meshes.0.id(),
+            far: far.mesh.id(),
+            distance: far.distance,
+        })
     }
 }
 
@@ -143,6 +167,7 @@ impl ExtractComponent for InstancedChunk {
             reach: reach(&local, chunk.buffer.bounds, chunk.max_scale, aabb.is_some()),
             buffer: chunk.buffer.clone(),
             mesh: chunk.mesh.id(),
+            lods: MeshLods::of(chunk),
             uniform: ChunkUniform::new(origin, chunk.mesh_top, &chunk.material, chunk.falloff)
                 .with_impostor(chunk.impostor.as_ref(), chunk.fade_out),
             bounds: Aabb {

@@ -209,19 +209,20 @@ fn grow(
     true
 }
 
-/// A chunk's record in its view, before its place in the pool and the arguments is known.
+/// A chunk's record in its view (of one of its meshes: the instances of its band), before its place in the pool and the arguments is known.
 pub(super) fn record(d: &Dispatch) -> CullRecord {
     let u = &d.gpu.uniform;
     let shadow_distance = match (d.view.shadow, d.extracted.shadows) {
         (true, InstancedShadows::Within(distance)) => distance,
         _ => -1.0,
     };
+    let (fade_in_from, fade_out_to) = d.part.band(u.fade_in_from, u.fade_out_to);
     CullRecord {
         origin: u.origin,
         reach: d.extracted.reach,
         shadow_distance,
-        fade_in_from: u.fade_in_from,
-        fade_out_to: u.fade_out_to,
+        fade_in_from,
+        fade_out_to,
         lod: u.lod,
         instances: d.gpu.count,
         first_instance: d.first_instance,

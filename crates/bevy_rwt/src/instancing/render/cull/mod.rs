@@ -16,6 +16,7 @@
 //! once this frame's early depth is reduced, and drawn from the late prepass on.
 
 mod layout;
+mod lods;
 mod occlusion;
 mod params;
 #[cfg(test)]
@@ -66,12 +67,33 @@ pub(in crate::instancing) struct CulledRange {
     pub kept: Range<u64>,
 }
 
-/// One chunk's culled draw in one view: the instances its early phase kept, and in a view
-/// that occludes, those its late phase kept.
+/// One mesh's culled draw of a chunk in one view: the mesh, the instances its early phase
+/// kept, and in a view that occludes, those its late phase kept.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(in crate::instancing) struct CulledDraw {
+    pub mesh: AssetId<Mesh>,
     pub early: CulledRange,
     pub late: Option<CulledRange>,
+}
+
+/// A chunk's culled draws in one view: one per mesh it draws (its class's near and far
+/// meshes where its instances lie on both sides of the far distance: [`lods`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub(in crate::instancing) struct CulledDraws([Option<CulledDraw>; 2]);
+
+impl CulledDraws {
+    /// Its draws, in the order they were recorded.
+    pub fn iter(&self) -> impl Iterator<Item = &CulledDraw> {
+        self.0.iter().flatten()
+    }
+
+    fn push(&mut self, draw: CulledDraw) {
+        let free = self.0.iter_mut().find(|d| d.is_none());
+        debug_assert!(free.is_some(), "a chunk draws at most two meshes");
+        if let Some(free) = free {
+            *free = Some(draw);
+        }
+    }
 }
 
 /// The frame's cull bind group, and the buffers it was made with.
@@ -110,7 +132,7 @@ pub(in crate::instancing) struct InstanceCuller {
     /// The bind group every dispatch of the frame uses.
     bind: Option<FrameBind>,
     /// This frame's culled draws, by (view, chunk) render entity.
-    draws: HashMap<(Entity, Entity), CulledDraw>,
+    draws: HashMap<(Entity, Entity), CulledDraws>,
     /// This frame's early phase, a dispatch per view.
     early: Vec<ViewWork>,
     /// This frame's late phase, by view.
@@ -123,8 +145,8 @@ pub(in crate::instancing) struct InstanceCuller {
 }
 
 impl InstanceCuller {
-    /// The culled draw of `chunk` in `view` this frame, with the buffers it reads.
-    pub fn draw(&self, view: Entity, chunk: Entity) -> Option<(&CulledDraw, &Buffer, &Buffer)> {
+    /// The culled draws of `chunk` in `view` this frame, with the buffers they read.
+    pub fn draw(&self, view: Entity, chunk: Entity) -> Option<(&CulledDraws, &Buffer, &Buffer)> {
         let draw = self.draws.get(&(view, chunk))?;
         Some((draw, self.kept.as_ref()?, self.args.as_ref()?))
     }
@@ -224,12 +246,14 @@ struct ViewCull {
     occluding: Option<occlusion::Occluding>,
 }
 
-/// One chunk in a view (a record of the view's dispatch).
+/// One chunk in a view, one mesh of it (a record of the view's dispatch).
 struct Dispatch<'a> {
     view: ViewCull,
     chunk: Entity,
     extracted: &'a ExtractedChunk,
     gpu: &'a GpuChunk,
+    /// The mesh and the instances it draws.
+    part: lods::Part,
     /// The chunk's first instance in the slab.
     first_instance: u32,
     /// The draw's arguments before culling (the instance count 0).
@@ -383,6 +407,7 @@ impl InstanceCuller {
                 record: *record,
                 instances: d.extracted.buffer.clone(),
                 occludes: o.late.is_some(),
+                far: d.part.far,
                 kept: o.kept..o.kept + bytes(d),
                 late: o.late.map(|l| l..l + bytes(d)),
             });
@@ -397,7 +422,13 @@ impl InstanceCuller {
                 kept: late..late + bytes(d),
             });
             self.draws
-                .insert((d.view.entity, d.chunk), CulledDraw { early, late });
+                .entry((d.view.entity, d.chunk))
+                .or_default()
+                .push(CulledDraw {
+                    mesh: d.part.mesh,
+                    early,
+                    late,
+                });
         }
     }
 }
@@ -456,25 +487,50 @@ impl CullInputs<'_, '_> {
             .filter(|(.., gpu)| gpu.count > 0)
             .filter(|(view, _, extracted, gpu)| {
                 whole::may_drop(view, &extracted.bounds, &gpu.uniform, extracted.shadows)
+                    || lods::across(view, extracted)
             })
-            .filter_map(|(view, chunk, extracted, gpu)| {
-                let args = self.args(extracted)?;
-                let first_instance = self.slab.range(chunk).filter(|_| gpu.own.is_none())?.start;
-                Some(Dispatch {
-                    view: *view,
-                    chunk,
-                    extracted,
-                    gpu,
-                    first_instance,
-                    args,
-                })
-            })
+            .flat_map(|(view, chunk, extracted, gpu)| self.parts(view, chunk, extracted, gpu))
+            .flatten()
             .collect()
     }
 
-    /// A chunk's draw arguments before culling, as the direct draw would give them.
-    fn args(&self, chunk: &ExtractedChunk) -> Option<[u32; ARGS_WORDS as usize]> {
-        MeshSlices::of(&self.meshes, &self.allocator, chunk.mesh).map(|s| s.args)
+    /// The dispatches of one chunk in one view, a mesh each; none unless every mesh is
+    /// ready and the chunk's instances are in the slab (then it is drawn whole).
+    fn parts<'a>(
+        &'a self,
+        view: &ViewCull,
+        chunk: Entity,
+        extracted: &'a ExtractedChunk,
+        gpu: &'a GpuChunk,
+    ) -> [Option<Dispatch<'a>>; 2] {
+        let first = self.slab.range(chunk).filter(|_| gpu.own.is_none());
+        let Some(first_instance) = first.map(|r| r.start) else {
+            return [None, None];
+        };
+        let parts = lods::parts(view, extracted, &self.meshes);
+        let dispatch = |part: Option<lods::Part>| {
+            let part = part?;
+            Some(Dispatch {
+                view: *view,
+                chunk,
+                extracted,
+                gpu,
+                part,
+                first_instance,
+                args: self.args(part.mesh)?,
+            })
+        };
+        let dispatches = parts.map(dispatch);
+        let ready = parts
+            .iter()
+            .zip(&dispatches)
+            .all(|(p, d)| p.is_none() == d.is_none());
+        if ready { dispatches } else { [None, None] }
+    }
+
+    /// A mesh's draw arguments before culling, as the direct draw would give them.
+    fn args(&self, mesh: AssetId<Mesh>) -> Option<[u32; ARGS_WORDS as usize]> {
+        MeshSlices::of(&self.meshes, &self.allocator, mesh).map(|s| s.args)
     }
 }
 
