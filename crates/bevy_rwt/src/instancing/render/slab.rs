@@ -121,6 +121,7 @@ impl InstanceSlab {
     }
 
     /// Instances the buffer holds (0 before the first chunk).
+    #[cfg(feature = "testing")]
     pub fn capacity(&self) -> u32 {
         self.buffer.as_ref().map_or(0, |_| self.ranges.capacity)
     }

@@ -1,9 +1,9 @@
 //! How a frame's culling is laid out: each view's region of the pool of kept instances,
 //! each chunk's record in it (its ranges, marks and workgroups), and buffers large enough.
 
-use super::{
-    ARGS_WORDS, CullRecord, CullView, Dispatch, INSTANCE_BYTES, InstanceCuller, WORKGROUP,
-};
+#[cfg(feature = "testing")]
+use super::CullView;
+use super::{ARGS_WORDS, CullRecord, Dispatch, INSTANCE_BYTES, InstanceCuller, WORKGROUP};
 use crate::look::InstancedShadows;
 use bevy::prelude::*;
 use bevy::render::render_resource::*;
