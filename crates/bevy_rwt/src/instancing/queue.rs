@@ -355,13 +355,15 @@ impl<'a> Upload<'a> {
         let impostors = self.impostors.and_then(|a| a.of(c)).is_some();
         let fade_out = c.impostor.filter(|_| impostors).map(|i| i.band());
         let mesh_bounds = self.checked.bounds(&look.mesh, self.meshes);
+        let meshes = (look.mesh.clone(), look.far.clone());
+        let far_per_instance = self.checked.far_as_tall(&meshes, self.meshes);
         let component = InstancedChunk {
             layer: target.entity,
             chunk: target.chunk,
             class,
             mesh: look.mesh.clone(),
-            meshes: (look.mesh.clone(), look.far.clone()),
-            far_per_instance: false,
+            meshes,
+            far_per_instance,
             material: look.material.clone(),
             mesh_top: mesh_bounds.1.y.max(1e-3),
             max_scale: c.scale * (1.0 + c.scale_variation.abs()),
@@ -371,11 +373,6 @@ impl<'a> Upload<'a> {
             fade_out,
         };
         let aabb = component.aabb(self.checked.class_bounds(&component.meshes, self.meshes));
-        let far_per_instance = self.checked.far_as_tall(&component.meshes, self.meshes);
-        let component = InstancedChunk {
-            far_per_instance,
-            ..component
-        };
         Some((component, aabb))
     }
 }
