@@ -17,8 +17,8 @@
 //! must draw the same frame and pass the same check.
 //!
 //! It prints `rwt-culling: draws D (far F) instances N kept G (gpu) C (cpu) mismatched M,
-//! pixel difference P`, then `rwt-culling: slab grown to G, shrunk to S instances: draws D kept G
-//! (gpu) C (cpu) mismatched M, pixel difference P`, and exits with an error unless the
+//! pixel difference P`, then `rwt-culling: slab grown to G, shrunk to S instances: draws D
+//! kept G (gpu) C (cpu) mismatched M, pixel difference P`, and exits with an error unless the
 //! counts agree, culling kept fewer instances than it was given, some blades drew the far
 //! mesh and some the near one, the slab shrank, and the
 //! frames differ by less than [`MOST_DIFFERENCE`] in the mean (0..255 a channel).

@@ -209,7 +209,8 @@ fn grow(
     true
 }
 
-/// A chunk's record in its view (of one of its meshes: the instances of its band), before its place in the pool and the arguments is known.
+/// A chunk's record in its view (of one of its meshes: the instances of its band), before
+/// its place in the pool and the arguments is known.
 pub(super) fn record(d: &Dispatch) -> CullRecord {
     let u = &d.gpu.uniform;
     let shadow_distance = match (d.view.shadow, d.extracted.shadows) {

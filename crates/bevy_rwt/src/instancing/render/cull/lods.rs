@@ -95,10 +95,9 @@ pub(super) fn across(view: &ViewCull, chunk: &ExtractedChunk) -> bool {
 }
 
 /// The distances from `eye` to the nearest and the farthest point of `bounds`.
-pub(super) fn distances(bounds: &Aabb, eye: Vec3) -> (f32, f32) {
-    let (min, max) = (Vec3::from(bounds.min()), Vec3::from(bounds.max()));
-    let farthest = Vec3::select((eye - min).cmpge(max - eye), min, max);
-    (eye.clamp(min, max).distance(eye), farthest.distance(eye))
+fn distances(bounds: &Aabb, eye: Vec3) -> (f32, f32) {
+    let (nearest, farthest) = super::whole::nearest_and_farthest(bounds, eye);
+    (nearest.distance(eye), farthest.distance(eye))
 }
 
 /// Whether the near and far meshes draw under one pipeline: prepared, the same vertex

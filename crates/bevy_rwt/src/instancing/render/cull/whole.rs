@@ -31,16 +31,24 @@ pub(super) fn may_drop(
         return true;
     }
     let eye = view.eye;
-    let farthest = Vec3::select((eye - min).cmpge(max - eye), min, max);
+    let (nearest, farthest) = nearest_and_farthest(bounds, eye);
     let far = farthest.distance(eye);
     let far_xz = farthest.xz().distance(eye.xz());
-    let near = eye.clamp(min, max).distance(eye);
+    let near = nearest.distance(eye);
     let lod = &chunk.lod;
     let grows = lod.falloff_on != 0 && far_xz > lod.falloff_near;
     let thins = lod.thinning_on != 0 && far_xz > lod.thinning_from;
     let casts_beyond = view.shadow && matches!(shadows, InstancedShadows::Within(d) if far > d);
     let fades = near < chunk.fade_in_from || (chunk.fade_out_to > 0.0 && far >= chunk.fade_out_to);
     grows || thins || casts_beyond || fades
+}
+
+/// The point of `bounds` nearest to `eye` (itself inside them) and the corner farthest
+/// from it.
+pub(super) fn nearest_and_farthest(bounds: &Aabb, eye: Vec3) -> (Vec3, Vec3) {
+    let (min, max) = (Vec3::from(bounds.min()), Vec3::from(bounds.max()));
+    let farthest = Vec3::select((eye - min).cmpge(max - eye), min, max);
+    (eye.clamp(min, max), farthest)
 }
 
 #[cfg(test)]
