@@ -3,7 +3,8 @@
 //! `scripts/gpu_bench.sh` runs it (built on any machine, run on one with a GPU), or
 //! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
 //! [--thin 25] [--shadow-distance 0] [--far-blade 0] [--msaa 4] [--tuft 1]
-//! [--shadows on|off] [--cull on|off] [--forest thinned|impostors] [--shots DIR] [--detail]`;
+//! [--shadows on|off] [--cull on|off] [--casters read|all] [--forest thinned|impostors]
+//! [--shots DIR] [--detail]`;
 //! `--shots` saves one
 //! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
@@ -19,6 +20,8 @@
 //! none). `--msaa` sets the samples per pixel (1, 2 or 4; Bevy's default 4), to tell the
 //! pixels' share of a frame. `--tuft K` draws K blades a mesh ([`tuft`]) at a K-th of the
 //! density: as many blades, a K-th of the instances (1, the default: one blade a mesh).
+//! `--casters all` draws every blade in a cascade's box into it ([`CascadeCasters::All`];
+//! `read`, the default, only those whose shadows fall where the camera reads it).
 //! For each blade count
 //! (millions of live blades) with the grass's shadows off, then on, each with culling per
 //! instance on the GPU off, then on ([`InstanceCulling`]), it waits for streaming to settle,
@@ -79,7 +82,7 @@ fn main() {
         Err(message) => {
             eprintln!("gpu_bench: {message}");
             eprintln!(
-                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--tuft K] [--shadows on|off] [--cull on|off] [--forest thinned|impostors] (M: millions)"
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--tuft K] [--shadows on|off] [--cull on|off] [--casters read|all] [--forest thinned|impostors] (M: millions)"
             );
             std::process::exit(2);
         }
@@ -110,6 +113,7 @@ fn main() {
             .with_despawn_budget(1_000_000)
             .with_max_tasks(32),
     ))
+    .insert_resource(options.casters)
     .insert_resource(Bench::new(options))
     .insert_resource(InstanceCulling::PerChunk)
     .add_systems(Startup, setup)
@@ -152,6 +156,8 @@ struct Options {
     /// The only shadows and culling timed (`None`: off, then on).
     shadows: Option<bool>,
     cull: Option<bool>,
+    /// Which blades the shadow cascades draw.
+    casters: CascadeCasters,
 }
 
 impl Default for Options {
@@ -170,6 +176,7 @@ impl Default for Options {
             forest: None,
             shadows: None,
             cull: None,
+            casters: CascadeCasters::WhereRead,
         }
     }
 }
@@ -221,6 +228,13 @@ impl Options {
                     };
                 }
                 "--tuft" => options.tuft = within(&value, 1..=64).ok_or_else(bad)?,
+                "--casters" => {
+                    options.casters = match value.as_str() {
+                        "read" => CascadeCasters::WhereRead,
+                        "all" => CascadeCasters::All,
+                        _ => return Err(bad()),
+                    };
+                }
                 "--shadows" | "--cull" => {
                     let on = match value.as_str() {
                         "on" => true,

@@ -167,7 +167,8 @@ use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 pub use diagnostics::{RwtDiagnosticsPlugin, RwtStats};
 pub use instancing::{
-    Bender, InstanceCulling, InstancedChunk, RwtFadeIn, RwtInstancingPlugin, RwtWind,
+    Bender, CascadeCasters, InstanceCulling, InstancedChunk, RwtFadeIn, RwtInstancingPlugin,
+    RwtWind,
 };
 pub use layers::RwtLayersPlugin;
 pub use layers::{
@@ -200,12 +201,12 @@ pub mod prelude {
     pub use crate::picking::{PickFilter, ScatterHit, ScatterPicking};
     pub use crate::save::{LoadWorld, NamedMap, RwtSavePlugin, SaveWorld, WorldLoaded, WorldSaved};
     pub use crate::{
-        AssetStatus, Bender, ChunkLoaded, ChunkUnloaded, ClassLook, DensityMapPainted, GroundMap,
-        GroundPlane, HeightSource, Impostor, InstanceCulling, InstancedChunk, InstancedShading,
-        InstancedShadows, InstancedThinning, LayerDensity, RwtDiagnosticsPlugin, RwtFadeIn,
-        RwtInstancingPlugin, RwtLayersPlugin, RwtPlugins, RwtSettings, RwtStats,
-        RwtStreamingPlugin, RwtSystems, RwtViewer, RwtViewersPlugin, RwtWind, ScatterClass,
-        ScatterEntity, ScatterLayer, ScatterLayerStatus, ViewCone,
+        AssetStatus, Bender, CascadeCasters, ChunkLoaded, ChunkUnloaded, ClassLook,
+        DensityMapPainted, GroundMap, GroundPlane, HeightSource, Impostor, InstanceCulling,
+        InstancedChunk, InstancedShading, InstancedShadows, InstancedThinning, LayerDensity,
+        RwtDiagnosticsPlugin, RwtFadeIn, RwtInstancingPlugin, RwtLayersPlugin, RwtPlugins,
+        RwtSettings, RwtStats, RwtStreamingPlugin, RwtSystems, RwtViewer, RwtViewersPlugin,
+        RwtWind, ScatterClass, ScatterEntity, ScatterLayer, ScatterLayerStatus, ViewCone,
     };
     pub use rwt_core::Lattice;
     pub use rwt_core::streaming::{Falloff, StreamingConfig};

@@ -100,6 +100,25 @@ pub enum InstanceCulling {
     PerInstance,
 }
 
+/// Which instances a directional light's shadow cascades draw.
+///
+/// A cascade's shadow map covers a box around its slice of the camera's frustum, wider
+/// than the slice and reaching behind the camera; each instanced chunk, and with culling per
+/// instance each instance, is drawn into it only where its shadow may fall on what the
+/// camera sees through that cascade.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Reflect)]
+#[reflect(Resource, Clone, Debug, PartialEq, Default)]
+pub enum CascadeCasters {
+    /// Those whose shadow may fall in the camera's frustum, in the slice of view depth
+    /// that reads the cascade (with a margin for filtering, the normal bias and diffuse
+    /// transmission). Lights with soft shadows (`soft_shadow_size`) draw every instance.
+    #[default]
+    WhereRead,
+    /// Every instance in the cascade's box, as Bevy draws meshes: for a shader that reads
+    /// the cascades elsewhere (a reflection, the shadows of points outside the frustum).
+    All,
+}
+
 /// One instance as the GPU reads it: 24 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

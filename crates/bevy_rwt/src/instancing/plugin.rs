@@ -2,7 +2,8 @@
 //! every [`InstancedChunk`] with one instanced draw.
 
 use super::{
-    BendField, Bender, InstanceCulling, InstancedChunk, InstancedMeshes, RwtFadeIn, RwtWind,
+    BendField, Bender, CascadeCasters, InstanceCulling, InstancedChunk, InstancedMeshes, RwtFadeIn,
+    RwtWind,
 };
 use super::{bend, far, mesh, render};
 use crate::settings::{RwtSystems, configure_sets, in_schedule};
@@ -37,6 +38,7 @@ impl Plugin for RwtInstancingPlugin {
         app.init_resource::<RwtWind>()
             .init_resource::<RwtFadeIn>()
             .init_resource::<InstanceCulling>()
+            .init_resource::<CascadeCasters>()
             .init_resource::<InstancedMeshes>()
             .init_resource::<BendField>()
             .init_resource::<crate::impostor::ImpostorAtlases>()
@@ -45,6 +47,7 @@ impl Plugin for RwtInstancingPlugin {
             .register_type::<RwtWind>()
             .register_type::<RwtFadeIn>()
             .register_type::<InstanceCulling>()
+            .register_type::<CascadeCasters>()
             .register_type::<InstancedChunk>()
             .add_systems(
                 self.schedule,
@@ -77,6 +80,7 @@ fn build_render(app: &mut App) {
         ExtractResourcePlugin::<RwtWind>::default(),
         ExtractResourcePlugin::<RwtFadeIn>::default(),
         ExtractResourcePlugin::<InstanceCulling>::default(),
+        ExtractResourcePlugin::<CascadeCasters>::default(),
         ExtractResourcePlugin::<BendField>::default(),
     ));
     #[cfg(feature = "testing")]

@@ -50,6 +50,10 @@ pub struct CullingReport {
     pub late_kept: u64,
     /// Instances the buffer of every chunk's instances holds (its size, not its use).
     pub slab_capacity: u64,
+    /// Instances of the draws in directional lights' cascades that the rest of the test
+    /// keeps and that cast nowhere the camera reads the cascade ([`crate::CascadeCasters`];
+    /// the CPU's count).
+    pub cascade_dropped: u64,
 }
 
 impl CullingCheck {
@@ -161,6 +165,15 @@ pub(in crate::instancing) fn check_culling(
             .filter(|g| c.record.keeps(&c.view, g))
             .map(|g| bytemuck::cast(*g))
             .collect();
+        if c.view.light.w != 0.0 {
+            let every_caster = CullView {
+                light: Vec4::ZERO,
+                ..c.view
+            };
+            let kept = c.instances.instances.iter();
+            let kept = kept.filter(|g| c.record.keeps(&every_caster, g)).count();
+            report.cascade_dropped += kept.saturating_sub(cpu.len()) as u64;
+        }
         gpu.sort_unstable();
         cpu.sort_unstable();
         report.draws += 1;

@@ -6,6 +6,7 @@
 
 use super::draw::{DrawChunkInstances, SetChunkBindGroup};
 use super::main_pass::{mesh_attributes, mesh_bin};
+use super::receivers::ShadowReceivers;
 use super::{
     ChunkBindings, ChunkPipelines, ClassFeatures, ExtractedChunk, MainViewer, Queued,
     instance_layout, rebin_cameras,
@@ -197,13 +198,15 @@ pub(in crate::instancing) fn queue_prepass(
 /// A shadow view: where it looks (a directional light's frustum reaches to the light), and
 /// what it draws.
 type ShadowView<'a> = (
+    Entity,
     &'a ExtractedView,
     Option<&'a Frustum>,
     Option<&'a RenderLayers>,
 );
 
 /// Bins the chunks that cast (their class's setting, their distance to the main camera)
-/// and that each shadow view's frustum holds into its shadow phase.
+/// and that each shadow view's frustum holds, where a directional light's cascade is read,
+/// into its shadow phase.
 #[allow(clippy::too_many_arguments)]
 pub(in crate::instancing) fn queue_shadows(
     draw_functions: Res<DrawFunctions<Shadow>>,
@@ -214,23 +217,27 @@ pub(in crate::instancing) fn queue_shadows(
     light_keys: Res<LightKeyCache>,
     viewer: Res<MainViewer>,
     mut queued: ResMut<Queued<Shadow>>,
+    receivers: ShadowReceivers,
 ) {
+    let receivers = receivers.by_view();
     let draw = draw_functions.read().id::<DrawInstancedDepth>();
     let casting: Vec<_> = chunks
         .iter()
         .filter(|(_, _, chunk)| casts(chunk, viewer.0))
         .collect();
-    for (view, frustum, layers) in &views {
+    for (entity, view, frustum, layers) in &views {
         let Some(phase) = phases.get_mut(&view.retained_view_entity) else {
             continue;
         };
         let light_key = light_keys.get(&view.retained_view_entity).copied();
         let sees_chunks = layers.is_none_or(|l| l.intersects(&RenderLayers::default()));
+        let read = receivers.get(&entity);
         let items = casting
             .iter()
             .filter(|_| sees_chunks)
             .filter(|(_, _, chunk)| {
                 frustum.is_none_or(|f| f.intersects_obb_identity(&chunk.bounds))
+                    && read.is_none_or(|r| r.may_cast(&chunk.bounds))
             })
             .filter_map(|&(entity, main_entity, chunk)| {
                 let light_key = light_key?;

@@ -15,6 +15,7 @@ mod cull_check;
 mod depth;
 mod draw;
 mod main_pass;
+mod receivers;
 mod retained;
 #[cfg(test)]
 mod shader_check;
@@ -39,7 +40,10 @@ pub(super) use slab::InstanceSlab;
 use uniforms::{ChunkUniform, FrameUniform, uniform_bytes};
 
 use super::bend::{BEND_FIELD_TEXELS, BendField};
-use super::{GpuInstance, InstanceBuffer, InstanceCulling, InstancedChunk, RwtFadeIn, RwtWind};
+use super::{
+    CascadeCasters, GpuInstance, InstanceBuffer, InstanceCulling, InstancedChunk, RwtFadeIn,
+    RwtWind,
+};
 use crate::look::{InstancedShadows, check_texture, check_topology};
 use bevy::camera::primitives::Aabb;
 use bevy::ecs::query::QueryItem;
@@ -222,6 +226,14 @@ impl ExtractResource for RwtFadeIn {
 
 impl ExtractResource for InstanceCulling {
     type Source = InstanceCulling;
+
+    fn extract_resource(source: &Self::Source) -> Self {
+        *source
+    }
+}
+
+impl ExtractResource for CascadeCasters {
+    type Source = CascadeCasters;
 
     fn extract_resource(source: &Self::Source) -> Self {
         *source

@@ -17,6 +17,11 @@
 struct View {
     // The view's half-spaces (normal, distance; inside where dot(n, p) + d > 0).
     planes: array<vec4<f32>, 6>,
+    // In a directional light's cascade, the half-spaces of where the camera reads its
+    // shadows (grown by a margin), and the direction the light travels (w: 1; 0 where every
+    // caster counts).
+    receivers: array<vec4<f32>, 6>,
+    light: vec4<f32>,
     // The view's clip space from world space: last frame's in the early phase, this
     // frame's in the late one.
     clip_from_world: mat4x4<f32>,
@@ -96,8 +101,22 @@ fn record_of(group: u32) -> u32 {
     return lo;
 }
 
-// Whether the instance may be seen: grown, within the shadow distance, and its sphere
-// (widened as thinning widens it) inside or across every half-space.
+// Whether a sphere's shadow may fall where the cascade is read: inside or across each of
+// those half-spaces, or carried into it by the light (`receivers.rs`).
+fn casts(center: vec3<f32>, radius: f32) -> bool {
+    for (var k = 0u; k < 6u; k++) {
+        let plane = view.receivers[k];
+        let outside = dot(plane.xyz, center) + plane.w + radius <= 0.0;
+        if outside && dot(plane.xyz, view.light.xyz) <= 0.0 {
+            return false;
+        }
+    }
+    return true;
+}
+
+// Whether the instance may be seen: grown, within the shadow distance, its sphere (widened
+// as thinning widens it) inside or across every half-space and, in a cascade, casting where
+// it is read.
 fn seen(r: Record, root: vec3<f32>, scale: f32, widen: f32) -> bool {
     if scale <= 0.0 {
         return false;
@@ -117,7 +136,7 @@ fn seen(r: Record, root: vec3<f32>, scale: f32, widen: f32) -> bool {
             return false;
         }
     }
-    return true;
+    return view.light.w == 0.0 || casts(root, radius);
 }
 
 // The pyramid's farthest depth at `at` on `level`; 0 (hides nothing) off its edge.

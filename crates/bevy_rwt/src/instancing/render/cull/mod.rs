@@ -28,6 +28,7 @@ pub(in crate::instancing) use occlusion::{cull_late, restore_early};
 pub(super) use params::{CullRecord, CullView};
 
 use super::draw::MeshSlices;
+use super::receivers::{Receivers, ShadowReceivers};
 use super::{ExtractedChunk, GpuChunk, InstanceSlab, MainViewer, Queued};
 #[cfg(test)]
 use crate::instancing::GpuInstance;
@@ -243,6 +244,8 @@ struct ViewCull {
     planes: [Vec4; 6],
     eye: Vec3,
     shadow: bool,
+    /// In a directional light's cascade, where its shadows are read.
+    receivers: Option<Receivers>,
     occluding: Option<occlusion::Occluding>,
 }
 
@@ -291,6 +294,7 @@ pub(in crate::instancing) struct CullInputs<'w, 's> {
     allocator: Res<'w, MeshAllocator>,
     viewer: Res<'w, MainViewer>,
     slab: Res<'w, InstanceSlab>,
+    receivers: ShadowReceivers<'w, 's>,
 }
 
 /// Lays out and writes the culling of every chunk binned into every view, and records the
@@ -444,6 +448,7 @@ impl CullInputs<'_, '_> {
     /// Every (view, chunk) binned this frame, once each, in a stable order (a view's
     /// dispatches together).
     fn dispatches(&self, occluding: &HashMap<Entity, occlusion::Occluding>) -> Vec<Dispatch<'_>> {
+        let receivers = self.receivers.by_view();
         let views: HashMap<RetainedViewEntity, ViewCull> = self
             .views
             .iter()
@@ -459,6 +464,7 @@ impl CullInputs<'_, '_> {
                     planes,
                     eye,
                     shadow,
+                    receivers: receivers.get(&entity).copied(),
                     occluding: occluding.get(&entity).copied(),
                 };
                 (view.retained_view_entity, cull)
@@ -555,8 +561,14 @@ impl InstanceCuller {
         for work in &mut plan.early {
             let d = &dispatches[work.records.start as usize];
             let (x, _) = grid(work.workgroups);
+            let (receivers, light) = match d.view.receivers {
+                Some(r) => (r.planes, r.light.extend(1.0)),
+                None => ([Vec4::ZERO; 6], Vec4::ZERO),
+            };
             let early = CullView {
                 planes: d.view.planes,
+                receivers,
+                light,
                 clip_from_world: Mat4::IDENTITY,
                 eye: d.view.eye,
                 phase: 0,

@@ -13,6 +13,11 @@ use bevy::render::render_resource::ShaderType;
 pub(in crate::instancing) struct CullView {
     /// The view's half-spaces (normal, distance; inside where `dot(n, p) + d > 0`).
     pub planes: [Vec4; 6],
+    /// In a directional light's cascade, the half-spaces of the region whose fragments read
+    /// its shadows (grown by a margin; [`receivers`](crate::instancing::render::receivers)), and the direction the light
+    /// travels (`w` 1; 0 where every caster counts).
+    pub receivers: [Vec4; 6],
+    pub light: Vec4,
     /// The view's clip space from world space: last frame's (early phase), this frame's
     /// (late phase).
     pub clip_from_world: Mat4,
@@ -86,8 +91,17 @@ impl CullRecord {
         if distance < self.fade_in_from || beyond {
             return false;
         }
-        view.planes
-            .iter()
-            .all(|p| p.truncate().dot(root) + p.w + radius > 0.0)
+        let casts = view.light.w == 0.0
+            || crate::instancing::render::receivers::casts(
+                &view.receivers,
+                view.light.truncate(),
+                root,
+                radius,
+            );
+        casts
+            && view
+                .planes
+                .iter()
+                .all(|p| p.truncate().dot(root) + p.w + radius > 0.0)
     }
 }

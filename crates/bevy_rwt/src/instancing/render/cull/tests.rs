@@ -24,16 +24,20 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
     // Each member's first word marked, then found in encase's bytes.
     let view = CullView {
         planes: [Vec4::splat(mark(0)); 6],
-        clip_from_world: Mat4::from_cols_array(&[mark(1); 16]),
-        eye: Vec3::splat(mark(2)),
-        phase: 3,
-        first_record: 4,
-        records: 5,
-        workgroups: 6,
-        workgroups_x: 7,
+        receivers: [Vec4::splat(mark(1)); 6],
+        light: Vec4::splat(mark(2)),
+        clip_from_world: Mat4::from_cols_array(&[mark(3); 16]),
+        eye: Vec3::splat(mark(4)),
+        phase: 5,
+        first_record: 6,
+        records: 7,
+        workgroups: 8,
+        workgroups_x: 9,
     };
     let names = [
         "planes",
+        "receivers",
+        "light",
         "clip_from_world",
         "eye",
         "phase",
@@ -44,7 +48,7 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
     ];
     assert_eq!(
         struct_layout(&types, "View"),
-        marked_layout(&view, Space::Storage, &names, |k| k >= 3)
+        marked_layout(&view, Space::Storage, &names, |k| k >= 5)
     );
     let record = CullRecord {
         origin: Vec3::splat(mark(0)),
@@ -154,6 +158,26 @@ fn an_instance_is_kept_where_its_sphere_meets_the_view_and_it_has_grown() {
     };
     assert!(shadow.keeps(&view, &at(Vec3::new(8.4, 0.0, 0.0), 0.0)));
     assert!(!shadow.keeps(&view, &at(Vec3::new(8.6, 0.0, 0.0), 0.0)));
+    // In a cascade read up to 6 m ahead, lit from above: what lies beyond casts nowhere.
+    let cascade = CullView {
+        receivers: [
+            Vec4::W,
+            Vec4::W,
+            Vec4::W,
+            Vec4::W,
+            Vec4::W,
+            Vec4::new(-1.0, 0.0, 0.0, 6.0),
+        ],
+        light: Vec4::new(0.0, -1.0, 0.0, 1.0),
+        ..view
+    };
+    assert!(no_fade.keeps(&cascade, &at(Vec3::new(6.4, 0.0, 0.0), 0.0)));
+    assert!(!no_fade.keeps(&cascade, &at(Vec3::new(6.6, 0.0, 0.0), 0.0)));
+    let lit_along = CullView {
+        light: Vec4::new(-1.0, 0.0, 0.0, 1.0),
+        ..cascade
+    };
+    assert!(no_fade.keeps(&lit_along, &at(Vec3::new(6.6, 0.0, 0.0), 0.0)));
     // Thinned from 20 m: at 40 m a quarter is kept, the lowest ranks; nearer, all.
     let thinned = CullRecord {
         lod: LodUniform {

@@ -1,7 +1,8 @@
 //! Which chunks a view draws whole without culling: those of which culling could drop no
 //! instance. A chunk wholly inside the view, nearer than where its fall-off and thinning
-//! begin, within its class's shadow distance of a shadow view's eye and inside its
-//! crossfades, in a view that does not occlude, keeps every instance; it is drawn directly,
+//! begin, within its class's shadow distance of a shadow view's eye and, in a cascade,
+//! where its shadows are read ([`receivers`](crate::instancing::render::receivers)), inside its crossfades, in a view that
+//! does not occlude, keeps every instance; it is drawn directly,
 //! with no dispatch, no uniform and no pool range (the same pixels, less work).
 
 use super::ViewCull;
@@ -39,8 +40,9 @@ pub(super) fn may_drop(
     let grows = lod.falloff_on != 0 && far_xz > lod.falloff_near;
     let thins = lod.thinning_on != 0 && far_xz > lod.thinning_from;
     let casts_beyond = view.shadow && matches!(shadows, InstancedShadows::Within(d) if far > d);
+    let casts_nowhere = view.receivers.is_some_and(|r| r.may_drop(min, max));
     let fades = near < chunk.fade_in_from || (chunk.fade_out_to > 0.0 && far >= chunk.fade_out_to);
-    grows || thins || casts_beyond || fades
+    grows || thins || casts_beyond || casts_nowhere || fades
 }
 
 /// The point of `bounds` nearest to `eye` (itself inside them) and the corner farthest
@@ -55,6 +57,7 @@ pub(super) fn nearest_and_farthest(bounds: &Aabb, eye: Vec3) -> (Vec3, Vec3) {
 mod tests {
     use super::super::tests::looking_down_x;
     use super::*;
+    use crate::instancing::render::receivers::Receivers;
     use crate::instancing::render::uniforms::LodUniform;
 
     /// A camera at the origin looking down +x (x > 0, |z| < x, no far plane).
@@ -64,6 +67,7 @@ mod tests {
             planes: looking_down_x(),
             eye: Vec3::ZERO,
             shadow: false,
+            receivers: None,
             occluding: None,
         }
     }
@@ -122,5 +126,23 @@ mod tests {
         assert!(may_drop(&shadow, &chunk(10.0, -2.0), &plain, within));
         assert!(!may_drop(&shadow, &chunk(5.0, -2.0), &plain, within));
         assert!(!may_drop(&view(), &chunk(10.0, -2.0), &plain, within));
+        // A cascade read up to 12 m ahead, lit from above: a chunk beyond is culled.
+        let cascade = ViewCull {
+            receivers: Some(Receivers {
+                planes: [
+                    Vec4::W,
+                    Vec4::W,
+                    Vec4::W,
+                    Vec4::W,
+                    Vec4::W,
+                    Vec4::new(-1.0, 0.0, 0.0, 12.0),
+                ],
+                light: Vec3::NEG_Y,
+            }),
+            ..shadow
+        };
+        let on = InstancedShadows::On;
+        assert!(!may_drop(&cascade, &chunk(5.0, -2.0), &plain, on));
+        assert!(may_drop(&cascade, &chunk(10.0, -2.0), &plain, on));
     }
 }
