@@ -20,8 +20,9 @@
 //! must draw the same frame and pass the same check.
 //!
 //! It prints `rwt-culling: draws D (far F) instances N kept G (gpu) C (cpu) mismatched M,
-//! cascade dropped K, pixel difference P, pixels differing X`, then `rwt-culling: slab grown to G, shrunk to S instances: draws D
-//! kept G (gpu) C (cpu) mismatched M, pixel difference P`, and exits with an error unless the
+//! cascade dropped K, pixel difference P, pixels differing X`, then `rwt-culling: slab
+//! grown to G, shrunk to S instances: draws D kept G (gpu) C (cpu) mismatched M, pixel
+//! difference P`, and exits with an error unless the
 //! counts agree, culling kept fewer instances than it was given, some blades drew the far
 //! mesh and some the near one, the cascade left blades out, the slab shrank, and the
 //! frames match ([`MOST_DIFFERENCE`] in the mean, [`MOST_PIXELS`]).

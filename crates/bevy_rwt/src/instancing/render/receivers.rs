@@ -65,9 +65,10 @@ impl Receivers {
         casts(&self.planes, self.light, center, radius)
     }
 
-    /// Whether an instance with its root inside `min..max` may cast nothing into the region
+    /// Whether an instance with its root inside `bounds` may cast nothing into the region
     /// (a chunk that culling per instance tests).
-    pub fn may_drop(&self, min: Vec3, max: Vec3) -> bool {
+    pub fn may_drop(&self, bounds: &Aabb) -> bool {
+        let (min, max) = (Vec3::from(bounds.min()), Vec3::from(bounds.max()));
         self.planes.iter().any(|p| {
             let nearest = Vec3::select(p.truncate().cmpge(Vec3::ZERO), min, max);
             p.truncate().dot(self.light) <= 0.0 && p.truncate().dot(nearest) + p.w <= 0.0
@@ -266,9 +267,18 @@ mod tests {
     #[test]
     fn a_chunk_is_tested_where_an_instance_may_cast_nothing_and_left_where_all_do() {
         let r = receivers(10.0..30.0);
-        assert!(!r.may_drop(Vec3::new(12.0, -1.0, -2.0), Vec3::new(16.0, 0.0, 2.0)));
-        assert!(r.may_drop(Vec3::new(28.0, -1.0, -2.0), Vec3::new(32.0, 0.0, 2.0)));
-        assert!(r.may_drop(Vec3::new(-8.0, -5.0, -2.0), Vec3::new(-4.0, -4.0, 2.0)));
+        assert!(!r.may_drop(&Aabb::from_min_max(
+            Vec3::new(12.0, -1.0, -2.0),
+            Vec3::new(16.0, 0.0, 2.0)
+        )));
+        assert!(r.may_drop(&Aabb::from_min_max(
+            Vec3::new(28.0, -1.0, -2.0),
+            Vec3::new(32.0, 0.0, 2.0)
+        )));
+        assert!(r.may_drop(&Aabb::from_min_max(
+            Vec3::new(-8.0, -5.0, -2.0),
+            Vec3::new(-4.0, -4.0, 2.0)
+        )));
         // A chunk wholly beyond the far bound casts nowhere; one across it may.
         let beyond = Aabb::from_min_max(Vec3::new(31.0, -1.0, -2.0), Vec3::new(35.0, 0.0, 2.0));
         let across = Aabb::from_min_max(Vec3::new(28.0, -1.0, -2.0), Vec3::new(32.0, 0.0, 2.0));

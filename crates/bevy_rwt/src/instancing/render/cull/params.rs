@@ -14,7 +14,8 @@ pub(in crate::instancing) struct CullView {
     /// The view's half-spaces (normal, distance; inside where `dot(n, p) + d > 0`).
     pub planes: [Vec4; 6],
     /// In a directional light's cascade, the half-spaces of the region whose fragments read
-    /// its shadows (grown by a margin; [`receivers`](crate::instancing::render::receivers)), and the direction the light
+    /// its shadows (grown by a margin;
+    /// [`receivers`](crate::instancing::render::receivers)), and the direction the light
     /// travels (`w` 1; 0 where every caster counts).
     pub receivers: [Vec4; 6],
     pub light: Vec4,

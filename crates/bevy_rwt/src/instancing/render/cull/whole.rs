@@ -1,9 +1,9 @@
 //! Which chunks a view draws whole without culling: those of which culling could drop no
 //! instance. A chunk wholly inside the view, nearer than where its fall-off and thinning
 //! begin, within its class's shadow distance of a shadow view's eye and, in a cascade,
-//! where its shadows are read ([`receivers`](crate::instancing::render::receivers)), inside its crossfades, in a view that
-//! does not occlude, keeps every instance; it is drawn directly,
-//! with no dispatch, no uniform and no pool range (the same pixels, less work).
+//! where its shadows are read ([`receivers`](crate::instancing::render::receivers)), inside
+//! its crossfades, in a view that does not occlude, keeps every instance; it is drawn
+//! directly, with no dispatch, no uniform and no pool range (the same pixels, less work).
 
 use super::ViewCull;
 use crate::instancing::render::uniforms::ChunkUniform;
@@ -40,7 +40,7 @@ pub(super) fn may_drop(
     let grows = lod.falloff_on != 0 && far_xz > lod.falloff_near;
     let thins = lod.thinning_on != 0 && far_xz > lod.thinning_from;
     let casts_beyond = view.shadow && matches!(shadows, InstancedShadows::Within(d) if far > d);
-    let casts_nowhere = view.receivers.is_some_and(|r| r.may_drop(min, max));
+    let casts_nowhere = view.receivers.is_some_and(|r| r.may_drop(bounds));
     let fades = near < chunk.fade_in_from || (chunk.fade_out_to > 0.0 && far >= chunk.fade_out_to);
     grows || thins || casts_beyond || casts_nowhere || fades
 }
