@@ -9,13 +9,16 @@
 #                                     the Vulkan loader; no network, no display); ARGS go to the
 #                                     example (--blades 1,5,10 --frames 240 --size 1920x1080
 #                                     --msaa 1|2|4 --tuft K --shadows on|off --cull on|off
-#                                     --casters read|all --forest thinned|impostors ...)
+#                                     --casters read|all --forest thinned|impostors
+#                                     --latency 0..3 ...)
 #   scripts/gpu_bench.sh split [ARGS] the 10 M case as open_world draws its grass (shadows
 #                                     within 25 m, far blade from 30 m, culled, shadows on,
-#                                     --detail) four times: as is, with --msaa 1 (the pixels'
-#                                     share), with --tuft 8 (a cost per instance) and with
-#                                     --casters all (every blade in a cascade's box drawn
-#                                     into it); about 5 minutes
+#                                     --detail) five times: as is, with --latency 0 (each
+#                                     frame waits for its own drawing: CPU and GPU times
+#                                     add up), with --msaa 1 (the pixels' share), with
+#                                     --tuft 8 (a cost per instance) and with --casters all
+#                                     (every blade in a cascade's box drawn into it); about
+#                                     6 minutes
 #
 # Built once, target/gpu-bench/ (about 20 MB) is all the run needs beside the driver: copy
 # it (or the working tree with it) to the GPU machine. The run stops after 470 s, inside 8
@@ -70,7 +73,7 @@ split)
     shift || true
     case_args=(--blades 10 --frames 120 --shadow-distance 25 --far-blade 30 --detail
         --shadows on --cull on)
-    for variant in "" "--msaa 1" "--tuft 8" "--casters all"; do
+    for variant in "" "--latency 0" "--msaa 1" "--tuft 8" "--casters all"; do
         echo "gpu-bench-split: ${variant:-as open_world draws it}"
         # shellcheck disable=SC2086 # the variant is two words or none
         "$0" run "${case_args[@]}" $variant "$@" || echo "gpu-bench-split: failed ($?)"

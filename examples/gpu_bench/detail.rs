@@ -3,7 +3,8 @@
 //! `gpu-bench-detail: blades=B shadows=S cull=C main_ms=M render_cpu_ms=R gpu_wait_ms=W PASS_ms=G ..`
 //!
 //! (medians over the frames timed): the main world's schedules, the render world's from
-//! its start to the GPU wait, the wait for the GPU to finish the frame, and each render
+//! its start to the GPU wait, the wait for the GPU to finish the frame `--latency` frames
+//! before (the frame itself with `--latency 0`), and each render
 //! pass's GPU time where the adapter has timestamp queries (Bevy's
 //! `RenderDiagnosticsPlugin`, averaged over its recent frames).
 

@@ -4,7 +4,7 @@
 //! `cargo run --release --example gpu_bench -- [--blades 1,5,10] [--frames 240] [--size 1920x1080]
 //! [--thin 25] [--shadow-distance 0] [--far-blade 0] [--msaa 4] [--tuft 1]
 //! [--shadows on|off] [--cull on|off] [--casters read|all] [--forest thinned|impostors]
-//! [--shots DIR] [--detail]`;
+//! [--latency 2] [--shots DIR] [--detail]`;
 //! `--shots` saves one
 //! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
@@ -32,9 +32,14 @@
 //!
 //! `B` is the live count measured (with `--tuft`, instances times K; a first pass measures
 //! the streamed area, so the densities meet the counts asked for). A frame is the time from
-//! one main-world frame to the next, with Bevy's pipelined rendering on as in a game, and the
-//! render world waits for the GPU to finish each frame: the time is that of the slower of the
-//! main world and render world plus GPU.
+//! one main-world frame to the next, with Bevy's pipelined rendering on as in a game. Without
+//! a window nothing paces the frames, so the render world, once it has submitted a frame,
+//! waits for the GPU to finish the frame `--latency` frames before it: 2 by default, as a
+//! window's swapchain allows in Bevy (`Window::desired_maximum_frame_latency`), so the CPU's
+//! work on a frame overlaps the GPU's on the one before and the time is that of the slowest
+//! of the main world, the render world and the GPU. With `--latency 0` each frame waits for
+//! its own drawing: the time is that of the slower of the main world and the render world
+//! plus the GPU.
 //! `cull=off` culls whole chunks on the CPU and draws every blade of those kept; `cull=on`
 //! also culls each blade on the GPU and draws indirectly.
 //!
@@ -49,7 +54,7 @@ use bevy::diagnostic::DiagnosticsStore;
 use bevy::log::{Level, LogPlugin};
 use bevy::prelude::*;
 use bevy::render::render_resource::{PollType, TextureFormat};
-use bevy::render::renderer::{RenderAdapterInfo, RenderDevice};
+use bevy::render::renderer::{RenderAdapterInfo, RenderDevice, RenderQueue};
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use bevy::render::{Render, RenderApp, RenderSystems};
 use bevy::window::ExitCondition;
@@ -73,6 +78,9 @@ const SETTLED_FRAMES: u32 = 10;
 const WARM_UP: Duration = Duration::from_secs(2);
 /// Longest a case is timed, whatever `--frames` asks.
 const LONGEST_TIMING: Duration = Duration::from_secs(15);
+/// Frames a window's swapchain lets the GPU fall behind in Bevy (its default
+/// `Window::desired_maximum_frame_latency`).
+const WINDOW_LATENCY: usize = 2;
 /// Longest streaming may take to settle before the bench gives up.
 const LONGEST_STREAMING: Duration = Duration::from_secs(180);
 
@@ -82,7 +90,7 @@ fn main() {
         Err(message) => {
             eprintln!("gpu_bench: {message}");
             eprintln!(
-                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--tuft K] [--shadows on|off] [--cull on|off] [--casters read|all] [--forest thinned|impostors] (M: millions)"
+                "usage: gpu_bench [--blades M,M,..] [--frames N] [--size WIDTHxHEIGHT] [--shots DIR] [--detail] [--thin METRES] [--shadow-distance METRES] [--far-blade METRES] [--msaa 1|2|4] [--tuft K] [--shadows on|off] [--cull on|off] [--casters read|all] [--forest thinned|impostors] [--latency 0..3] (M: millions)"
             );
             std::process::exit(2);
         }
@@ -113,12 +121,14 @@ fn main() {
             .with_despawn_budget(1_000_000)
             .with_max_tasks(32),
     ))
-    .insert_resource(options.casters)
-    .insert_resource(Bench::new(options))
-    .insert_resource(InstanceCulling::PerChunk)
-    .add_systems(Startup, setup)
-    .add_systems(First, tick)
-    .add_systems(Last, step);
+    .insert_resource(options.casters);
+    app.sub_app_mut(RenderApp)
+        .insert_resource(InFlight::new(options.latency));
+    app.insert_resource(Bench::new(options))
+        .insert_resource(InstanceCulling::PerChunk)
+        .add_systems(Startup, setup)
+        .add_systems(First, tick)
+        .add_systems(Last, step);
     app.sub_app_mut(RenderApp).add_systems(
         Render,
         wait_for_gpu.in_set(GpuWait).after(RenderSystems::Render),
@@ -158,6 +168,8 @@ struct Options {
     cull: Option<bool>,
     /// Which blades the shadow cascades draw.
     casters: CascadeCasters,
+    /// Frames the GPU may be behind the render world.
+    latency: usize,
 }
 
 impl Default for Options {
@@ -177,6 +189,7 @@ impl Default for Options {
             shadows: None,
             cull: None,
             casters: CascadeCasters::WhereRead,
+            latency: WINDOW_LATENCY,
         }
     }
 }
@@ -228,6 +241,7 @@ impl Options {
                     };
                 }
                 "--tuft" => options.tuft = within(&value, 1..=64).ok_or_else(bad)?,
+                "--latency" => options.latency = within(&value, 0..=3).ok_or_else(bad)?,
                 "--casters" => {
                     options.casters = match value.as_str() {
                         "read" => CascadeCasters::WhereRead,
@@ -611,10 +625,43 @@ fn print_case(bench: &Bench, live: usize, report: &Report) {
 #[derive(SystemSet, Clone, Debug, PartialEq, Eq, Hash)]
 struct GpuWait;
 
-/// Waits for the GPU to finish the frame just submitted, so that a frame's time includes its
-/// drawing (without a window nothing else paces the frames).
-fn wait_for_gpu(device: Res<RenderDevice>) {
-    if let Err(error) = device.poll(PollType::wait_indefinitely()) {
-        error!("gpu_bench: waiting for the GPU failed: {error}");
+/// The frames submitted that the GPU may still be drawing, oldest first, each as the wait
+/// for its work.
+#[derive(Resource)]
+struct InFlight {
+    latency: usize,
+    frames: std::collections::VecDeque<PollType>,
+}
+
+impl InFlight {
+    fn new(latency: usize) -> Self {
+        Self {
+            latency,
+            frames: std::collections::VecDeque::with_capacity(latency + 1),
+        }
+    }
+}
+
+/// Waits for the GPU to finish the frame `latency` frames before the one just submitted, so
+/// that frames are paced by the GPU as a window's swapchain paces them (without a window
+/// nothing else does), and a frame's time includes its drawing.
+fn wait_for_gpu(
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    mut in_flight: ResMut<InFlight>,
+) {
+    // An empty submission's index is that of all work submitted so far: this frame's.
+    let submitted = queue.submit(std::iter::empty());
+    in_flight.frames.push_back(PollType::Wait {
+        submission_index: Some(submitted),
+        timeout: None,
+    });
+    while in_flight.frames.len() > in_flight.latency {
+        let Some(wait) = in_flight.frames.pop_front() else {
+            break;
+        };
+        if let Err(error) = device.poll(wait) {
+            error!("gpu_bench: waiting for the GPU failed: {error}");
+        }
     }
 }
