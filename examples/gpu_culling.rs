@@ -1,10 +1,13 @@
 //! Culling per instance on the GPU, checked in a real renderer (`scripts/smoke.sh` runs it
 //! under Xvfb and lavapipe): `cargo run --example gpu_culling`.
 //!
-//! A field of grass that thins out with distance ([`InstancedThinning`]), no wind (so that
-//! two frames can match), a sun with shadows, and a camera at the field's edge looking
-//! across it, so that many chunks are cut by the view's sides, and the sun's cascade holds
-//! blades whose shadows fall outside the view. The blades have a far mesh
+//! A field of grass that thins out with distance ([`InstancedThinning`]), sparse poles 6 m
+//! tall, no wind (so that two frames can match), a low sun with shadows across the view, and
+//! a camera at the field's edge looking across it, so that many chunks are cut by the view's
+//! sides, and the sun's cascade holds blades whose shadows fall outside the view and poles
+//! outside it whose long shadows fall inside (on one side of the view they do, on the other
+//! they fall away: a cascade that took the light's direction the wrong way round would keep
+//! the latter and lose the former). The blades have a far mesh
 //! from 20 m, the same blade made again: drawn whole, a chunk draws the mesh its nearest
 //! point calls for, culled, each blade the one its own distance calls for; the same
 //! pixels either way, and the check counts each mesh's draw. Two screenshots: chunks
@@ -74,12 +77,35 @@ fn setup(
         RwtViewer::all_around(),
         Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
     ));
-    spawn_shadow_sun(&mut commands);
+    spawn_shadow_sun(&mut commands, LOW_SUN);
+    commands.spawn(pole_layer(&mut meshes));
     check.blades = Blades {
         near: meshes.add(grass_field::blade()),
         far: meshes.add(grass_field::blade()),
     };
     commands.spawn(grass_layer(&check.blades, FIELD_DENSITY));
+}
+
+/// Towards the sun: 17 degrees up, across the camera's view (its right side: poles beyond
+/// it cast shadows 20 m long into the view).
+const LOW_SUN: Vec3 = Vec3::new(-0.447, 0.3, 0.894);
+/// Poles per square metre, and their width and height (metres).
+const POLE_DENSITY: f64 = 0.02;
+const POLE_WIDTH: f32 = 0.6;
+const POLE_HEIGHT: f32 = 6.0;
+
+/// Sparse tall poles, instanced, streamed as the field is.
+fn pole_layer(meshes: &mut Assets<Mesh>) -> ScatterLayer {
+    let pole = Mesh::from(Cuboid::new(POLE_WIDTH, POLE_HEIGHT, POLE_WIDTH))
+        .translated_by(Vec3::Y * POLE_HEIGHT / 2.0);
+    let poles = ScatterClass::instanced(
+        LayerDensity::Constant(POLE_DENSITY),
+        meshes.add(pole),
+        InstancedShading::default(),
+    );
+    ScatterLayer::new(vec![poles])
+        .with_tile_size(2.0)
+        .with_streaming(FIELD_STREAMING)
 }
 
 /// Blades per square metre of the field.
@@ -109,13 +135,16 @@ fn grass_layer(blades: &Blades, density: f64) -> ScatterLayer {
         .with_instanced_far(blades.far.clone(), FAR_BLADE);
     ScatterLayer::new(vec![grass])
         .with_tile_size(2.0)
-        .with_streaming(StreamingConfig {
-            chunk_size: 8.0,
-            load_distance: 40.0,
-            unload_distance: 48.0,
-            near_distance: 40.0,
-        })
+        .with_streaming(FIELD_STREAMING)
 }
+
+/// Streaming to 40 m in 8 m chunks.
+const FIELD_STREAMING: StreamingConfig = StreamingConfig {
+    chunk_size: 8.0,
+    load_distance: 40.0,
+    unload_distance: 48.0,
+    near_distance: 40.0,
+};
 
 /// The check's progress: frames since streaming settled, whether a report was asked and
 /// the report, and for the slab's part the dense layer while it lives, the slab's size with

@@ -23,7 +23,7 @@ use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::frame_check::{
-    Captures, culling_check_app, mean_difference, out_of_patience, output_dir, passed,
+    Captures, HIGH_SUN, culling_check_app, mean_difference, out_of_patience, output_dir, passed,
     pixels_differing, spawn_shadow_sun,
 };
 use rwt_examples::grass_field;
@@ -80,7 +80,7 @@ fn setup(
         RwtViewer::all_around(),
         low(),
     ));
-    spawn_shadow_sun(&mut commands);
+    spawn_shadow_sun(&mut commands, HIGH_SUN);
     let blade = meshes.add(grass_field::blade());
     let grass = ScatterClass::instanced(LayerDensity::Constant(8.0), blade, default());
     commands.spawn(

@@ -20,7 +20,9 @@ use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::density::Density;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::foliage;
-use rwt_examples::frame_check::{Captures, out_of_patience, output_dir, passed, spawn_shadow_sun};
+use rwt_examples::frame_check::{
+    Captures, HIGH_SUN, out_of_patience, output_dir, passed, spawn_shadow_sun,
+};
 use std::sync::Arc;
 
 /// Least intersection over union of the two frames' tree pixels.
@@ -93,7 +95,7 @@ fn setup(
         RwtViewer::all_around(),
         Transform::from_xyz(0.0, 6.0, 0.0).looking_at(Vec3::new(200.0, 5.0, 0.0), Vec3::Y),
     ));
-    spawn_shadow_sun(&mut commands);
+    spawn_shadow_sun(&mut commands, HIGH_SUN);
     let white = materials.add(StandardMaterial {
         perceptual_roughness: 0.9,
         ..default()

@@ -100,15 +100,18 @@ pub fn culling_check_app(title: &str) -> App {
     app
 }
 
-/// A sun casting shadows into one cascade (a software driver draws every cascade on the
-/// CPU).
-pub fn spawn_shadow_sun(commands: &mut Commands) {
+/// Towards a sun 61 degrees up.
+pub const HIGH_SUN: Vec3 = Vec3::new(1.0, 2.0, 0.5);
+
+/// A sun towards `toward_sun` casting shadows into one cascade (a software driver draws every
+/// cascade on the CPU).
+pub fn spawn_shadow_sun(commands: &mut Commands, toward_sun: Vec3) {
     commands.spawn((
         DirectionalLight {
             shadow_maps_enabled: true,
             ..default()
         },
-        Transform::from_xyz(1.0, 2.0, 0.5).looking_at(Vec3::ZERO, Vec3::Y),
+        Transform::from_translation(toward_sun).looking_at(Vec3::ZERO, Vec3::Y),
         CascadeShadowConfigBuilder {
             num_cascades: 1,
             maximum_distance: 60.0,
