@@ -102,6 +102,7 @@ fn main() {
         std::process::exit(1);
     }
     let detailed = options.detail;
+    let latency = options.latency;
     let mut app = App::new();
     app.add_plugins((
         DefaultPlugins
@@ -121,18 +122,18 @@ fn main() {
             .with_despawn_budget(1_000_000)
             .with_max_tasks(32),
     ))
-    .insert_resource(options.casters);
+    .insert_resource(options.casters)
+    .insert_resource(Bench::new(options))
+    .insert_resource(InstanceCulling::PerChunk)
+    .add_systems(Startup, setup)
+    .add_systems(First, tick)
+    .add_systems(Last, step);
     app.sub_app_mut(RenderApp)
-        .insert_resource(InFlight::new(options.latency));
-    app.insert_resource(Bench::new(options))
-        .insert_resource(InstanceCulling::PerChunk)
-        .add_systems(Startup, setup)
-        .add_systems(First, tick)
-        .add_systems(Last, step);
-    app.sub_app_mut(RenderApp).add_systems(
-        Render,
-        wait_for_gpu.in_set(GpuWait).after(RenderSystems::Render),
-    );
+        .insert_resource(InFlight::new(latency))
+        .add_systems(
+            Render,
+            wait_for_gpu.in_set(GpuWait).after(RenderSystems::Render),
+        );
     if detailed {
         detail::add(&mut app, GpuWait);
     }
