@@ -62,16 +62,16 @@ impl FrameClock {
 
     /// The recorded frames' times, summarised; stops recording and forgets them.
     pub fn take(&self) -> FrameTimes {
+        FrameTimes::of(&self.take_frames())
+    }
+
+    /// The recorded frames' times one by one (main world, render world, whole frame, in
+    /// ms), for timings that pool several runs of a setting; stops recording and forgets
+    /// them.
+    pub fn take_frames(&self) -> Vec<[f64; 3]> {
         let mut t = self.0.lock().unwrap();
-        let column = |i: usize| Spread::of(t.samples.iter().map(|s| s[i]).collect());
-        let times = FrameTimes {
-            main: column(0),
-            render_world: column(1),
-            frame: column(2),
-        };
-        t.samples.clear();
         t.recording = false;
-        times
+        std::mem::take(&mut t.samples)
     }
 }
 
@@ -113,6 +113,18 @@ pub struct FrameTimes {
     pub render_world: Spread,
     /// The whole frame.
     pub frame: Spread,
+}
+
+impl FrameTimes {
+    /// The times of `frames` (main world, render world, whole frame, in ms), summarised.
+    pub fn of(frames: &[[f64; 3]]) -> Self {
+        let column = |i: usize| Spread::of(frames.iter().map(|s| s[i]).collect());
+        Self {
+            main: column(0),
+            render_world: column(1),
+            frame: column(2),
+        }
+    }
 }
 
 /// As the benchmarks' result lines show it.

@@ -1,14 +1,17 @@
 //! `RWT_COST=1` (with a scripted session, `RWT_SCREENSHOT`): once the script has settled in
 //! its view, times the frame drawn by the direct path (`InstanceCulling::PerChunk`: chunks
-//! drawn whole, no occlusion), then culled per instance on the GPU with occlusion (the
+//! drawn whole, no occlusion) and culled per instance on the GPU with occlusion (the
 //! camera's `OcclusionCulling`, as open_world runs), prints one line each and the ratios:
 //!
 //! `open-world-cost: view=V cull=whole live=N main_ms=X/Y render_world_ms=X/Y frame_ms=X/Y`
 //! `open-world-cost: view=V cull=occlusion live=N main_ms=X/Y render_world_ms=X/Y frame_ms=X/Y`
-//! `open-world-cost: ratio occlusion/whole frame_ms=R render_world_ms=R`
+//! `open-world-cost: ratio occlusion/whole frame_ms=R render_world_ms=R rounds=R1,R2,..`
 //!
-//! (median/p95 of 30 frames after 15 to warm up; `rwt_examples::frame_clock` says what each
-//! time covers). The screenshot is taken after, of the culled frame.
+//! The two settings take turns, [`ROUNDS`] times [`TIMED`] frames each after a few to warm
+//! up, so that a slow minute of the machine weighs on both alike: each line is the median/p95
+//! of a setting's frames over every round (`rwt_examples::frame_clock` says what each time
+//! covers), the ratios those medians', and `rounds` each round's frame ratio. The screenshot
+//! is taken after, of the culled frame.
 
 use crate::script::ScriptSystems;
 use bevy::prelude::*;
@@ -17,12 +20,16 @@ use bevy_rwt::prelude::*;
 use rwt_examples::frame_clock::{FrameClock, FrameClockPlugin, FrameTimes};
 use rwt_examples::prelude::*;
 
-/// Frames run after each change of setting, before timing.
-const WARM_UP: u32 = 15;
-/// Frames timed per setting.
-const TIMED: usize = 30;
+/// Frames run after the first change of setting, before timing (pipelines compile).
+const FIRST_WARM_UP: u32 = 15;
+/// Frames run after each later change of setting, before timing.
+const WARM_UP: u32 = 4;
+/// Frames timed per setting and round.
+const TIMED: usize = 8;
+/// Turns each setting takes.
+const ROUNDS: usize = 4;
 
-/// The settings timed, in order: name, culling, whether the camera occludes.
+/// The settings timed, in turn: name, culling, whether the camera occludes.
 const SETTINGS: [(&str, InstanceCulling, bool); 2] = [
     ("whole", InstanceCulling::PerChunk, false),
     ("occlusion", InstanceCulling::PerInstance, true),
@@ -52,18 +59,20 @@ impl Plugin for CostPlugin {
     }
 }
 
-/// Where the timing is: waiting for the script, timing a setting (frames since it was
-/// applied), or done; and the times so far.
+/// Where the timing is: waiting for the script, timing turn `turn` (setting `turn %
+/// SETTINGS.len()`) with the frames since it was applied, or done; and the frames so far.
 #[derive(Resource, Default)]
 struct Cost {
     timing: Option<(usize, u32)>,
     done: bool,
-    times: Vec<FrameTimes>,
+    /// Per setting, its timed frames over every round.
+    frames: [Vec<[f64; 3]>; SETTINGS.len()],
+    /// Per round, the culled frame's median over the whole frame's.
+    rounds: Vec<f64>,
 }
 
 /// Starts once nothing holds the script's screenshot and streaming has settled; holds the
 /// screenshot until every setting is timed.
-#[allow(clippy::too_many_arguments)]
 fn time_settings(
     mut cost: ResMut<Cost>,
     clock: Res<FrameClock>,
@@ -76,7 +85,7 @@ fn time_settings(
     if cost.done {
         return;
     }
-    let Some((setting, frames)) = cost.timing else {
+    let Some((turn, frames)) = cost.timing else {
         if !report.hold && stats.pending_tasks == 0 {
             apply(0, &cameras, &mut commands);
             cost.timing = Some((0, 0));
@@ -86,33 +95,48 @@ fn time_settings(
     };
     report.hold = true;
     let frames = frames + 1;
-    cost.timing = Some((setting, frames));
-    clock.record(frames > WARM_UP);
+    cost.timing = Some((turn, frames));
+    let warm_up = if turn < SETTINGS.len() {
+        FIRST_WARM_UP
+    } else {
+        WARM_UP
+    };
+    clock.record(frames > warm_up);
     if clock.recorded() < TIMED {
         return;
     }
-    let times = clock.take();
-    println!(
-        "open-world-cost: view={} cull={} live={} {times}",
-        std::env::var("RWT_VIEW").unwrap_or_else(|_| "eye".into()),
-        SETTINGS[setting].0,
-        live.0 + live.1
-    );
-    cost.times.push(times);
-    if setting + 1 < SETTINGS.len() {
-        apply(setting + 1, &cameras, &mut commands);
-        cost.timing = Some((setting + 1, 0));
+    let setting = turn % SETTINGS.len();
+    let timed = clock.take_frames();
+    if setting + 1 == SETTINGS.len() {
+        let whole = FrameTimes::of(&cost.frames[0][cost.frames[0].len() - TIMED..]);
+        cost.rounds
+            .push(FrameTimes::of(&timed).frame.median / whole.frame.median);
+    }
+    cost.frames[setting].extend(timed);
+    if turn + 1 < ROUNDS * SETTINGS.len() {
+        apply((turn + 1) % SETTINGS.len(), &cameras, &mut commands);
+        cost.timing = Some((turn + 1, 0));
         return;
     }
-    if let [whole, culled] = cost.times[..] {
-        println!(
-            "open-world-cost: ratio occlusion/whole frame_ms={:.2} render_world_ms={:.2}",
-            culled.frame.median / whole.frame.median,
-            culled.render_world.median / whole.render_world.median
-        );
-    }
+    report_times(&cost, live.0 + live.1);
     cost.done = true;
     report.hold = false;
+}
+
+/// Prints the result lines.
+fn report_times(cost: &Cost, live: usize) {
+    let view = std::env::var("RWT_VIEW").unwrap_or_else(|_| "eye".into());
+    let [whole, culled] = cost.frames.each_ref().map(|f| FrameTimes::of(f));
+    for ((name, ..), times) in SETTINGS.iter().zip([whole, culled]) {
+        println!("open-world-cost: view={view} cull={name} live={live} {times}");
+    }
+    let rounds: Vec<String> = cost.rounds.iter().map(|r| format!("{r:.2}")).collect();
+    println!(
+        "open-world-cost: ratio occlusion/whole frame_ms={:.2} render_world_ms={:.2} rounds={}",
+        culled.frame.median / whole.frame.median,
+        culled.render_world.median / whole.render_world.median,
+        rounds.join(",")
+    );
 }
 
 /// Sets the culling of setting `i` and gives the camera occlusion or takes it away.
