@@ -43,9 +43,9 @@ use rwt_examples::grass_field;
 
 /// Most mean difference between the two frames (0..255 a channel).
 const MOST_DIFFERENCE: f64 = 0.05;
-/// Most pixels that may differ by more than [`BY`] in some channel (a blade's missing
-/// shadow darkens the ground by more).
-const MOST_PIXELS: usize = 20;
+/// Most pixels that may differ by more than [`BY`] in some channel: none. The frames have no
+/// multisampling, so a blade or a blade's shadow dropped while in view is whole pixels off.
+const MOST_PIXELS: usize = 0;
 /// What a channel may differ by in a pixel that matches.
 const BY: u8 = 24;
 /// Frames each step waits once streaming has settled (pipelines compile on the CPU).
@@ -74,6 +74,10 @@ fn setup(
     ));
     commands.spawn((
         Camera3d::default(),
+        // Lavapipe shades every sample on the CPU: without multisampling the run is
+        // three times quicker, and the frames compared differ pixel by pixel, not
+        // smoothed by the resolve.
+        Msaa::Off,
         RwtViewer::all_around(),
         Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
     ));

@@ -30,8 +30,10 @@ use rwt_examples::grass_field;
 
 /// Most mean difference between the two frames (0..255 a channel).
 const MOST_DIFFERENCE: f64 = 0.05;
-/// Most pixels that may differ by more than [`BY`] in some channel.
-const MOST_PIXELS: usize = 20;
+/// Most pixels that may differ by more than [`BY`] in some channel: none. The frames have no
+/// multisampling, so a blade dropped while in view is whole pixels off (a blade one pixel
+/// wide at the field's far edge, which levels 5 and up of the pyramid hid, showed so).
+const MOST_PIXELS: usize = 0;
 /// What a channel may differ by in a pixel that matches.
 const BY: u8 = 24;
 /// Frames each step waits once streaming has settled (pipelines compile on the CPU).
@@ -75,6 +77,10 @@ fn setup(
     ));
     commands.spawn((
         Camera3d::default(),
+        // Lavapipe shades every sample on the CPU: without multisampling the run is
+        // three times quicker, and the frames compared differ pixel by pixel, not
+        // smoothed by the resolve.
+        Msaa::Off,
         DepthPrepass,
         OcclusionCulling,
         RwtViewer::all_around(),

@@ -2,24 +2,26 @@
 //! under Xvfb and lavapipe): `cargo run --example instanced_passes`.
 //!
 //! A field of tall instanced grass, a box beside it, a few stiff textured cards lying on
-//! the ground (`bend_response` 0) and a low sun. Five screenshots of the same scene, each
-//! compared region by region:
+//! the ground (`bend_response` 0) and a low sun, drawn without multisampling (lavapipe shades
+//! every sample on the CPU) but in step 4. Six screenshots of the same scene, each compared
+//! region by region:
 //! 1. shadows on: the reference; each card (found by picking) shows its texture's red disc
 //!    at its centre and the ground at its corners, where the texture's alpha cuts it out;
 //! 2. the sun's shadows off: the grass the box shades must be brighter there, so the
 //!    grass receives shadows;
 //! 3. the grass class's shadows off ([`InstancedShadows::Off`]): the bare ground just
 //!    behind the field (away from the sun) must be brighter there, so the grass casts;
-//! 4. depth, normal and motion-vector prepasses with TAA and SSAO (and MSAA off, as they
-//!    need): the grass must still be drawn (its region unlike the bare ground) and the image
-//!    not blank;
-//! 5. a [`Bender`] standing in the grass and another on the cards: the blades around the
+//! 4. 4x MSAA with depth, normal and motion-vector prepasses: the grass must still be drawn
+//!    (its region unlike the bare ground), its pipelines made for four samples;
+//! 5. the same prepasses with TAA and SSAO (and MSAA off, as they need): the grass must
+//!    still be drawn and the image not blank;
+//! 6. a [`Bender`] standing in the grass and another on the cards: the blades around the
 //!    first must lie down (the pixels around it change much more than pixels of grass far
 //!    from it), and the cards must not move (their class does not respond: its pipelines
 //!    compile without the bend field).
 //!
 //! It prints `rwt-passes: cards C cut out K, receive lit L shadowed S, cast off L on S,
-//! prepass grass G ground B, bent near N far F stiff T` (cards drawn and cut out as their
+//! multisampled grass G ground B, prepass grass G ground B, bent near N far F stiff T` (cards drawn and cut out as their
 //! texture says; mean luminances, 0..255; mean pixel changes for the benders) and exits
 //! with an error when a check fails. Screenshots go to `RWT_PASSES_DIR` (default
 //! `target/passes`).
@@ -119,6 +121,7 @@ fn setup(
 ) {
     commands.spawn((
         Camera3d::default(),
+        Msaa::Off,
         RwtViewer::all_around(),
         Transform::from_xyz(-5.0, 6.0, 9.0).looking_at(Vec3::new(2.0, 0.0, 0.5), Vec3::Y),
     ));
@@ -275,6 +278,7 @@ enum Step {
     Reference,
     SunShadowsOff,
     GrassShadowsOff,
+    Multisampled,
     Prepasses,
     Bent,
     Done,
@@ -419,10 +423,18 @@ fn next(step: Step, scene: &mut Scene, commands: &mut Commands) -> Step {
             set_grass_shadows(scene, commands, InstancedShadows::On);
             if let Ok((camera, ..)) = scene.camera.single() {
                 commands.entity(camera).insert((
-                    Msaa::Off,
+                    Msaa::Sample4,
                     DepthPrepass,
                     NormalPrepass,
                     MotionVectorPrepass,
+                ));
+            }
+            Step::Multisampled
+        }
+        Step::Multisampled => {
+            if let Ok((camera, ..)) = scene.camera.single() {
+                commands.entity(camera).insert((
+                    Msaa::Off,
                     TemporalAntiAliasing::default(),
                     ScreenSpaceAmbientOcclusion::default(),
                 ));
@@ -500,13 +512,18 @@ fn save(image: &Image, step: Step) {
 
 /// Prints the line; whether every check holds.
 fn report(check: &Check) -> bool {
-    let ([reference, sun_off, grass_off, prepass, _], [straight, bent], [near, far, cards_at]) = (
+    let (
+        [reference, sun_off, grass_off, multisampled, prepass, _],
+        [straight, bent],
+        [near, far, cards_at],
+    ) = (
         check.shots.as_slice(),
         check.bent.as_slice(),
         check.bent_regions.as_slice(),
-    ) else {
+    )
+    else {
         eprintln!(
-            "rwt-passes: FAIL expected five screenshots, got {}",
+            "rwt-passes: FAIL expected six screenshots, got {}",
             check.shots.len()
         );
         return false;
@@ -515,8 +532,15 @@ fn report(check: &Check) -> bool {
     let (bent_near, bent_far, stiff) = (change(*near), change(*far), change(*cards_at));
     let (cards, cut) = check.cards;
     println!(
-        "rwt-passes: cards {cards} cut out {cut}, receive lit {:.1} shadowed {:.1}, cast off {:.1} on {:.1}, prepass grass {:.1} ground {:.1}, bent near {bent_near:.1} far {bent_far:.1} stiff {stiff:.1}",
-        sun_off[0], reference[0], grass_off[1], reference[1], prepass[2], prepass[1]
+        "rwt-passes: cards {cards} cut out {cut}, receive lit {:.1} shadowed {:.1}, cast off {:.1} on {:.1}, multisampled grass {:.1} ground {:.1}, prepass grass {:.1} ground {:.1}, bent near {bent_near:.1} far {bent_far:.1} stiff {stiff:.1}",
+        sun_off[0],
+        reference[0],
+        grass_off[1],
+        reference[1],
+        multisampled[2],
+        multisampled[1],
+        prepass[2],
+        prepass[1]
     );
     // Each check holds only when its comparison does (a NaN region fails it).
     let checks = [
@@ -531,6 +555,10 @@ fn report(check: &Check) -> bool {
         (
             reference[1] < 0.85 * grass_off[1],
             "the ground behind the grass is not darker when the grass casts shadows",
+        ),
+        (
+            (multisampled[2] - multisampled[1]).abs() > 10.0,
+            "with 4x MSAA and the prepasses the grass is not drawn",
         ),
         (
             (prepass[2] - prepass[1]).abs() > 10.0,

@@ -10,7 +10,7 @@
 # (or took fewer than its three screenshots, 1x, 30x and 1000x), or mesh_ground placed an
 # instance off its glTF level's surfaces (floating, buried, on a wall); and runs
 # instanced_passes, which fails unless instanced grass receives and casts shadows and is
-# drawn with the prepasses, TAA and SSAO, gpu_culling, which fails unless the frame culled
+# drawn with 4x MSAA and with the prepasses, TAA and SSAO, gpu_culling, which fails unless the frame culled
 # per instance on the GPU is the frame drawn whole and its indirect counts are the CPU's, and
 # gpu_occlusion, which fails unless a camera rising over a hill, occluding, draws the frame
 # drawn whole (the blades peeking over the crest included) and occlusion dropped instances,
