@@ -28,7 +28,7 @@
 //! difference P`, and exits with an error unless the
 //! counts agree, culling kept fewer instances than it was given, some blades drew the far
 //! mesh and some the near one, the cascade left blades out, the slab shrank, and the
-//! frames match ([`MOST_DIFFERENCE`] in the mean, [`MOST_PIXELS`]).
+//! frames match (`MOST_DIFFERENCE` in the mean, `MOST_PIXELS`).
 //! Screenshots go to `RWT_CULLING_DIR` (default `target/culling`).
 
 use bevy::app::AppExit;

@@ -11,8 +11,8 @@
 //! ([`InstanceCulling::PerChunk`], no occlusion), then culled per instance with occlusion,
 //! and [`CullingCheck`] reads back that frame's counts. It prints `rwt-occlusion: draws D
 //! occluding O instances N kept G (gpu) C (frustum) late L, pixel difference P, pixels
-//! differing X` and exits with an error unless the two frames match ([`MOST_DIFFERENCE`],
-//! [`MOST_PIXELS`]), occlusion dropped instances, the late phase kept some, and no draw
+//! differing X` and exits with an error unless the two frames match (`MOST_DIFFERENCE`,
+//! `MOST_PIXELS`), occlusion dropped instances, the late phase kept some, and no draw
 //! kept more than the frustum alone keeps. Screenshots go to `RWT_OCCLUSION_DIR` (default
 //! `target/occlusion`).
 

@@ -9,8 +9,8 @@
 //! is a card, culled per instance ([`CullingCheck`] reads that frame's counts back). It
 //! prints `rwt-impostor: trees T, mesh pixels M, impostor pixels I, silhouette IoU U, colour
 //! difference C` (`T`: the tree entities of the first frame) and exits with an error unless the silhouettes' intersection over union
-//! is at least [`LEAST_IOU`], the mean colour difference where both show a tree is under
-//! [`MOST_COLOUR`], and culling kept the CPU's instances. Screenshots go to
+//! is at least `LEAST_IOU`, the mean colour difference where both show a tree is under
+//! `MOST_COLOUR`, and culling kept the CPU's instances. Screenshots go to
 //! `RWT_IMPOSTOR_DIR` (default `target/impostor`).
 
 use bevy::app::AppExit;

@@ -8,7 +8,7 @@
 //! `--shots` saves one
 //! frame of each case there as
 //! `blades-M-shadows-S-cull-C.png`; `--detail` prints where each case's frame time goes
-//! ([`detail`]).
+//! (`detail`).
 //!
 //! The scene is [`grass_field`]'s: instanced blades streamed around a camera 2 m above a
 //! field, under a sun with cascaded shadow maps, drawn into an image; the grass thins out
