@@ -21,10 +21,10 @@
 //!    compile without the bend field).
 //!
 //! It prints `rwt-passes: cards C cut out K, receive lit L shadowed S, cast off L on S,
-//! multisampled grass G ground B, prepass grass G ground B, bent near N far F stiff T` (cards drawn and cut out as their
-//! texture says; mean luminances, 0..255; mean pixel changes for the benders) and exits
-//! with an error when a check fails. Screenshots go to `RWT_PASSES_DIR` (default
-//! `target/passes`).
+//! multisampled grass G ground B, prepass grass G ground B, bent near N far F stiff T`
+//! (cards drawn and cut out as their texture says; mean luminances, 0..255; mean pixel
+//! changes for the benders) and exits with an error when a check fails. Screenshots go to
+//! `RWT_PASSES_DIR` (default `target/passes`).
 
 use bevy::anti_alias::taa::TemporalAntiAliasing;
 use bevy::app::AppExit;
