@@ -36,8 +36,8 @@ use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::frame_check::{
-    Captures, culling_check_app, mean_difference, out_of_patience, output_dir, passed,
-    pixels_differing, spawn_shadow_sun,
+    COMPARED_MSAA, Captures, culling_check_app, mean_difference, out_of_patience, output_dir,
+    passed, pixels_differing, spawn_shadow_sun,
 };
 use rwt_examples::grass_field;
 
@@ -74,10 +74,7 @@ fn setup(
     ));
     commands.spawn((
         Camera3d::default(),
-        // Lavapipe shades every sample on the CPU: without multisampling the run is
-        // three times quicker, and the frames compared differ pixel by pixel, not
-        // smoothed by the resolve.
-        Msaa::Off,
+        COMPARED_MSAA,
         RwtViewer::all_around(),
         Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
     ));

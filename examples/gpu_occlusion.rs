@@ -23,8 +23,8 @@ use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::frame_check::{
-    Captures, HIGH_SUN, culling_check_app, mean_difference, out_of_patience, output_dir, passed,
-    pixels_differing, spawn_shadow_sun,
+    COMPARED_MSAA, Captures, HIGH_SUN, culling_check_app, mean_difference, out_of_patience,
+    output_dir, passed, pixels_differing, spawn_shadow_sun,
 };
 use rwt_examples::grass_field;
 
@@ -77,10 +77,7 @@ fn setup(
     ));
     commands.spawn((
         Camera3d::default(),
-        // Lavapipe shades every sample on the CPU: without multisampling the run is
-        // three times quicker, and the frames compared differ pixel by pixel, not
-        // smoothed by the resolve.
-        Msaa::Off,
+        COMPARED_MSAA,
         DepthPrepass,
         OcclusionCulling,
         RwtViewer::all_around(),

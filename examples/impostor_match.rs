@@ -21,7 +21,7 @@ use bevy_rwt::rwt_core::density::Density;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::foliage;
 use rwt_examples::frame_check::{
-    Captures, HIGH_SUN, out_of_patience, output_dir, passed, spawn_shadow_sun,
+    COMPARED_MSAA, Captures, HIGH_SUN, out_of_patience, output_dir, passed, spawn_shadow_sun,
 };
 use std::sync::Arc;
 
@@ -87,10 +87,7 @@ fn setup(
 ) {
     commands.spawn((
         Camera3d::default(),
-        // Lavapipe shades every sample on the CPU: without multisampling the run is
-        // three times quicker, and the frames compared differ pixel by pixel, not
-        // smoothed by the resolve.
-        Msaa::Off,
+        COMPARED_MSAA,
         Projection::Perspective(PerspectiveProjection {
             fov: 9f32.to_radians(),
             far: 2000.0,
