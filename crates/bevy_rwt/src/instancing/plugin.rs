@@ -106,6 +106,7 @@ fn build_render(app: &mut App) {
         .init_resource::<render::Queued<Opaque3d>>()
         .init_resource::<render::Queued<Opaque3dPrepass>>()
         .init_resource::<render::Queued<Shadow>>()
+        .init_resource::<render::CascadeReceivers>()
         .add_systems(
             RenderStartup,
             (
@@ -119,6 +120,8 @@ fn build_render(app: &mut App) {
         .add_systems(
             Render,
             (
+                // After the lights' shadow views are made, before the shadow queue.
+                render::find_receivers.in_set(RenderSystems::PrepareViews),
                 (render::prepare_frame, render::prepare_chunks)
                     .in_set(RenderSystems::PrepareResources),
                 (

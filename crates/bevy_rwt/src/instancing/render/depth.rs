@@ -6,7 +6,7 @@
 
 use super::draw::{DrawChunkInstances, SetChunkBindGroup};
 use super::main_pass::{mesh_attributes, mesh_bin};
-use super::receivers::ShadowReceivers;
+use super::receivers::CascadeReceivers;
 use super::{
     ChunkBindings, ChunkPipelines, ClassFeatures, ExtractedChunk, MainViewer, Queued,
     instance_layout, rebin_cameras,
@@ -217,9 +217,8 @@ pub(in crate::instancing) fn queue_shadows(
     light_keys: Res<LightKeyCache>,
     viewer: Res<MainViewer>,
     mut queued: ResMut<Queued<Shadow>>,
-    receivers: ShadowReceivers,
+    receivers: Res<CascadeReceivers>,
 ) {
-    let receivers = receivers.by_view();
     let draw = draw_functions.read().id::<DrawInstancedDepth>();
     let casting: Vec<_> = chunks
         .iter()
@@ -231,7 +230,7 @@ pub(in crate::instancing) fn queue_shadows(
         };
         let light_key = light_keys.get(&view.retained_view_entity).copied();
         let sees_chunks = layers.is_none_or(|l| l.intersects(&RenderLayers::default()));
-        let read = receivers.get(&entity);
+        let read = receivers.of(entity);
         let items = casting
             .iter()
             .filter(|_| sees_chunks)

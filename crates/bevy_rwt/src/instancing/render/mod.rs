@@ -34,6 +34,7 @@ pub(super) use depth::{
 };
 pub(super) use draw::DrawInstancedChunk;
 pub(super) use main_pass::{InstancedPipeline, init_main_pipeline, queue_main};
+pub(super) use receivers::{CascadeReceivers, find_receivers};
 use retained::BinnedChunk;
 pub(super) use retained::Queued;
 pub(super) use slab::InstanceSlab;

@@ -14,7 +14,6 @@
 
 use crate::instancing::CascadeCasters;
 use bevy::camera::primitives::{Aabb, Frustum};
-use bevy::ecs::system::SystemParam;
 use bevy::light::CascadeShadowConfig;
 use bevy::math::primitives::ViewFrustum;
 use bevy::pbr::{ExtractedDirectionalLight, LightEntity, ViewLightEntities};
@@ -121,66 +120,62 @@ pub(in crate::instancing) fn margin(texel: f32, normal_bias: f32) -> f32 {
     1.0 + texel * (8.0 + normal_bias.max(0.0))
 }
 
-/// What finding each shadow view's receivers reads.
-#[derive(SystemParam)]
-pub(in crate::instancing) struct ShadowReceivers<'w, 's> {
-    setting: Option<Res<'w, CascadeCasters>>,
-    cameras: Query<
-        'w,
-        's,
-        (
-            &'static ExtractedView,
-            &'static Frustum,
-            &'static ViewLightEntities,
-        ),
-    >,
-    shadow_views: Query<'w, 's, (&'static ExtractedView, &'static LightEntity)>,
-    lights: Query<'w, 's, &'static ExtractedDirectionalLight>,
+/// The receivers of every directional light's cascade this frame, by shadow view
+/// ([`find_receivers`]); none for a view that keeps every caster.
+#[derive(Resource, Default)]
+pub(in crate::instancing) struct CascadeReceivers(HashMap<Entity, Receivers>);
+
+impl CascadeReceivers {
+    /// The receivers of shadow view `view`, where its casters can be narrowed down.
+    pub fn of(&self, view: Entity) -> Option<&Receivers> {
+        self.0.get(&view)
+    }
 }
 
-impl ShadowReceivers<'_, '_> {
-    /// The receivers of every directional light's cascade, by shadow view ([`CascadeCasters`]).
-    /// None for a light with soft shadows (their penumbra reaches as far as the light's size
-    /// makes it).
-    pub fn by_view(&self) -> HashMap<Entity, Receivers> {
-        let mut found = HashMap::default();
-        if self.setting.as_deref().copied().unwrap_or_default() == CascadeCasters::All {
-            return found;
-        }
-        for (camera, frustum, lights) in &self.cameras {
-            for &entity in &lights.lights {
-                let Ok((view, light)) = self.shadow_views.get(entity) else {
-                    continue;
-                };
-                let LightEntity::Directional {
-                    light_entity,
-                    cascade_index,
-                } = *light
-                else {
-                    continue;
-                };
-                let Ok(light) = self.lights.get(light_entity) else {
-                    continue;
-                };
-                if light.soft_shadow_size.is_some() {
-                    continue;
-                }
-                let Some(depths) = depths(&light.cascade_shadow_config, cascade_index) else {
-                    continue;
-                };
-                // The cascade's projection is orthographic: 2 / width on the diagonal.
-                let size = view.viewport.z.max(1) as f32;
-                let texel = 2.0 / (view.clip_from_view.x_axis.x.abs().max(1e-6) * size);
-                let margin = margin(texel, light.shadow_normal_bias);
-                let travels = light.transform.forward().as_vec3();
-                let eye = &camera.world_from_view;
-                found.insert(
-                    entity,
-                    Receivers::new(&frustum.0, eye, depths, travels, margin),
-                );
+/// Finds the receivers of every directional light's cascade ([`CascadeCasters`]), once a
+/// frame for the shadow queue and the culling. None for a light with soft shadows (their
+/// penumbra reaches as far as the light's size makes it).
+pub(in crate::instancing) fn find_receivers(
+    setting: Option<Res<CascadeCasters>>,
+    cameras: Query<(&ExtractedView, &Frustum, &ViewLightEntities)>,
+    shadow_views: Query<(&ExtractedView, &LightEntity)>,
+    lights: Query<&ExtractedDirectionalLight>,
+    mut found: ResMut<CascadeReceivers>,
+) {
+    found.0.clear();
+    if setting.as_deref().copied().unwrap_or_default() == CascadeCasters::All {
+        return;
+    }
+    for (camera, frustum, views) in &cameras {
+        for &entity in &views.lights {
+            let Ok((view, light)) = shadow_views.get(entity) else {
+                continue;
+            };
+            let LightEntity::Directional {
+                light_entity,
+                cascade_index,
+            } = *light
+            else {
+                continue;
+            };
+            let Ok(light) = lights.get(light_entity) else {
+                continue;
+            };
+            if light.soft_shadow_size.is_some() {
+                continue;
             }
+            let Some(depths) = depths(&light.cascade_shadow_config, cascade_index) else {
+                continue;
+            };
+            // The cascade's projection is orthographic: 2 / width on the diagonal.
+            let size = view.viewport.z.max(1) as f32;
+            let texel = 2.0 / (view.clip_from_view.x_axis.x.abs().max(1e-6) * size);
+            let margin = margin(texel, light.shadow_normal_bias);
+            let travels = light.transform.forward().as_vec3();
+            let eye = &camera.world_from_view;
+            let receivers = Receivers::new(&frustum.0, eye, depths, travels, margin);
+            found.0.insert(entity, receivers);
         }
-        found
     }
 }
 

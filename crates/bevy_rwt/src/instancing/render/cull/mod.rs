@@ -28,7 +28,7 @@ pub(in crate::instancing) use occlusion::{cull_late, restore_early};
 pub(super) use params::{CullRecord, CullView};
 
 use super::draw::MeshSlices;
-use super::receivers::{Receivers, ShadowReceivers};
+use super::receivers::{CascadeReceivers, Receivers};
 use super::{ExtractedChunk, GpuChunk, InstanceSlab, MainViewer, Queued};
 #[cfg(test)]
 use crate::instancing::GpuInstance;
@@ -249,9 +249,12 @@ struct ViewCull {
     occluding: Option<occlusion::Occluding>,
 }
 
+/// Each mesh's draw arguments before culling, found once a frame.
+type MeshArgs = HashMap<AssetId<Mesh>, Option<[u32; ARGS_WORDS as usize]>>;
+
 /// One chunk in a view, one mesh of it (a record of the view's dispatch).
 struct Dispatch<'a> {
-    view: ViewCull,
+    view: &'a ViewCull,
     chunk: Entity,
     extracted: &'a ExtractedChunk,
     gpu: &'a GpuChunk,
@@ -294,7 +297,7 @@ pub(in crate::instancing) struct CullInputs<'w, 's> {
     allocator: Res<'w, MeshAllocator>,
     viewer: Res<'w, MainViewer>,
     slab: Res<'w, InstanceSlab>,
-    receivers: ShadowReceivers<'w, 's>,
+    receivers: Res<'w, CascadeReceivers>,
 }
 
 /// Lays out and writes the culling of every chunk binned into every view, and records the
@@ -322,7 +325,8 @@ pub(in crate::instancing) fn cull_instances(
         .iter()
         .map(|(e, view, _, shadow, p)| (e, view, shadow, p));
     let occluding = culler.pyramids.prepare(views, &device, &cache);
-    let dispatches = inputs.dispatches(&occluding);
+    let views = inputs.views(&occluding);
+    let dispatches = inputs.dispatches(&views);
     if dispatches.is_empty() {
         return;
     }
@@ -445,12 +449,12 @@ fn grid(groups: u32) -> (u32, u32) {
 }
 
 impl CullInputs<'_, '_> {
-    /// Every (view, chunk) binned this frame, once each, in a stable order (a view's
-    /// dispatches together).
-    fn dispatches(&self, occluding: &HashMap<Entity, occlusion::Occluding>) -> Vec<Dispatch<'_>> {
-        let receivers = self.receivers.by_view();
-        let views: HashMap<RetainedViewEntity, ViewCull> = self
-            .views
+    /// How each view culls this frame.
+    fn views(
+        &self,
+        occluding: &HashMap<Entity, occlusion::Occluding>,
+    ) -> HashMap<RetainedViewEntity, ViewCull> {
+        self.views
             .iter()
             .map(|(entity, view, frustum, shadow, _)| {
                 let eye = match (shadow, self.viewer.0) {
@@ -464,38 +468,47 @@ impl CullInputs<'_, '_> {
                     planes,
                     eye,
                     shadow,
-                    receivers: receivers.get(&entity).copied(),
+                    receivers: self.receivers.of(entity).copied(),
                     occluding: occluding.get(&entity).copied(),
                 };
                 (view.retained_view_entity, cull)
             })
-            .collect();
-        // The view by reference: sorting moves each pair, and a view is some 250 bytes.
-        let mut pairs: Vec<(&ViewCull, Entity, &ExtractedChunk, &GpuChunk)> = Vec::new();
+            .collect()
+    }
+
+    /// Every (view, chunk) binned this frame in one of `views`, once each, in a stable
+    /// order (a view's dispatches together).
+    fn dispatches<'a>(
+        &'a self,
+        views: &'a HashMap<RetainedViewEntity, ViewCull>,
+    ) -> Vec<Dispatch<'a>> {
+        // Every (view, chunk) binned in any phase, once each: the camera's chunks are in
+        // its main pass and its prepass.
+        let mut pairs: Vec<(&ViewCull, Entity)> = Vec::new();
         let mut add = |retained: &RetainedViewEntity,
                        entities: &mut dyn Iterator<Item = Entity>| {
-            let Some(view) = views.get(retained) else {
-                return;
-            };
-            for entity in entities {
-                if let Ok((extracted, gpu)) = self.chunks.get(entity) {
-                    pairs.push((view, entity, extracted, gpu));
-                }
+            if let Some(view) = views.get(retained) {
+                pairs.extend(entities.map(|entity| (view, entity)));
             }
         };
         self.main.binned().for_each(|(r, mut e)| add(r, &mut e));
         self.prepass.binned().for_each(|(r, mut e)| add(r, &mut e));
         self.shadow.binned().for_each(|(r, mut e)| add(r, &mut e));
-        pairs.sort_by_key(|(view, chunk, ..)| (view.entity, *chunk));
-        pairs.dedup_by_key(|(view, chunk, ..)| (view.entity, *chunk));
+        pairs.sort_unstable_by_key(|(view, chunk)| (view.entity, *chunk));
+        pairs.dedup_by_key(|(view, chunk)| (view.entity, *chunk));
+        let mut args = HashMap::default();
         pairs
             .into_iter()
-            .filter(|(.., gpu)| gpu.count > 0)
-            .filter(|(view, _, extracted, gpu)| {
-                whole::may_drop(view, &extracted.bounds, &gpu.uniform, extracted.shadows)
-                    || lods::across(view, extracted)
+            .filter_map(|(view, chunk)| {
+                let (extracted, gpu) = self.chunks.get(chunk).ok()?;
+                let culls = gpu.count > 0
+                    && (whole::may_drop(view, &extracted.bounds, &gpu.uniform, extracted.shadows)
+                        || lods::across(view, extracted));
+                culls.then_some((view, chunk, extracted, gpu))
             })
-            .flat_map(|(view, chunk, extracted, gpu)| self.parts(view, chunk, extracted, gpu))
+            .flat_map(|(view, chunk, extracted, gpu)| {
+                self.parts(view, chunk, extracted, gpu, &mut args)
+            })
             .flatten()
             .collect()
     }
@@ -504,10 +517,11 @@ impl CullInputs<'_, '_> {
     /// ready and the chunk's instances are in the slab (then it is drawn whole).
     fn parts<'a>(
         &'a self,
-        view: &ViewCull,
+        view: &'a ViewCull,
         chunk: Entity,
         extracted: &'a ExtractedChunk,
         gpu: &'a GpuChunk,
+        args: &mut MeshArgs,
     ) -> [Option<Dispatch<'a>>; 2] {
         let first = self.slab.range(chunk).filter(|_| gpu.own.is_none());
         let Some(first_instance) = first.map(|r| r.start) else {
@@ -517,13 +531,16 @@ impl CullInputs<'_, '_> {
         let dispatch = |part: Option<lods::Part>| {
             let part = part?;
             Some(Dispatch {
-                view: *view,
+                view,
                 chunk,
                 extracted,
                 gpu,
                 part,
                 first_instance,
-                args: self.args(part.mesh)?,
+                args: *args
+                    .entry(part.mesh)
+                    .or_insert_with(|| self.args(part.mesh))
+                    .as_ref()?,
             })
         };
         let dispatches = parts.map(dispatch);
