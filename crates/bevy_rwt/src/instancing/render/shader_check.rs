@@ -12,7 +12,9 @@ use bevy::render::render_resource::ShaderType;
 use bevy::render::render_resource::encase::internal::WriteInto;
 use bevy::render::render_resource::encase::{StorageBuffer, UniformBuffer};
 use bevy::render::render_resource::{DownlevelFlags, WgpuFeatures};
-use bevy::shader::{Shader, ShaderCache, ShaderCacheSource, ShaderDefVal};
+use bevy::shader::{
+    Shader, ShaderCache, ShaderCacheError, ShaderCacheSource, ShaderDefVal, ValidateShader,
+};
 use std::path::{Path, PathBuf};
 
 /// The crates whose WGSL the instanced shader imports, directly or through others.
@@ -79,23 +81,25 @@ fn modules(dir: &Path, found: &mut Vec<(String, String)>) {
     }
 }
 
-/// A shader cache that validates what it composes (in test builds) and whose modules are
-/// the `Debug` text of the composed naga module's types.
-pub(super) fn bare_cache() -> ShaderCache<String, ()> {
-    ShaderCache::new(
-        (),
-        WgpuFeatures::all(),
-        DownlevelFlags::all(),
-        |_, source, _| match source {
-            ShaderCacheSource::Naga(module) => Ok(format!("{:?}", module.types)),
-            _ => Ok(String::new()),
-        },
-    )
+/// What a test reads of a composed and validated module.
+pub(super) type ReadModule =
+    fn(&(), ShaderCacheSource, &ValidateShader) -> Result<String, ShaderCacheError>;
+
+/// Reads a module's types, as `Debug` prints them (for [`struct_layout`]).
+const TYPES: ReadModule = |_, source, _| match source {
+    ShaderCacheSource::Naga(module) => Ok(format!("{:?}", module.types)),
+    _ => Ok(String::new()),
+};
+
+/// A [`cache_with_fade_reading`] of the modules' types (`TYPES`).
+pub(super) fn cache_with_fade() -> ShaderCache<String, ()> {
+    cache_with_fade_reading(TYPES)
 }
 
-/// A cache holding the level of detail our shaders share (`rwt::fade`).
-pub(super) fn cache_with_fade() -> ShaderCache<String, ()> {
-    let mut cache = bare_cache();
+/// A shader cache that validates what it composes (in test builds), holding the level of
+/// detail our shaders share (`rwt::fade`), whose modules are what `read` reads of them.
+pub(super) fn cache_with_fade_reading(read: ReadModule) -> ShaderCache<String, ()> {
+    let mut cache = ShaderCache::new((), WgpuFeatures::all(), DownlevelFlags::all(), read);
     let fade = Shader::from_wgsl(include_str!("fade.wgsl"), "fade.wgsl");
     cache.set_shader(AssetId::from(Uuid::from_u128(u128::MAX - 1)), fade);
     cache

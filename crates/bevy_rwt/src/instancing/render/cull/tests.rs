@@ -2,13 +2,13 @@
 
 use super::super::reach;
 use super::super::shader_check::{
-    Space, cache_with_fade, mark, marked_layout, marked_lod, struct_layout,
+    Space, cache_with_fade, cache_with_fade_reading, mark, marked_layout, marked_lod, struct_layout,
 };
 use super::super::uniforms::LodUniform;
 use super::*;
 use bevy::asset::uuid::Uuid;
 use bevy::camera::primitives::Aabb;
-use bevy::shader::Shader;
+use bevy::shader::{Shader, ShaderCacheSource};
 
 #[test]
 fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
@@ -90,6 +90,32 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
         marked_layout(&record, Space::Storage, &names, |k| k >= 6)
     );
     assert_eq!(struct_layout(&types, "Lod"), marked_lod());
+}
+
+/// The dispatches' workgroups are as large as the CPU lays them out by (`WORKGROUP`), as
+/// naga reads the entry point.
+#[test]
+fn the_cull_shader_runs_workgroups_as_large_as_the_cpu_lays_out() {
+    let mut cache = cache_with_fade_reading(|_, source, _| match source {
+        ShaderCacheSource::Naga(module) => {
+            let sizes: Vec<_> = module
+                .entry_points
+                .iter()
+                .map(|e| e.workgroup_size)
+                .collect();
+            Ok(format!("{sizes:?}"))
+        }
+        _ => Ok(String::new()),
+    });
+    let id = AssetId::from(Uuid::from_u128(7));
+    cache.set_shader(
+        id,
+        Shader::from_wgsl(include_str!("cull.wgsl"), "cull.wgsl"),
+    );
+    let read = cache
+        .get(0, id, &[])
+        .expect("cull.wgsl composes and validates");
+    assert_eq!(*read, format!("[[{WORKGROUP}, 1, 1]]"));
 }
 
 /// The half-spaces of a view looking down +x from the origin: x > 0 and |z| < x (no near
