@@ -8,19 +8,11 @@ use super::super::uniforms::LodUniform;
 use super::*;
 use bevy::asset::uuid::Uuid;
 use bevy::camera::primitives::Aabb;
-use bevy::shader::{Shader, ShaderCacheSource};
+use bevy::shader::{Shader, ShaderCache, ShaderCacheSource};
 
 #[test]
 fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
-    let mut cache = cache_with_fade();
-    let id = AssetId::from(Uuid::from_u128(7));
-    cache.set_shader(
-        id,
-        Shader::from_wgsl(include_str!("cull.wgsl"), "cull.wgsl"),
-    );
-    let types = cache
-        .get(0, id, &[])
-        .expect("cull.wgsl composes and validates");
+    let types = composed_cull(cache_with_fade());
     // Each member's first word marked, then found in encase's bytes.
     let view = CullView {
         planes: [Vec4::splat(mark(0)); 6],
@@ -96,7 +88,7 @@ fn the_cull_shader_validates_and_reads_its_settings_as_rust_writes_them() {
 /// naga reads the entry point.
 #[test]
 fn the_cull_shader_runs_workgroups_as_large_as_the_cpu_lays_out() {
-    let mut cache = cache_with_fade_reading(|_, source, _| match source {
+    let cache = cache_with_fade_reading(|_, source, _| match source {
         ShaderCacheSource::Naga(module) => {
             let sizes: Vec<_> = module
                 .entry_points
@@ -107,15 +99,18 @@ fn the_cull_shader_runs_workgroups_as_large_as_the_cpu_lays_out() {
         }
         _ => Ok(String::new()),
     });
+    assert_eq!(composed_cull(cache), format!("[[{WORKGROUP}, 1, 1]]"));
+}
+
+/// What `cache` reads of `cull.wgsl`, composed and validated.
+fn composed_cull(mut cache: ShaderCache<String, ()>) -> String {
     let id = AssetId::from(Uuid::from_u128(7));
     cache.set_shader(
         id,
         Shader::from_wgsl(include_str!("cull.wgsl"), "cull.wgsl"),
     );
-    let read = cache
-        .get(0, id, &[])
-        .expect("cull.wgsl composes and validates");
-    assert_eq!(*read, format!("[[{WORKGROUP}, 1, 1]]"));
+    let read = cache.get(0, id, &[]);
+    read.expect("cull.wgsl composes and validates").to_string()
 }
 
 /// The half-spaces of a view looking down +x from the origin: x > 0 and |z| < x (no near
