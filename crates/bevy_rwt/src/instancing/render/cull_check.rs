@@ -88,6 +88,13 @@ pub(in crate::instancing) struct FrameCheck {
     requested: bool,
 }
 
+impl FrameCheck {
+    /// Whether the frame being rendered is to be checked.
+    pub(super) fn requested(&self) -> bool {
+        self.requested
+    }
+}
+
 /// Takes this frame's request, if any.
 pub(in crate::instancing) fn extract_culling_check(
     source: Extract<Option<Res<CullingCheck>>>,

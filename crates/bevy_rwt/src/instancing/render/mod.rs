@@ -14,6 +14,8 @@ mod cull;
 mod cull_check;
 mod depth;
 mod draw;
+#[cfg(test)]
+mod extract_tests;
 mod main_pass;
 mod receivers;
 mod retained;
@@ -151,13 +153,20 @@ impl SyncComponent for InstancedChunk {
     type Target = ExtractedChunk;
 }
 
+/// Extracted when it changed: the render world keeps a chunk's extraction until then (its
+/// render entity lives as long as the component), so a frame costs what changed, not every
+/// chunk.
 impl ExtractComponent for InstancedChunk {
     type QueryData = (
         &'static InstancedChunk,
         &'static GlobalTransform,
         Option<&'static Aabb>,
     );
-    type QueryFilter = ();
+    type QueryFilter = Or<(
+        Changed<InstancedChunk>,
+        Changed<GlobalTransform>,
+        Changed<Aabb>,
+    )>;
     type Out = ExtractedChunk;
 
     fn extract_component(

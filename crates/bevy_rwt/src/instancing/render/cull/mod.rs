@@ -308,6 +308,7 @@ pub(in crate::instancing) fn cull_instances(
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
     cache: Res<PipelineCache>,
+    #[cfg(feature = "testing")] check: Res<super::FrameCheck>,
 ) {
     culler.draws.clear();
     culler.early.clear();
@@ -344,6 +345,10 @@ pub(in crate::instancing) fn cull_instances(
     }
     culler.early = plan.early;
     culler.record(&dispatches, &plan.offsets);
+    #[cfg(feature = "testing")]
+    if check.requested() {
+        culler.keep_for_check(&dispatches, &plan.offsets);
+    }
 }
 
 /// At the start of the frame's render graph, before any view's passes: encodes the early
@@ -403,11 +408,10 @@ impl InstanceCuller {
         span.end(&mut pass);
     }
 
-    /// Records this frame's culled draws (and, for the check, what culled each).
-    fn record(&mut self, dispatches: &[Dispatch], offsets: &[Offsets]) {
-        self.draw_count = dispatches.len() as u32;
+    /// Keeps what culled each of this frame's draws, for the check.
+    #[cfg(feature = "testing")]
+    fn keep_for_check(&mut self, dispatches: &[Dispatch], offsets: &[Offsets]) {
         let bytes = |d: &Dispatch| u64::from(d.gpu.count) * INSTANCE_BYTES;
-        #[cfg(feature = "testing")]
         for ((d, o), record) in dispatches.iter().zip(offsets).zip(self.records.get()) {
             let view = self.early.iter().find(|v| v.entity == d.view.entity);
             self.checked.push(super::cull_check::Checked {
@@ -420,6 +424,12 @@ impl InstanceCuller {
                 late: o.late.map(|l| l..l + bytes(d)),
             });
         }
+    }
+
+    /// Records this frame's culled draws.
+    fn record(&mut self, dispatches: &[Dispatch], offsets: &[Offsets]) {
+        self.draw_count = dispatches.len() as u32;
+        let bytes = |d: &Dispatch| u64::from(d.gpu.count) * INSTANCE_BYTES;
         for (d, o) in dispatches.iter().zip(offsets) {
             let early = CulledRange {
                 args: u64::from(o.draw * ARGS_WORDS * 4),
