@@ -73,7 +73,7 @@ impl InstanceCuller {
                 .zip(&dispatches[first..last])
                 .map(|(o, d)| {
                     let range_end = o.late.unwrap_or(o.kept);
-                    range_end + u64::from(d.gpu.count) * INSTANCE_BYTES - pool
+                    range_end + d.bytes() - pool
                 })
                 .max()
                 .unwrap_or(0);

@@ -267,6 +267,11 @@ struct Dispatch<'a> {
 }
 
 impl Dispatch<'_> {
+    /// The bytes of the chunk's instances: of each range of the pool it keeps into.
+    fn bytes(&self) -> u64 {
+        u64::from(self.gpu.count) * INSTANCE_BYTES
+    }
+
     /// Last frame's and this frame's clip space from world space, where the dispatch
     /// occludes in two phases.
     fn occludes(&self) -> Option<(Mat4, Mat4)> {
@@ -411,7 +416,6 @@ impl InstanceCuller {
     /// Keeps what culled each of this frame's draws, for the check.
     #[cfg(feature = "testing")]
     fn keep_for_check(&mut self, dispatches: &[Dispatch], offsets: &[Offsets]) {
-        let bytes = |d: &Dispatch| u64::from(d.gpu.count) * INSTANCE_BYTES;
         for ((d, o), record) in dispatches.iter().zip(offsets).zip(self.records.get()) {
             let view = self.early.iter().find(|v| v.entity == d.view.entity);
             self.checked.push(super::cull_check::Checked {
@@ -420,8 +424,8 @@ impl InstanceCuller {
                 instances: d.extracted.buffer.clone(),
                 occludes: o.late.is_some(),
                 far: d.part.far,
-                kept: o.kept..o.kept + bytes(d),
-                late: o.late.map(|l| l..l + bytes(d)),
+                kept: o.kept..o.kept + d.bytes(),
+                late: o.late.map(|l| l..l + d.bytes()),
             });
         }
     }
@@ -429,15 +433,14 @@ impl InstanceCuller {
     /// Records this frame's culled draws.
     fn record(&mut self, dispatches: &[Dispatch], offsets: &[Offsets]) {
         self.draw_count = dispatches.len() as u32;
-        let bytes = |d: &Dispatch| u64::from(d.gpu.count) * INSTANCE_BYTES;
         for (d, o) in dispatches.iter().zip(offsets) {
             let early = CulledRange {
                 args: u64::from(o.draw * ARGS_WORDS * 4),
-                kept: o.kept..o.kept + bytes(d),
+                kept: o.kept..o.kept + d.bytes(),
             };
             let late = o.late.map(|late| CulledRange {
                 args: u64::from((self.draw_count + o.draw) * ARGS_WORDS * 4),
-                kept: late..late + bytes(d),
+                kept: late..late + d.bytes(),
             });
             self.draws
                 .entry((d.view.entity, d.chunk))
