@@ -9,16 +9,21 @@
 //!
 //! The rising frame is taken twice: with chunks drawn whole
 //! ([`InstanceCulling::PerChunk`], no occlusion), then culled per instance with occlusion,
-//! and [`CullingCheck`] reads back that frame's counts. It prints `rwt-occlusion: draws D
-//! occluding O instances N kept G (gpu) C (frustum) late L, pixel difference P, pixels
-//! differing X` and exits with an error unless the two frames match (`MOST_DIFFERENCE`,
-//! `MOST_PIXELS`), occlusion dropped instances, the late phase kept some, and no draw
-//! kept more than the frustum alone keeps. Screenshots go to `RWT_OCCLUSION_DIR` (default
-//! `target/occlusion`).
+//! and [`CullingCheck`] reads back that frame's counts. While chunks are drawn whole, Bevy's
+//! pipeline statistics (`RenderDiagnosticsPlugin`; lavapipe has them) count the vertices
+//! the camera's late prepass shades: a chunk drawn whole was all drawn by the early
+//! prepass, so none. It prints `rwt-occlusion: draws D occluding O instances N kept G (gpu)
+//! C (frustum) late L, pixel difference P, pixels differing X, late prepass vertices V
+//! (drawn whole)` and exits with an error unless the two frames match (`MOST_DIFFERENCE`,
+//! `MOST_PIXELS`), occlusion dropped instances, the late phase kept some, no draw kept more
+//! than the frustum alone keeps, and the late prepass shaded no vertex of chunks drawn
+//! whole. Screenshots go to `RWT_OCCLUSION_DIR` (default `target/occlusion`).
 
 use bevy::app::AppExit;
 use bevy::core_pipeline::prepass::DepthPrepass;
+use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore};
 use bevy::prelude::*;
+use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
@@ -53,6 +58,7 @@ fn high() -> Transform {
 
 fn main() -> AppExit {
     culling_check_app("rwt gpu_occlusion")
+        .add_plugins(RenderDiagnosticsPlugin)
         .init_resource::<Check>()
         .add_systems(Startup, setup)
         .add_systems(Update, run_check)
@@ -98,20 +104,27 @@ fn setup(
     );
 }
 
+/// Bevy's count of the vertices the camera's late prepass shaded (pipeline statistics).
+const LATE_PREPASS_VERTICES: DiagnosticPath =
+    DiagnosticPath::const_new("render/late prepass/vertex_shader_invocations");
+
 /// The check's progress: frames since streaming settled (or the camera came back down),
-/// the report.
+/// the report, the late prepass's vertices while chunks were drawn whole (none where the
+/// adapter has no pipeline statistics).
 #[derive(Resource, Default)]
 struct Check {
     settled_at: Option<u32>,
     frame: u32,
     report: Option<CullingReport>,
+    late_whole: Option<f64>,
 }
 
-/// The culling setting and its check.
+/// The culling setting, its check, and Bevy's render diagnostics (what the passes drew).
 #[derive(bevy::ecs::system::SystemParam)]
 struct Culling<'w> {
     setting: ResMut<'w, InstanceCulling>,
     check: Res<'w, CullingCheck>,
+    diagnostics: Res<'w, DiagnosticsStore>,
 }
 
 fn run_check(
@@ -142,6 +155,9 @@ fn run_check(
     let dir = output_dir("RWT_OCCLUSION_DIR", "target/occlusion");
     match (captures.get("whole"), captures.get("occluded")) {
         (None, _) => {
+            // The last frames were drawn whole, from the same place.
+            let late = culling.diagnostics.get(&LATE_PREPASS_VERTICES);
+            check.late_whole = late.and_then(|d| d.value());
             **camera = high();
             captures.capture(&mut commands, "whole", dir);
         }
@@ -159,7 +175,7 @@ fn run_check(
         }
         (Some(whole), Some(occluded)) => {
             let Some(report) = check.report else { return };
-            let passed = conclude(&report, whole, occluded);
+            let passed = conclude(&report, check.late_whole, whole, occluded);
             exit.write(if passed {
                 AppExit::Success
             } else {
@@ -170,11 +186,17 @@ fn run_check(
 }
 
 /// Prints the result line; whether every check passed.
-fn conclude(report: &CullingReport, whole: &image::RgbImage, occluded: &image::RgbImage) -> bool {
+fn conclude(
+    report: &CullingReport,
+    late_whole: Option<f64>,
+    whole: &image::RgbImage,
+    occluded: &image::RgbImage,
+) -> bool {
     let difference = mean_difference(whole, occluded);
     let differing = pixels_differing(whole, occluded, BY);
+    let late_vertices = late_whole.map_or("unknown".into(), |v| v.to_string());
     println!(
-        "rwt-occlusion: draws {} occluding {} instances {} kept {} (gpu) {} (frustum) late {}, pixel difference {difference:.3}, pixels differing {differing}",
+        "rwt-occlusion: draws {} occluding {} instances {} kept {} (gpu) {} (frustum) late {}, pixel difference {difference:.3}, pixels differing {differing}, late prepass vertices {late_vertices} (drawn whole)",
         report.draws,
         report.occluding_draws,
         report.instances,
@@ -196,6 +218,14 @@ fn conclude(report: &CullingReport, whole: &image::RgbImage, occluded: &image::R
         (
             difference >= MOST_DIFFERENCE || differing > MOST_PIXELS,
             "the occluded frame differs from the whole one",
+        ),
+        (
+            late_whole.is_none(),
+            "no pipeline statistics: the adapter cannot count the late prepass's vertices",
+        ),
+        (
+            late_whole.is_some_and(|v| v > 0.0),
+            "the late prepass drew chunks the early prepass had drawn whole",
         ),
     ];
     passed("rwt-occlusion", &failures)

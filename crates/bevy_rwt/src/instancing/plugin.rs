@@ -107,6 +107,7 @@ fn build_render(app: &mut App) {
         .init_resource::<render::Queued<Opaque3dPrepass>>()
         .init_resource::<render::Queued<Shadow>>()
         .init_resource::<render::CascadeReceivers>()
+        .init_resource::<render::LatePrepass>()
         .add_systems(
             RenderStartup,
             (
@@ -143,10 +144,10 @@ fn build_render(app: &mut App) {
         .add_systems(
             Core3d,
             (
-                render::cull_late
+                (render::cull_late, render::begin_late_prepass)
                     .after(early_downsample_depth)
                     .before(late_prepass),
-                render::restore_early
+                render::end_late_prepass
                     .after(late_prepass)
                     .before(Core3dSystems::MainPass),
             ),

@@ -1,10 +1,15 @@
 //! The draw of one chunk: its bind group, its mesh once per instance: the instances culling
 //! kept for the view, drawn indirectly, or all of them.
+//!
+//! A camera with Bevy's `OcclusionCulling` draws its depth prepass twice: early, then late,
+//! for what its depth pyramid hid from the early phase ([`LatePrepass`]). A chunk drawn whole
+//! is drawn whole in the early prepass and not again; a culled chunk draws what culling's
+//! late phase kept.
 
 use super::{ExtractedChunk, GpuChunk, InstanceCuller, InstanceSlab};
 use bevy::ecs::system::{SystemParamItem, lifetimeless::*};
 use bevy::pbr::{SetMeshViewBindGroup, SetMeshViewBindingArrayBindGroup};
-use bevy::prelude::{AssetId, Entity, Mesh};
+use bevy::prelude::{AssetId, Entity, Mesh, ResMut, Resource};
 use bevy::render::mesh::allocator::MeshAllocator;
 use bevy::render::mesh::{RenderMesh, RenderMeshBufferInfo};
 use bevy::render::render_asset::RenderAssets;
@@ -12,6 +17,7 @@ use bevy::render::render_phase::{
     PhaseItem, RenderCommand, RenderCommandResult, SetItemPipeline, TrackedRenderPass,
 };
 use bevy::render::render_resource::{Buffer, IndexFormat};
+use bevy::render::renderer::ViewQuery;
 
 /// The draw of one chunk in the main pass.
 pub(in crate::instancing) type DrawInstancedChunk = (
@@ -45,8 +51,33 @@ impl<P: PhaseItem, const I: usize> RenderCommand<P> for SetChunkBindGroup<I> {
     }
 }
 
+/// The view whose late prepass is being encoded, if any (set just before Bevy's
+/// `late_prepass`, cleared just after).
+#[derive(Resource, Default)]
+pub(in crate::instancing) struct LatePrepass(Option<Entity>);
+
+impl LatePrepass {
+    fn is(&self, view: Entity) -> bool {
+        self.0 == Some(view)
+    }
+}
+
+/// Before the view's late prepass: marks it as being encoded.
+pub(in crate::instancing) fn begin_late_prepass(
+    view: ViewQuery<Entity>,
+    mut late: ResMut<LatePrepass>,
+) {
+    late.0 = Some(view.entity());
+}
+
+/// After the view's late prepass.
+pub(in crate::instancing) fn end_late_prepass(mut late: ResMut<LatePrepass>) {
+    late.0 = None;
+}
+
 /// Draws a chunk's mesh once per instance: those culling kept for the view (for each mesh
-/// it chose, in each of its ranges), or all.
+/// it chose, in each of its ranges; in the late prepass, the late range only), or all
+/// (nothing in the late prepass).
 pub(in crate::instancing) struct DrawChunkInstances;
 
 impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
@@ -55,6 +86,7 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
         SRes<MeshAllocator>,
         SRes<InstanceSlab>,
         Option<SRes<InstanceCuller>>,
+        SRes<LatePrepass>,
     );
     type ViewQuery = Entity;
     type ItemQuery = (Read<ExtractedChunk>, Read<GpuChunk>);
@@ -63,11 +95,12 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
         item_of: &P,
         view: Entity,
         item: Option<(&'w ExtractedChunk, &'w GpuChunk)>,
-        (meshes, allocator, slab, culler): SystemParamItem<'w, '_, Self::Param>,
+        (meshes, allocator, slab, culler, late): SystemParamItem<'w, '_, Self::Param>,
         pass: &mut TrackedRenderPass<'w>,
     ) -> RenderCommandResult {
         let (meshes, allocator) = (meshes.into_inner(), allocator.into_inner());
         let culled = culler.and_then(|c| c.into_inner().draw(view, item_of.entity()));
+        let late = late.is(view);
         let Some((chunk, gpu)) = item else {
             return RenderCommandResult::Skip;
         };
@@ -77,7 +110,8 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
                     return RenderCommandResult::Skip;
                 };
                 slices.bind(pass);
-                for range in std::iter::once(&draw.early).chain(&draw.late) {
+                let early = (!late).then_some(&draw.early);
+                for range in early.into_iter().chain(&draw.late) {
                     pass.set_vertex_buffer(1, kept.slice(range.kept.clone()));
                     if slices.indices.is_some() {
                         pass.draw_indexed_indirect(args, range.args);
@@ -86,6 +120,9 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
                     }
                 }
             }
+            return RenderCommandResult::Success;
+        }
+        if late {
             return RenderCommandResult::Success;
         }
         let Some(slices) = MeshSlices::of(meshes, allocator, chunk.mesh) else {

@@ -24,9 +24,7 @@ mod shader_check;
 mod slab;
 mod uniforms;
 
-pub(super) use cull::{
-    InstanceCuller, cull_instances, cull_late, encode_cull, init_culler, restore_early,
-};
+pub(super) use cull::{InstanceCuller, cull_instances, cull_late, encode_cull, init_culler};
 #[cfg(feature = "testing")]
 pub use cull_check::{CullingCheck, CullingReport};
 #[cfg(feature = "testing")]
@@ -34,7 +32,7 @@ pub(super) use cull_check::{FrameCheck, check_culling, extract_culling_check};
 pub(super) use depth::{
     DrawInstancedDepth, InstancedDepthPipeline, init_depth_pipeline, queue_prepass, queue_shadows,
 };
-pub(super) use draw::DrawInstancedChunk;
+pub(super) use draw::{DrawInstancedChunk, LatePrepass, begin_late_prepass, end_late_prepass};
 pub(super) use main_pass::{InstancedPipeline, init_main_pipeline, queue_main};
 pub(super) use receivers::{CascadeReceivers, find_receivers};
 use retained::BinnedChunk;

@@ -167,20 +167,12 @@ impl InstanceCuller {
             | BufferUsages::COPY_SRC;
         self.fresh_pool |= grow(&mut self.kept, device, kept, "rwt_kept_instances", usage);
         let block = draws * u64::from(ARGS_WORDS) * 4;
-        // Copied from by the check (`testing`) and the late phase, into by the late phase.
+        // Copied from by the check (`testing`).
         let usage = BufferUsages::INDIRECT
             | BufferUsages::STORAGE
             | BufferUsages::COPY_DST
             | BufferUsages::COPY_SRC;
         grow(&mut self.args, device, 2 * block, "rwt_cull_args", usage);
-        let usage = BufferUsages::COPY_DST | BufferUsages::COPY_SRC;
-        grow(
-            &mut self.phases,
-            device,
-            2 * block,
-            "rwt_cull_phases",
-            usage,
-        );
         let usage = BufferUsages::STORAGE | BufferUsages::COPY_DST;
         let marks = u64::from(marks.max(1)) * 4;
         grow(&mut self.marks, device, marks, "rwt_cull_marks", usage);

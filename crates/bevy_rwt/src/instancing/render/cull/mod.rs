@@ -24,7 +24,7 @@ mod tests;
 mod whole;
 
 use layout::{Offsets, Plan, ViewWork};
-pub(in crate::instancing) use occlusion::{cull_late, restore_early};
+pub(in crate::instancing) use occlusion::cull_late;
 pub(super) use params::{CullRecord, CullView};
 
 use super::draw::MeshSlices;
@@ -125,9 +125,6 @@ pub(in crate::instancing) struct InstanceCuller {
     args: Option<Buffer>,
     /// One bit per instance of a chunk in an occluding view: hidden in the early phase.
     marks: Option<Buffer>,
-    /// The early block put aside during the late prepass, then the early block with no
-    /// instances ([`occlusion`]).
-    phases: Option<Buffer>,
     /// The pyramids views occlude with.
     pyramids: occlusion::Pyramids,
     /// The bind group every dispatch of the frame uses.
@@ -212,7 +209,6 @@ pub(in crate::instancing) fn init_culler(
         fresh_pool: false,
         args: None,
         marks: None,
-        phases: None,
         pyramids,
         bind: None,
         draws: HashMap::default(),
@@ -572,8 +568,7 @@ impl CullInputs<'_, '_> {
 
 impl InstanceCuller {
     /// Writes the records, each view's settings (their offsets into `plan`; a late phase's
-    /// where the view occludes), the arguments (both blocks with no instances) and the early
-    /// block with no instances the late phase restores.
+    /// where the view occludes) and the arguments (both blocks with no instances).
     fn write(
         &mut self,
         dispatches: &[Dispatch],
@@ -633,10 +628,9 @@ impl InstanceCuller {
         self.views.write_buffer(device, queue);
         let args: Vec<u32> = dispatches.iter().flat_map(|d| d.args).collect();
         let block: &[u8] = bytemuck::cast_slice(&args);
-        if let (Some(buffer), Some(phases)) = (&self.args, &self.phases) {
+        if let Some(buffer) = &self.args {
             queue.write_buffer(buffer, 0, block);
             queue.write_buffer(buffer, block.len() as u64, block);
-            queue.write_buffer(phases, block.len() as u64, block);
         }
     }
 

@@ -5,12 +5,12 @@
 //! last frame's pyramid hides, seen from last frame's view, is marked rather than kept. The
 //! early depth prepass draws what was kept; Bevy reduces it into this frame's pyramid; then
 //! [`cull_late`] tests the marked instances against it and keeps, into each draw's late
-//! range, those it does not hide. The late prepass draws the late ranges only (the early
-//! block of arguments is put aside, and counts nothing meanwhile); [`restore_early`] puts
-//! it back for the main pass, which draws both. What the early depth holds, the frame
-//! holds too, so an instance seen this frame is never dropped, however the view moved.
+//! range, those it does not hide. The late prepass draws the late ranges only
+//! ([`LatePrepass`](super::super::draw::LatePrepass)), the main pass both. What the early
+//! depth holds, the frame holds too, so an instance seen this frame is never dropped,
+//! however the view moved.
 
-use super::{ARGS_WORDS, InstanceCuller, ViewWork, grid};
+use super::{InstanceCuller, ViewWork, grid};
 use bevy::core_pipeline::mip_generation::experimental::depth::ViewDepthPyramid;
 use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::platform::collections::HashMap;
@@ -20,7 +20,6 @@ use bevy::render::render_resource::binding_types::texture_2d;
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::view::ExtractedView;
-use std::ops::Range;
 
 /// What culling reads of a view to occlude: its pyramid, and whether it has a depth prepass.
 pub(super) type PyramidQuery = (Option<&'static ViewDepthPyramid>, Has<DepthPrepass>);
@@ -145,10 +144,9 @@ impl Pyramids {
     }
 }
 
-/// One view's late phase this frame: its draws (records of the early block), its settings'
-/// dynamic offset, its binding of the pool and its workgroups.
+/// One view's late phase this frame: its settings' dynamic offset, its binding of the pool
+/// and its workgroups.
 pub(super) struct LateWork {
-    draws: Range<u32>,
     params: u32,
     pool: u64,
     workgroups: u32,
@@ -157,30 +155,19 @@ pub(super) struct LateWork {
 impl LateWork {
     pub fn new(view: &ViewWork, params: u32) -> Self {
         Self {
-            draws: view.records.clone(),
             params,
             pool: view.pool,
             workgroups: view.workgroups,
         }
     }
-
-    /// The view's records of the early block, in bytes.
-    fn bytes(&self) -> Range<u64> {
-        let record = u64::from(ARGS_WORDS) * 4;
-        u64::from(self.draws.start) * record..u64::from(self.draws.end) * record
-    }
 }
 
-/// What one view's late phase needs this frame: its work, its pipeline and pyramid, the
-/// arguments and the buffer the early block is put aside in. `cull_late` and
-/// `restore_early` both ask for it, so the block is restored exactly when it was put aside.
+/// What one view's late phase needs this frame: its work, its pipeline and pyramid.
 struct LateFrame<'a> {
     work: &'a LateWork,
     bind_group: &'a BindGroup,
     pipeline: &'a ComputePipeline,
     pyramid: &'a BindGroup,
-    args: &'a Buffer,
-    phases: &'a Buffer,
 }
 
 impl InstanceCuller {
@@ -190,15 +177,12 @@ impl InstanceCuller {
             bind_group: &self.bind.as_ref()?.bind_group,
             pipeline: cache.get_compute_pipeline(self.pipeline?)?,
             pyramid: self.pyramids.bind_group(view)?,
-            args: self.args.as_ref()?,
-            phases: self.phases.as_ref()?,
         })
     }
 }
 
 /// After the early depth prepass is reduced into the view's pyramid: culls the instances
-/// the early phase hid against it, puts the early block aside and zeroes its counts for the
-/// late prepass.
+/// the early phase hid against it, into each draw's late range.
 pub(in crate::instancing) fn cull_late(
     view: ViewQuery<Entity>,
     culler: Option<Res<InstanceCuller>>,
@@ -211,52 +195,18 @@ pub(in crate::instancing) fn cull_late(
     };
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
-    let encoder = ctx.command_encoder();
-    {
-        let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor {
+    let mut pass = ctx
+        .command_encoder()
+        .begin_compute_pass(&ComputePassDescriptor {
             label: Some("rwt_cull_late"),
             timestamp_writes: None,
         });
-        let span = diagnostics.pass_span(&mut pass, "rwt_cull_late");
-        pass.set_pipeline(late.pipeline);
-        pass.set_bind_group(1, late.pyramid, &[]);
-        let offsets = [late.work.params, late.work.pool as u32];
-        pass.set_bind_group(0, late.bind_group, &offsets);
-        let (x, y) = grid(late.work.workgroups);
-        pass.dispatch_workgroups(x, y, 1);
-        span.end(&mut pass);
-    }
-    let bytes = late.work.bytes();
-    let block = u64::from(culler.draw_count * ARGS_WORDS * 4);
-    let size = bytes.end - bytes.start;
-    encoder.copy_buffer_to_buffer(late.args, bytes.start, late.phases, bytes.start, size);
-    encoder.copy_buffer_to_buffer(
-        late.phases,
-        block + bytes.start,
-        late.args,
-        bytes.start,
-        size,
-    );
-}
-
-/// After the late prepass: puts the view's early block back for the main pass.
-pub(in crate::instancing) fn restore_early(
-    view: ViewQuery<Entity>,
-    culler: Option<Res<InstanceCuller>>,
-    cache: Res<PipelineCache>,
-    mut ctx: RenderContext,
-) {
-    let Some(culler) = culler else { return };
-    let Some(late) = culler.late_frame(view.entity(), &cache) else {
-        return;
-    };
-    let bytes = late.work.bytes();
-    let size = bytes.end - bytes.start;
-    ctx.command_encoder().copy_buffer_to_buffer(
-        late.phases,
-        bytes.start,
-        late.args,
-        bytes.start,
-        size,
-    );
+    let span = diagnostics.pass_span(&mut pass, "rwt_cull_late");
+    pass.set_pipeline(late.pipeline);
+    pass.set_bind_group(1, late.pyramid, &[]);
+    let offsets = [late.work.params, late.work.pool as u32];
+    pass.set_bind_group(0, late.bind_group, &offsets);
+    let (x, y) = grid(late.work.workgroups);
+    pass.dispatch_workgroups(x, y, 1);
+    span.end(&mut pass);
 }
