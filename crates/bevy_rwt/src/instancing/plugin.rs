@@ -13,7 +13,10 @@ use bevy::core_pipeline::prepass::Opaque3dPrepass;
 use bevy::core_pipeline::prepass::node::late_prepass;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::ecs::schedule::InternedScheduleLabel;
-use bevy::pbr::{MeshPipelineSystems, Shadow, init_prepass_pipeline};
+use bevy::pbr::{
+    LATE_SHADOW_PASS, MeshPipelineSystems, Shadow, init_prepass_pipeline, per_view_shadow_pass,
+    shared_shadow_pass,
+};
 use bevy::prelude::*;
 use bevy::render::diagnostic::begin_diagnostics_frame;
 use bevy::render::extract_component::ExtractComponentPlugin;
@@ -107,7 +110,7 @@ fn build_render(app: &mut App) {
         .init_resource::<render::Queued<Opaque3dPrepass>>()
         .init_resource::<render::Queued<Shadow>>()
         .init_resource::<render::CascadeReceivers>()
-        .init_resource::<render::LatePrepass>()
+        .init_resource::<render::LatePasses>()
         .add_systems(
             RenderStartup,
             (
@@ -144,11 +147,18 @@ fn build_render(app: &mut App) {
         .add_systems(
             Core3d,
             (
-                (render::cull_late, render::begin_late_prepass)
+                render::cull_late
                     .after(early_downsample_depth)
                     .before(late_prepass),
-                render::end_late_prepass
+                render::begin_late_passes
+                    .after(early_downsample_depth)
+                    .before(late_prepass)
+                    .before(per_view_shadow_pass::<LATE_SHADOW_PASS>)
+                    .before(shared_shadow_pass::<LATE_SHADOW_PASS>),
+                render::end_late_passes
                     .after(late_prepass)
+                    .after(per_view_shadow_pass::<LATE_SHADOW_PASS>)
+                    .after(shared_shadow_pass::<LATE_SHADOW_PASS>)
                     .before(Core3dSystems::MainPass),
             ),
         );

@@ -1,10 +1,10 @@
 //! The draw of one chunk: its bind group, its mesh once per instance: the instances culling
 //! kept for the view, drawn indirectly, or all of them.
 //!
-//! A camera with Bevy's `OcclusionCulling` draws its depth prepass twice: early, then late,
-//! for what its depth pyramid hid from the early phase ([`LatePrepass`]). A chunk drawn whole
-//! is drawn whole in the early prepass and not again; a culled chunk draws what culling's
-//! late phase kept.
+//! A camera or light with Bevy's `OcclusionCulling` draws its depth prepass or shadow maps
+//! twice: early, then late, for what its depth pyramid hid from the early phase
+//! ([`LatePasses`]). A chunk drawn whole is drawn whole in the early pass and not again; a
+//! culled chunk draws what culling's late phase kept (only a camera's culling occludes).
 
 use super::{ExtractedChunk, GpuChunk, InstanceCuller, InstanceSlab};
 use bevy::ecs::system::{SystemParamItem, lifetimeless::*};
@@ -17,7 +17,6 @@ use bevy::render::render_phase::{
     PhaseItem, RenderCommand, RenderCommandResult, SetItemPipeline, TrackedRenderPass,
 };
 use bevy::render::render_resource::{Buffer, IndexFormat};
-use bevy::render::renderer::ViewQuery;
 
 /// The draw of one chunk in the main pass.
 pub(in crate::instancing) type DrawInstancedChunk = (
@@ -51,33 +50,24 @@ impl<P: PhaseItem, const I: usize> RenderCommand<P> for SetChunkBindGroup<I> {
     }
 }
 
-/// The view whose late prepass is being encoded, if any (set just before Bevy's
-/// `late_prepass`, cleared just after).
+/// Whether Bevy's late passes are being encoded: the late prepass and the late shadow
+/// passes (set before them, cleared after them and before the main pass).
 #[derive(Resource, Default)]
-pub(in crate::instancing) struct LatePrepass(Option<Entity>);
+pub(in crate::instancing) struct LatePasses(bool);
 
-impl LatePrepass {
-    fn is(&self, view: Entity) -> bool {
-        self.0 == Some(view)
-    }
+/// Before the late passes.
+pub(in crate::instancing) fn begin_late_passes(mut late: ResMut<LatePasses>) {
+    late.0 = true;
 }
 
-/// Before the view's late prepass: marks it as being encoded.
-pub(in crate::instancing) fn begin_late_prepass(
-    view: ViewQuery<Entity>,
-    mut late: ResMut<LatePrepass>,
-) {
-    late.0 = Some(view.entity());
-}
-
-/// After the view's late prepass.
-pub(in crate::instancing) fn end_late_prepass(mut late: ResMut<LatePrepass>) {
-    late.0 = None;
+/// After the late passes.
+pub(in crate::instancing) fn end_late_passes(mut late: ResMut<LatePasses>) {
+    late.0 = false;
 }
 
 /// Draws a chunk's mesh once per instance: those culling kept for the view (for each mesh
-/// it chose, in each of its ranges; in the late prepass, the late range only), or all
-/// (nothing in the late prepass).
+/// it chose, in each of its ranges; in a late pass, the late range only), or all (nothing
+/// in a late pass).
 pub(in crate::instancing) struct DrawChunkInstances;
 
 impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
@@ -86,7 +76,7 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
         SRes<MeshAllocator>,
         SRes<InstanceSlab>,
         Option<SRes<InstanceCuller>>,
-        SRes<LatePrepass>,
+        SRes<LatePasses>,
     );
     type ViewQuery = Entity;
     type ItemQuery = (Read<ExtractedChunk>, Read<GpuChunk>);
@@ -100,7 +90,7 @@ impl<P: PhaseItem> RenderCommand<P> for DrawChunkInstances {
     ) -> RenderCommandResult {
         let (meshes, allocator) = (meshes.into_inner(), allocator.into_inner());
         let culled = culler.and_then(|c| c.into_inner().draw(view, item_of.entity()));
-        let late = late.is(view);
+        let late = late.0;
         let Some((chunk, gpu)) = item else {
             return RenderCommandResult::Skip;
         };

@@ -32,7 +32,7 @@ pub(super) use cull_check::{FrameCheck, check_culling, extract_culling_check};
 pub(super) use depth::{
     DrawInstancedDepth, InstancedDepthPipeline, init_depth_pipeline, queue_prepass, queue_shadows,
 };
-pub(super) use draw::{DrawInstancedChunk, LatePrepass, begin_late_prepass, end_late_prepass};
+pub(super) use draw::{DrawInstancedChunk, LatePasses, begin_late_passes, end_late_passes};
 pub(super) use main_pass::{InstancedPipeline, init_main_pipeline, queue_main};
 pub(super) use receivers::{CascadeReceivers, find_receivers};
 use retained::BinnedChunk;

@@ -6,7 +6,7 @@
 //! early depth prepass draws what was kept; Bevy reduces it into this frame's pyramid; then
 //! [`cull_late`] tests the marked instances against it and keeps, into each draw's late
 //! range, those it does not hide. The late prepass draws the late ranges only
-//! ([`LatePrepass`](super::super::draw::LatePrepass)), the main pass both. What the early
+//! ([`LatePasses`](super::super::draw::LatePasses)), the main pass both. What the early
 //! depth holds, the frame holds too, so an instance seen this frame is never dropped,
 //! however the view moved.
 
