@@ -18,8 +18,8 @@
 //! - K walks on foot (a capsule that trunks, stumps and rocks stop; avian3d), K again flies.
 //!
 //! The camera culls what hills, trees and bushes hide (`OcclusionCulling`; `RWT_OCCLUSION=0`
-//! draws it all); `RWT_COST=1` times the scripted view's frame culled so and drawn whole
-//! (`cost`).
+//! draws it all); `RWT_COST=1` times the scripted view's frame culled so, drawn whole, and
+//! drawn whole by a camera that still occludes Bevy's own meshes (`cost`).
 
 mod cost;
 mod gameplay;
