@@ -135,8 +135,6 @@ pub(in crate::instancing) struct InstanceCuller {
     early: Vec<ViewWork>,
     /// This frame's late phase, by view.
     late: HashMap<Entity, occlusion::LateWork>,
-    /// This frame's draws (records in each block of the arguments).
-    draw_count: u32,
     /// This frame's culled draws, in the order of their arguments, for the check.
     #[cfg(feature = "testing")]
     checked: Vec<super::cull_check::Checked>,
@@ -214,7 +212,6 @@ pub(in crate::instancing) fn init_culler(
         draws: HashMap::default(),
         early: Vec::new(),
         late: HashMap::default(),
-        draw_count: 0,
         #[cfg(feature = "testing")]
         checked: Vec::new(),
     });
@@ -426,16 +423,17 @@ impl InstanceCuller {
         }
     }
 
-    /// Records this frame's culled draws.
+    /// Records this frame's culled draws (the late block of arguments follows the early
+    /// one, a record each).
     fn record(&mut self, dispatches: &[Dispatch], offsets: &[Offsets]) {
-        self.draw_count = dispatches.len() as u32;
+        let draw_count = dispatches.len() as u32;
         for (d, o) in dispatches.iter().zip(offsets) {
             let early = CulledRange {
                 args: u64::from(o.draw * ARGS_WORDS * 4),
                 kept: o.kept..o.kept + d.bytes(),
             };
             let late = o.late.map(|late| CulledRange {
-                args: u64::from((self.draw_count + o.draw) * ARGS_WORDS * 4),
+                args: u64::from((draw_count + o.draw) * ARGS_WORDS * 4),
                 kept: late..late + d.bytes(),
             });
             self.draws
