@@ -1,11 +1,13 @@
 //! Occlusion in culling per instance, checked in a real renderer (`scripts/smoke.sh` runs
 //! it under Xvfb and lavapipe): `cargo run --example gpu_occlusion`.
 //!
-//! A field of grass around a hill, no wind, and a camera with Bevy's `DepthPrepass` and
-//! `OcclusionCulling`. The camera waits low behind the hill, where the hill hides the field
-//! beyond it, then rises in one frame to look over it: that frame's early phase still tests
-//! against the depth seen from below, which hid the field, so everything it now shows,
-//! down to the blades whose tips peek over the crest, must be kept by the late phase.
+//! A field of grass around a hill, no wind, a camera with Bevy's `DepthPrepass` and
+//! `OcclusionCulling`, and a low sun behind it with `OcclusionCulling` too (its cascade
+//! culls the casters its depth hides: the hill hides part of the field from it). The camera
+//! waits low behind the hill, where the hill hides the field beyond it, then rises in one
+//! frame to look over it: that frame's early phase still tests against the depth seen from
+//! below, which hid the field, so everything it now shows, down to the blades whose tips
+//! peek over the crest, must be kept by the late phase.
 //!
 //! The rising frame is taken twice: with chunks drawn whole
 //! ([`InstanceCulling::PerChunk`], no occlusion), then culled per instance with occlusion,
@@ -13,11 +15,12 @@
 //! pipeline statistics (`RenderDiagnosticsPlugin`; lavapipe has them) count the vertices
 //! the camera's late prepass shades: a chunk drawn whole was all drawn by the early
 //! prepass, so none. It prints `rwt-occlusion: draws D occluding O instances N kept G (gpu)
-//! C (frustum) late L, pixel difference P, pixels differing X, late prepass vertices V
-//! (drawn whole)` and exits with an error unless the two frames match (`MOST_DIFFERENCE`,
-//! `MOST_PIXELS`), occlusion dropped instances, the late phase kept some, no draw kept more
-//! than the frustum alone keeps, and the late prepass shaded no vertex of chunks drawn
-//! whole. Screenshots go to `RWT_OCCLUSION_DIR` (default `target/occlusion`).
+//! C (frustum) late L, cascade draws S occluded H, pixel difference P, pixels differing X,
+//! late prepass vertices V (drawn whole)` and exits with an error unless the two frames
+//! match (`MOST_DIFFERENCE`, `MOST_PIXELS`), occlusion dropped instances, the late phase
+//! kept some, the sun's cascade occluded some, no draw kept more than the frustum alone
+//! keeps, and the late prepass shaded no vertex of chunks drawn whole. Screenshots go to
+//! `RWT_OCCLUSION_DIR` (default `target/occlusion`).
 
 use bevy::app::AppExit;
 use bevy::core_pipeline::prepass::DepthPrepass;
@@ -28,8 +31,8 @@ use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::frame_check::{
-    COMPARED_MSAA, Captures, HIGH_SUN, culling_check_app, mean_difference, out_of_patience,
-    output_dir, passed, pixels_differing, spawn_shadow_sun,
+    COMPARED_MSAA, Captures, culling_check_app, mean_difference, out_of_patience, output_dir,
+    passed, pixels_differing, spawn_shadow_sun,
 };
 use rwt_examples::grass_field;
 
@@ -45,6 +48,9 @@ const BY: u8 = 24;
 const WAIT: u32 = 12;
 /// Most frames the check may take.
 const PATIENCE: u32 = 600;
+
+/// Towards a sun 18 degrees up behind the camera's rest (the camera looks along +x).
+const BEHIND_SUN: Vec3 = Vec3::new(-1.0, 0.33, 0.2);
 
 /// The camera's rest: low behind the hill, which hides the field beyond it.
 fn low() -> Transform {
@@ -89,7 +95,10 @@ fn setup(
         RwtViewer::all_around(),
         low(),
     ));
-    spawn_shadow_sun(&mut commands, HIGH_SUN);
+    // A low sun behind the camera: the hill hides part of the field beyond it from the
+    // sun, and the sun's cascade culls what its depth hides too.
+    let sun = spawn_shadow_sun(&mut commands, BEHIND_SUN);
+    commands.entity(sun).insert(OcclusionCulling);
     let blade = meshes.add(grass_field::blade());
     let grass = ScatterClass::instanced(LayerDensity::Constant(8.0), blade, default());
     commands.spawn(
@@ -196,13 +205,15 @@ fn conclude(
     let differing = pixels_differing(whole, occluded, BY);
     let late_vertices = late_whole.map_or("unknown".into(), |v| v.to_string());
     println!(
-        "rwt-occlusion: draws {} occluding {} instances {} kept {} (gpu) {} (frustum) late {}, pixel difference {difference:.3}, pixels differing {differing}, late prepass vertices {late_vertices} (drawn whole)",
+        "rwt-occlusion: draws {} occluding {} instances {} kept {} (gpu) {} (frustum) late {}, cascade draws {} occluded {}, pixel difference {difference:.3}, pixels differing {differing}, late prepass vertices {late_vertices} (drawn whole)",
         report.draws,
         report.occluding_draws,
         report.instances,
         report.gpu_kept,
         report.cpu_kept,
-        report.late_kept
+        report.late_kept,
+        report.cascade_occluding_draws,
+        report.cascade_occluded
     );
     let failures = [
         (report.occluding_draws == 0, "no draw occluded"),
@@ -215,6 +226,10 @@ fn conclude(
             "occlusion dropped no instance",
         ),
         (report.late_kept == 0, "the late phase kept nothing"),
+        (
+            report.cascade_occluding_draws == 0 || report.cascade_occluded == 0,
+            "the sun's cascade occluded nothing",
+        ),
         (
             difference >= MOST_DIFFERENCE || differing > MOST_PIXELS,
             "the occluded frame differs from the whole one",

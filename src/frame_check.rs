@@ -110,20 +110,22 @@ pub const HIGH_SUN: Vec3 = Vec3::new(1.0, 2.0, 0.5);
 
 /// A sun towards `toward_sun` casting shadows into one cascade (a software driver draws every
 /// cascade on the CPU).
-pub fn spawn_shadow_sun(commands: &mut Commands, toward_sun: Vec3) {
-    commands.spawn((
-        DirectionalLight {
-            shadow_maps_enabled: true,
-            ..default()
-        },
-        Transform::from_translation(toward_sun).looking_at(Vec3::ZERO, Vec3::Y),
-        CascadeShadowConfigBuilder {
-            num_cascades: 1,
-            maximum_distance: 60.0,
-            ..default()
-        }
-        .build(),
-    ));
+pub fn spawn_shadow_sun(commands: &mut Commands, toward_sun: Vec3) -> Entity {
+    commands
+        .spawn((
+            DirectionalLight {
+                shadow_maps_enabled: true,
+                ..default()
+            },
+            Transform::from_translation(toward_sun).looking_at(Vec3::ZERO, Vec3::Y),
+            CascadeShadowConfigBuilder {
+                num_cascades: 1,
+                maximum_distance: 60.0,
+                ..default()
+            }
+            .build(),
+        ))
+        .id()
 }
 
 /// Prints `PREFIX: FAIL what` for each failed check; whether none failed.

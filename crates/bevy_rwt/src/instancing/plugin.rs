@@ -149,7 +149,9 @@ fn build_render(app: &mut App) {
             (
                 render::cull_late
                     .after(early_downsample_depth)
-                    .before(late_prepass),
+                    .before(late_prepass)
+                    .before(per_view_shadow_pass::<LATE_SHADOW_PASS>)
+                    .before(shared_shadow_pass::<LATE_SHADOW_PASS>),
                 render::begin_late_passes
                     .after(early_downsample_depth)
                     .before(late_prepass)

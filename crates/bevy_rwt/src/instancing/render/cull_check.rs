@@ -54,6 +54,11 @@ pub struct CullingReport {
     /// keeps and that cast nowhere the camera reads the cascade ([`crate::CascadeCasters`];
     /// the CPU's count).
     pub cascade_dropped: u64,
+    /// Culled draws in cascades that occlude (a light's `OcclusionCulling`).
+    pub cascade_occluding_draws: usize,
+    /// Instances of those draws that the rest of the test keeps and the cascade's depth hid
+    /// (neither phase kept them; the CPU's count less the GPU's).
+    pub cascade_occluded: u64,
 }
 
 impl CullingCheck {
@@ -105,12 +110,14 @@ pub(in crate::instancing) fn extract_culling_check(
 }
 
 /// One culled draw as the check sees it: its view's early dispatch, its record, the chunk's
-/// instances, whether its view occludes.
+/// instances, whether its view occludes and is a light's.
 pub(super) struct Checked {
     pub view: CullView,
     pub record: CullRecord,
     pub instances: Arc<InstanceBuffer>,
     pub occludes: bool,
+    /// Whether its view is a light's.
+    pub shadow: bool,
     /// Whether it draws its class's far mesh (chosen per instance).
     pub far: bool,
     /// The byte ranges of the pool its early and late phases keep into.
@@ -192,6 +199,10 @@ pub(in crate::instancing) fn check_culling(
             // What the pyramid hid is dropped from the frustum's instances, never added.
             report.occluding_draws += 1;
             report.late_kept += u64::from(late);
+            if c.shadow {
+                report.cascade_occluding_draws += 1;
+                report.cascade_occluded += cpu.len().saturating_sub(gpu.len()) as u64;
+            }
             cpu.dedup();
             report.mismatched += usize::from(gpu.iter().any(|g| cpu.binary_search(g).is_err()));
         } else {

@@ -4,7 +4,7 @@
 //! A camera or light with Bevy's `OcclusionCulling` draws its depth prepass or shadow maps
 //! twice: early, then late, for what its depth pyramid hid from the early phase
 //! ([`LatePasses`]). A chunk drawn whole is drawn whole in the early pass and not again; a
-//! culled chunk draws what culling's late phase kept (only a camera's culling occludes).
+//! culled chunk draws what culling's late phase kept.
 
 use super::{ExtractedChunk, GpuChunk, InstanceCuller, InstanceSlab};
 use bevy::ecs::system::{SystemParamItem, lifetimeless::*};

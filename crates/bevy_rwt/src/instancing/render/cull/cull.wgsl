@@ -4,7 +4,7 @@
 // the chunk's kept instances in the view and counts it in the chunk's indirect draw
 // arguments.
 //
-// Occlusion takes two phases in a camera with a depth pyramid. The early phase (before the
+// Occlusion takes two phases in a view with a depth pyramid (a camera, a cascade). The early phase (before the
 // frame's passes) also tests each instance against last frame's pyramid, seen from last
 // frame's view: one hidden there is not kept but marked. The late phase (after the early
 // depth prepass has been reduced into this frame's pyramid) tests the marked ones against

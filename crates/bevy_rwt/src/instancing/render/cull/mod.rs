@@ -11,9 +11,10 @@
 //! culled draw (culling off, the adapter unable, the pool full, or nothing culling could
 //! drop: [`whole`]) is drawn directly, whole.
 //!
-//! A camera with Bevy's `OcclusionCulling` and `DepthPrepass` also culls what its depth
-//! pyramid hides, in two phases ([`occlusion`]): what last frame's depth hid is tested again
-//! once this frame's early depth is reduced, and drawn from the late prepass on.
+//! A camera with Bevy's `OcclusionCulling` and `DepthPrepass`, and the cascades of a light
+//! with `OcclusionCulling`, also cull what their depth pyramids hide, in two phases
+//! ([`occlusion`]): what last frame's depth hid is tested again once this frame's early
+//! depth is reduced, and drawn from the late prepass and late shadow passes on.
 
 mod layout;
 mod lods;
@@ -416,6 +417,7 @@ impl InstanceCuller {
                 record: *record,
                 instances: d.extracted.buffer.clone(),
                 occludes: o.late.is_some(),
+                shadow: d.view.shadow,
                 far: d.part.far,
                 kept: o.kept..o.kept + d.bytes(),
                 late: o.late.map(|l| l..l + d.bytes()),

@@ -1,11 +1,14 @@
-//! Occlusion for culling per instance, in a camera with Bevy's `OcclusionCulling` and
-//! `DepthPrepass` (and so a `ViewDepthPyramid`).
+//! Occlusion for culling per instance, in a view with a `ViewDepthPyramid` of Bevy's: a
+//! camera with `OcclusionCulling` and `DepthPrepass`, and the cascades of a directional
+//! light with `OcclusionCulling` (under such a camera). A caster its cascade's depth hides
+//! changes nothing in the shadow map, so the shadows lose nothing.
 //!
 //! The early phase runs with the rest of culling, before the frame's passes: an instance
 //! last frame's pyramid hides, seen from last frame's view, is marked rather than kept. The
 //! early depth prepass draws what was kept; Bevy reduces it into this frame's pyramid; then
 //! [`cull_late`] tests the marked instances against it and keeps, into each draw's late
-//! range, those it does not hide. The late prepass draws the late ranges only
+//! range, those it does not hide. The late prepass and late shadow passes draw the late
+//! ranges only
 //! ([`LatePasses`](super::super::draw::LatePasses)), the main pass both. What the early
 //! depth holds, the frame holds too, so an instance seen this frame is never dropped,
 //! however the view moved.
@@ -16,6 +19,7 @@ use bevy::core_pipeline::prepass::DepthPrepass;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RecordDiagnostics;
+use bevy::render::occlusion_culling::OcclusionCullingSubviewEntities;
 use bevy::render::render_resource::binding_types::texture_2d;
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
@@ -97,7 +101,8 @@ impl Pyramids {
             .or(self.none.as_ref())
     }
 
-    /// Binds the pyramid of each camera view that occludes, and says how each occludes.
+    /// Binds the pyramid of each view that occludes (a camera with a depth prepass, a
+    /// cascade), and says how each occludes.
     pub fn prepare<'a>(
         &mut self,
         views: impl IntoIterator<Item = ViewPyramid<'a>>,
@@ -112,7 +117,7 @@ impl Pyramids {
         let mut occluding = HashMap::default();
         let mut by_view = HashMap::default();
         for (entity, view, shadow, (pyramid, depth_prepass)) in views {
-            let Some(pyramid) = pyramid.filter(|_| depth_prepass && !shadow) else {
+            let Some(pyramid) = pyramid.filter(|_| depth_prepass || shadow) else {
                 continue;
             };
             let current = view.clip_from_world.unwrap_or_else(|| {
@@ -181,18 +186,25 @@ impl InstanceCuller {
     }
 }
 
-/// After the early depth prepass is reduced into the view's pyramid: culls the instances
-/// the early phase hid against it, into each draw's late range.
+/// After the early depth prepass and shadow maps are reduced into their pyramids: culls
+/// the instances the early phase hid against them, into each draw's late range, for the
+/// camera and each of its cascades that occludes.
 pub(in crate::instancing) fn cull_late(
-    view: ViewQuery<Entity>,
+    view: ViewQuery<(Entity, Option<&OcclusionCullingSubviewEntities>)>,
     culler: Option<Res<InstanceCuller>>,
     cache: Res<PipelineCache>,
     mut ctx: RenderContext,
 ) {
     let Some(culler) = culler else { return };
-    let Some(late) = culler.late_frame(view.entity(), &cache) else {
+    let (camera, cascades) = view.into_inner();
+    let cascades = cascades.map(|c| c.0.as_slice()).unwrap_or_default();
+    let frames: Vec<LateFrame> = std::iter::once(&camera)
+        .chain(cascades)
+        .filter_map(|&view| culler.late_frame(view, &cache))
+        .collect();
+    if frames.is_empty() {
         return;
-    };
+    }
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     let mut pass = ctx
@@ -202,11 +214,13 @@ pub(in crate::instancing) fn cull_late(
             timestamp_writes: None,
         });
     let span = diagnostics.pass_span(&mut pass, "rwt_cull_late");
-    pass.set_pipeline(late.pipeline);
-    pass.set_bind_group(1, late.pyramid, &[]);
-    let offsets = [late.work.params, late.work.pool as u32];
-    pass.set_bind_group(0, late.bind_group, &offsets);
-    let (x, y) = grid(late.work.workgroups);
-    pass.dispatch_workgroups(x, y, 1);
+    for late in frames {
+        pass.set_pipeline(late.pipeline);
+        pass.set_bind_group(1, late.pyramid, &[]);
+        let offsets = [late.work.params, late.work.pool as u32];
+        pass.set_bind_group(0, late.bind_group, &offsets);
+        let (x, y) = grid(late.work.workgroups);
+        pass.dispatch_workgroups(x, y, 1);
+    }
     span.end(&mut pass);
 }
