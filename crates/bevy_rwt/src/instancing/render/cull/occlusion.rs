@@ -25,8 +25,13 @@ use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::view::ExtractedView;
 
-/// What culling reads of a view to occlude: its pyramid, and whether it has a depth prepass.
-pub(super) type PyramidQuery = (Option<&'static ViewDepthPyramid>, Has<DepthPrepass>);
+/// What culling reads of a view to occlude: its pyramid, whether it has a depth prepass,
+/// and (a camera) its cascades that occlude.
+pub(super) type PyramidQuery = (
+    Option<&'static ViewDepthPyramid>,
+    Has<DepthPrepass>,
+    Option<&'static OcclusionCullingSubviewEntities>,
+);
 
 /// A view as [`Pyramids::prepare`] reads it: its entity, itself, whether it is a shadow
 /// view, and its [`PyramidQuery`].
@@ -34,7 +39,11 @@ pub(super) type ViewPyramid<'a> = (
     Entity,
     &'a ExtractedView,
     bool,
-    (Option<&'a ViewDepthPyramid>, bool),
+    (
+        Option<&'a ViewDepthPyramid>,
+        bool,
+        Option<&'a OcclusionCullingSubviewEntities>,
+    ),
 );
 
 /// How a view occludes this frame: its clip space from world space, and last frame's where
@@ -114,10 +123,23 @@ impl Pyramids {
             let entries = BindGroupEntries::single(&self.none_texture);
             self.none = Some(device.create_bind_group("rwt_cull_no_pyramid", &layout, &entries));
         }
+        let views: Vec<ViewPyramid> = views.into_iter().collect();
+        // A cascade's pyramid is reduced only under a camera whose own pyramid is: under
+        // another, it holds nothing or an old frame's depth.
+        let reduced: Vec<Entity> = views
+            .iter()
+            .filter(|(.., (pyramid, _, _))| pyramid.is_some())
+            .flat_map(|(.., (_, _, cascades))| cascades.iter().flat_map(|c| c.0.iter().copied()))
+            .collect();
         let mut occluding = HashMap::default();
         let mut by_view = HashMap::default();
-        for (entity, view, shadow, (pyramid, depth_prepass)) in views {
-            let Some(pyramid) = pyramid.filter(|_| depth_prepass || shadow) else {
+        for (entity, view, shadow, (pyramid, depth_prepass, _)) in views {
+            let occludes = if shadow {
+                reduced.contains(&entity)
+            } else {
+                depth_prepass
+            };
+            let Some(pyramid) = pyramid.filter(|_| occludes) else {
                 continue;
             };
             let current = view.clip_from_world.unwrap_or_else(|| {
