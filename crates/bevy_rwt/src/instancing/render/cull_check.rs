@@ -199,11 +199,11 @@ pub(in crate::instancing) fn check_culling(
             // What the pyramid hid is dropped from the frustum's instances, never added.
             report.occluding_draws += 1;
             report.late_kept += u64::from(late);
+            cpu.dedup();
             if c.shadow {
                 report.cascade_occluding_draws += 1;
                 report.cascade_occluded += cpu.len().saturating_sub(gpu.len()) as u64;
             }
-            cpu.dedup();
             report.mismatched += usize::from(gpu.iter().any(|g| cpu.binary_search(g).is_err()));
         } else {
             report.mismatched += usize::from(gpu != cpu || late != 0);

@@ -4,12 +4,13 @@
 // the chunk's kept instances in the view and counts it in the chunk's indirect draw
 // arguments.
 //
-// Occlusion takes two phases in a view with a depth pyramid (a camera, a cascade). The early phase (before the
-// frame's passes) also tests each instance against last frame's pyramid, seen from last
-// frame's view: one hidden there is not kept but marked. The late phase (after the early
-// depth prepass has been reduced into this frame's pyramid) tests the marked ones against
-// it and keeps those it does not hide, into the draw's second range. A blade seen this
-// frame is kept by one of the two: what the early depth holds, the frame holds too.
+// Occlusion takes two phases in a view with a depth pyramid (a camera, a light's cascade).
+// The early phase (before the frame's passes) also tests each instance against last frame's
+// pyramid, seen from last frame's view: one hidden there is not kept but marked. The late
+// phase (after the early depth prepass or shadow map has been reduced into this frame's
+// pyramid) tests the marked ones against it and keeps those it does not hide, into the
+// draw's second range. A blade seen this frame is kept by one of the two: what the early
+// depth holds, the frame holds too.
 
 #import rwt::fade::{Lod, kept_fraction, growth}
 

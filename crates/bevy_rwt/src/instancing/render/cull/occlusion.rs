@@ -5,13 +5,12 @@
 //!
 //! The early phase runs with the rest of culling, before the frame's passes: an instance
 //! last frame's pyramid hides, seen from last frame's view, is marked rather than kept. The
-//! early depth prepass draws what was kept; Bevy reduces it into this frame's pyramid; then
-//! [`cull_late`] tests the marked instances against it and keeps, into each draw's late
-//! range, those it does not hide. The late prepass and late shadow passes draw the late
-//! ranges only
-//! ([`LatePasses`](super::super::draw::LatePasses)), the main pass both. What the early
-//! depth holds, the frame holds too, so an instance seen this frame is never dropped,
-//! however the view moved.
+//! early depth prepass (or shadow pass) draws what was kept; Bevy reduces it into this
+//! frame's pyramid; then [`cull_late`] tests the marked instances against it and keeps,
+//! into each draw's late range, those it does not hide. The late prepass and late shadow
+//! passes draw the late ranges only ([`LatePasses`](super::super::draw::LatePasses)), the
+//! main pass both. What the early depth holds, the frame holds too, so an instance seen
+//! this frame is never dropped, however the view moved.
 
 use super::{InstanceCuller, ViewWork, grid};
 use bevy::core_pipeline::mip_generation::experimental::depth::ViewDepthPyramid;
