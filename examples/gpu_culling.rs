@@ -2,21 +2,22 @@
 //! under Xvfb and lavapipe): `cargo run --example gpu_culling`.
 //!
 //! A field of grass that thins out with distance ([`InstancedThinning`]), sparse poles 6 m
-//! tall, no wind (so that two frames can match), a low sun with shadows across the view, and
-//! a camera at the field's edge looking across it, so that many chunks are cut by the view's
-//! sides, and the sun's cascade holds blades whose shadows fall outside the view and poles
-//! outside it whose long shadows fall inside (on one side of the view they do, on the other
-//! they fall away: a cascade that took the light's direction the wrong way round would keep
-//! the latter and lose the former). The blades have a far mesh
-//! from 20 m, the same blade made again: drawn whole, a chunk draws the mesh its nearest
-//! point calls for, culled, each blade the one its own distance calls for; the same
-//! pixels either way, and the check counts each mesh's draw. Two screenshots: chunks
-//! drawn whole, every chunk in the cascade's box casting ([`InstanceCulling::PerChunk`],
-//! [`CascadeCasters::All`]), then culled per instance, the cascade drawing only the blades
-//! whose shadows fall in view ([`InstanceCulling::PerInstance`],
-//! [`CascadeCasters::WhereRead`]), whose frame is also checked by
-//! [`CullingCheck`]: every culled draw's instances, read back from its indirect arguments
-//! and the pool of kept instances, must be those the same test keeps on the CPU.
+//! tall, no wind (so that two frames can match), a low sun with shadows across the view
+//! (with Bevy's `OcclusionCulling`, which its cascade must ignore: the camera has none, so
+//! nothing reduces the cascade's depth pyramid), and a camera at the field's edge looking
+//! across it, so that many chunks are cut by the view's sides, and the sun's cascade holds
+//! blades whose shadows fall outside the view and poles outside it whose long shadows fall
+//! inside (on one side of the view they do, on the other they fall away: a cascade that
+//! took the light's direction the wrong way round would keep the latter and lose the
+//! former). The blades have a far mesh from 20 m, the same blade made again: drawn whole, a
+//! chunk draws the mesh its nearest point calls for, culled, each blade the one its own
+//! distance calls for; the same pixels either way, and the check counts each mesh's draw.
+//! Two screenshots: chunks drawn whole, every chunk in the cascade's box casting
+//! ([`InstanceCulling::PerChunk`], [`CascadeCasters::All`]), then culled per instance, the
+//! cascade drawing only the blades whose shadows fall in view
+//! ([`InstanceCulling::PerInstance`], [`CascadeCasters::WhereRead`]), whose frame is also
+//! checked by [`CullingCheck`]: every culled draw's instances, read back from its indirect
+//! arguments and the pool of kept instances, must be those the same test keeps on the CPU.
 //!
 //! Then the buffer of every chunk's instances is made to grow and shrink under the field: a
 //! denser second layer comes and goes, and the field's instances, moved to a smaller buffer,
@@ -25,14 +26,15 @@
 //! It prints `rwt-culling: draws D (far F) instances N kept G (gpu) C (cpu) mismatched M,
 //! cascade dropped K, pixel difference P, pixels differing X`, then `rwt-culling: slab
 //! grown to G, shrunk to S instances: draws D kept G (gpu) C (cpu) mismatched M, pixel
-//! difference P`, and exits with an error unless the
-//! counts agree, culling kept fewer instances than it was given, some blades drew the far
-//! mesh and some the near one, the cascade left blades out, the slab shrank, and the
-//! frames match (`MOST_DIFFERENCE` in the mean, `MOST_PIXELS`).
+//! difference P`, and exits with an error unless the counts agree, culling kept fewer
+//! instances than it was given, some blades drew the far mesh and some the near one, the
+//! cascade left blades out and did not occlude, the slab shrank, and the frames match
+//! (`MOST_DIFFERENCE` in the mean, `MOST_PIXELS`).
 //! Screenshots go to `RWT_CULLING_DIR` (default `target/culling`).
 
 use bevy::app::AppExit;
 use bevy::prelude::*;
+use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::frame_check::{
@@ -78,7 +80,10 @@ fn setup(
         RwtViewer::all_around(),
         Transform::from_xyz(-30.0, 3.0, -10.0).looking_at(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
     ));
-    spawn_shadow_sun(&mut commands, LOW_SUN);
+    // The sun asks for occlusion, the camera does not: nothing reduces the cascade's depth
+    // pyramid then, so the cascade must not occlude.
+    let sun = spawn_shadow_sun(&mut commands, LOW_SUN);
+    commands.entity(sun).insert(OcclusionCulling);
     commands.spawn(pole_layer(&mut meshes));
     check.blades = Blades {
         near: meshes.add(grass_field::blade()),
@@ -297,6 +302,10 @@ fn conclude(report: &CullingReport, whole: &image::RgbImage, culled: &image::Rgb
         (
             report.cascade_dropped == 0,
             "the cascade drew every blade in its box",
+        ),
+        (
+            report.occluding_draws > 0,
+            "a view occluded with a depth pyramid nothing reduced",
         ),
         (
             difference >= MOST_DIFFERENCE || differing > MOST_PIXELS,

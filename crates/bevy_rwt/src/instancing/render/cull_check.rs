@@ -43,7 +43,8 @@ pub struct CullingReport {
     /// Culled draws of a class's far mesh, chosen by each instance's distance (a chunk
     /// across the far distance draws its near mesh too, in another draw).
     pub far_draws: usize,
-    /// Culled draws in views that occlude.
+    /// Culled draws in views that occlude (that test against a depth pyramid, from the
+    /// second frame they do on in two phases).
     pub occluding_draws: usize,
     /// Instances the late phase of occlusion kept: hidden by last frame's depth, not by
     /// this frame's.
@@ -116,6 +117,8 @@ pub(super) struct Checked {
     pub record: CullRecord,
     pub instances: Arc<InstanceBuffer>,
     pub occludes: bool,
+    /// Whether its view tests against a depth pyramid (in its first frame, no phase yet).
+    pub pyramid: bool,
     /// Whether its view is a light's.
     pub shadow: bool,
     /// Whether it draws its class's far mesh (chosen per instance).
@@ -193,11 +196,11 @@ pub(in crate::instancing) fn check_culling(
         report.draws += 1;
         report.far_draws += usize::from(c.far);
         report.instances += c.instances.instances.len() as u64;
+        report.occluding_draws += usize::from(c.pyramid);
         report.gpu_kept += gpu.len() as u64;
         report.cpu_kept += cpu.len() as u64;
         if c.occludes {
             // What the pyramid hid is dropped from the frustum's instances, never added.
-            report.occluding_draws += 1;
             report.late_kept += u64::from(late);
             cpu.dedup();
             if c.shadow {

@@ -417,6 +417,7 @@ impl InstanceCuller {
                 record: *record,
                 instances: d.extracted.buffer.clone(),
                 occludes: o.late.is_some(),
+                pyramid: d.view.occluding.is_some(),
                 shadow: d.view.shadow,
                 far: d.part.far,
                 kept: o.kept..o.kept + d.bytes(),
