@@ -55,7 +55,8 @@ pub struct CullingReport {
     /// keeps and that cast nowhere the camera reads the cascade ([`crate::CascadeCasters`];
     /// the CPU's count).
     pub cascade_dropped: u64,
-    /// Culled draws in cascades that occlude (a light's `OcclusionCulling`).
+    /// Culled draws in cascades that occlude (a light's `OcclusionCulling`), counted as
+    /// [`occluding_draws`](Self::occluding_draws) counts them.
     pub cascade_occluding_draws: usize,
     /// Instances of those draws that the rest of the test keeps and the cascade's depth hid
     /// (neither phase kept them; the CPU's count less the GPU's).
@@ -197,6 +198,7 @@ pub(in crate::instancing) fn check_culling(
         report.far_draws += usize::from(c.far);
         report.instances += c.instances.instances.len() as u64;
         report.occluding_draws += usize::from(c.pyramid);
+        report.cascade_occluding_draws += usize::from(c.pyramid && c.shadow);
         report.gpu_kept += gpu.len() as u64;
         report.cpu_kept += cpu.len() as u64;
         if c.occludes {
@@ -204,7 +206,6 @@ pub(in crate::instancing) fn check_culling(
             report.late_kept += u64::from(late);
             cpu.dedup();
             if c.shadow {
-                report.cascade_occluding_draws += 1;
                 report.cascade_occluded += cpu.len().saturating_sub(gpu.len()) as u64;
             }
             report.mismatched += usize::from(gpu.iter().any(|g| cpu.binary_search(g).is_err()));

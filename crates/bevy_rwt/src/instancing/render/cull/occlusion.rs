@@ -188,22 +188,23 @@ impl LateWork {
     }
 }
 
-/// What one view's late phase needs this frame: its work, its pipeline and pyramid.
-struct LateFrame<'a> {
-    work: &'a LateWork,
-    bind_group: &'a BindGroup,
+/// What every view's late phase shares this frame: the pipeline and the frame's bind group.
+struct LatePhase<'a> {
     pipeline: &'a ComputePipeline,
-    pyramid: &'a BindGroup,
+    bind_group: &'a BindGroup,
 }
 
 impl InstanceCuller {
-    fn late_frame<'a>(&'a self, view: Entity, cache: &'a PipelineCache) -> Option<LateFrame<'a>> {
-        Some(LateFrame {
-            work: self.late.get(&view)?,
-            bind_group: &self.bind.as_ref()?.bind_group,
+    fn late_phase<'a>(&'a self, cache: &'a PipelineCache) -> Option<LatePhase<'a>> {
+        Some(LatePhase {
             pipeline: cache.get_compute_pipeline(self.pipeline?)?,
-            pyramid: self.pyramids.bind_group(view)?,
+            bind_group: &self.bind.as_ref()?.bind_group,
         })
+    }
+
+    /// One view's late work this frame and the pyramid it tests against.
+    fn late_work(&self, view: Entity) -> Option<(&LateWork, &BindGroup)> {
+        Some((self.late.get(&view)?, self.pyramids.bind_group(view)?))
     }
 }
 
@@ -219,13 +220,13 @@ pub(in crate::instancing) fn cull_late(
     let Some(culler) = culler else { return };
     let (camera, cascades) = view.into_inner();
     let cascades = cascades.map(|c| c.0.as_slice()).unwrap_or_default();
-    let frames: Vec<LateFrame> = std::iter::once(&camera)
+    let views: Vec<_> = std::iter::once(&camera)
         .chain(cascades)
-        .filter_map(|&view| culler.late_frame(view, &cache))
+        .filter_map(|&view| culler.late_work(view))
         .collect();
-    if frames.is_empty() {
+    let Some(phase) = culler.late_phase(&cache).filter(|_| !views.is_empty()) else {
         return;
-    }
+    };
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
     let mut pass = ctx
@@ -235,12 +236,11 @@ pub(in crate::instancing) fn cull_late(
             timestamp_writes: None,
         });
     let span = diagnostics.pass_span(&mut pass, "rwt_cull_late");
-    for late in frames {
-        pass.set_pipeline(late.pipeline);
-        pass.set_bind_group(1, late.pyramid, &[]);
-        let offsets = [late.work.params, late.work.pool as u32];
-        pass.set_bind_group(0, late.bind_group, &offsets);
-        let (x, y) = grid(late.work.workgroups);
+    pass.set_pipeline(phase.pipeline);
+    for (work, pyramid) in views {
+        pass.set_bind_group(1, pyramid, &[]);
+        pass.set_bind_group(0, phase.bind_group, &[work.params, work.pool as u32]);
+        let (x, y) = grid(work.workgroups);
         pass.dispatch_workgroups(x, y, 1);
     }
     span.end(&mut pass);
