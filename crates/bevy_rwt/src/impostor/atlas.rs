@@ -1,7 +1,7 @@
 //! The atlas a bake fills: its texels before encoding, one level of it (both halves), the
 //! mip chain that keeps a cut-out's coverage, and the sRGB image with its sampler.
 
-use super::bake::ImpostorFrames;
+use super::frames::ImpostorFrames;
 use bevy::asset::RenderAssetUsages;
 use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler, ImageSamplerDescriptor};
 use bevy::prelude::*;

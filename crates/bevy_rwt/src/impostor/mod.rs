@@ -12,6 +12,7 @@
 
 mod atlas;
 pub mod bake;
+mod frames;
 
 pub use bake::{BakeError, BakedImpostor, ImpostorFrames};
 

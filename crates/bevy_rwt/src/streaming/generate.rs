@@ -3,15 +3,18 @@
 //! chunk's per-instance edits and footprints. Generation tasks make them so, and picking
 //! makes them again for the chunks a ray crosses.
 
-use super::keep_out::Clearing;
+use super::discs::Discs;
 use super::resolve::Sources;
 use crate::edits::{Edit, EditSet};
 use crate::footprints::GroundFootprint;
 use crate::ground::{GroundRule, GroundSettings, Stands};
 use crate::layers::{ScatterLayer, SharedDensity};
+use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
+use glam::DVec2;
 use rwt_core::density::Scale;
 use rwt_core::query::{Point, QueryError, Rect, Sampler};
+use rwt_core::streaming::ChunkCoord;
 use std::sync::Arc;
 
 /// What a game changed in a chunk: its per-instance edits and the footprints over it.
@@ -154,5 +157,48 @@ impl Changes {
         self.edits
             .as_ref()
             .is_some_and(|e| e.iter().any(|(_, edit)| matches!(edit, Edit::Reclass(_))))
+    }
+}
+
+/// Another layer's points as they clear a layer ([`keep_out`](super::keep_out)): how
+/// they are generated and edited.
+#[derive(Clone)]
+pub(crate) struct Clearing {
+    pub generator: Generator,
+    /// Per class of the other layer: how far its instances clear.
+    pub radii: Arc<[f32]>,
+    /// The other layer's chunk size and edits by chunk.
+    pub chunk_size: f64,
+    pub edits: HashMap<ChunkCoord, Arc<EditSet>>,
+}
+
+impl Clearing {
+    /// The largest radius an instance of the other layer clears.
+    pub fn reach(&self) -> f64 {
+        self.radii.iter().fold(0.0f32, |m, r| m.max(*r)) as f64
+    }
+
+    /// Removes from `out` (the points of `rect`) every point within reach of an instance
+    /// of the other layer.
+    pub fn clear(&self, rect: Rect, out: &mut Vec<Point>) -> Result<(), QueryError> {
+        let reach = self.reach();
+        if reach <= 0.0 || out.is_empty() {
+            return Ok(());
+        }
+        let grown = Rect::new(
+            rect.min() - DVec2::splat(reach),
+            rect.max() + DVec2::splat(reach),
+        )
+        .unwrap_or(rect);
+        let g = &self.generator;
+        let mut others = g.points(grown, &g.scaled(1.0, None), &Changes::default())?;
+        for (chunk, set) in &self.edits {
+            if chunk.rect(self.chunk_size).overlaps(&grown) {
+                g.edit(set, &mut others);
+            }
+        }
+        let discs = Discs::new(&others, &self.radii, reach);
+        out.retain(|p| !discs.covers(p.position));
+        Ok(())
     }
 }

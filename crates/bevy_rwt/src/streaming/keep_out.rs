@@ -6,95 +6,15 @@
 //! An edit of the other layer (a tree removed) generates again the chunks within reach.
 
 use super::LayerState;
-use super::generate::{Changes, Generator};
+use super::generate::{Clearing, Generator};
 use crate::edits::EditSet;
 use crate::layers::{KeepOut, LayerRef, ScatterLayer};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use glam::DVec2;
-use rwt_core::query::{Point, QueryError, Rect};
+use rwt_core::query::Rect;
 use rwt_core::streaming::ChunkCoord;
 use std::sync::Arc;
-
-/// Another layer's points as they clear a layer: how they are generated and edited.
-#[derive(Clone)]
-pub(crate) struct Clearing {
-    generator: Generator,
-    /// Per class of the other layer: how far its instances clear.
-    radii: Arc<[f32]>,
-    /// The other layer's chunk size and edits by chunk.
-    chunk_size: f64,
-    edits: HashMap<ChunkCoord, Arc<EditSet>>,
-}
-
-impl Clearing {
-    fn reach(&self) -> f64 {
-        self.radii.iter().fold(0.0f32, |m, r| m.max(*r)) as f64
-    }
-
-    /// Removes from `out` (the points of `rect`) every point within reach of an instance
-    /// of the other layer.
-    pub fn clear(&self, rect: Rect, out: &mut Vec<Point>) -> Result<(), QueryError> {
-        let reach = self.reach();
-        if reach <= 0.0 || out.is_empty() {
-            return Ok(());
-        }
-        let grown = Rect::new(
-            rect.min() - DVec2::splat(reach),
-            rect.max() + DVec2::splat(reach),
-        )
-        .unwrap_or(rect);
-        let g = &self.generator;
-        let mut others = g.points(grown, &g.scaled(1.0, None), &Changes::default())?;
-        for (chunk, set) in &self.edits {
-            if chunk.rect(self.chunk_size).overlaps(&grown) {
-                g.edit(set, &mut others);
-            }
-        }
-        let discs = Discs::new(&others, &self.radii, reach);
-        out.retain(|p| !discs.covers(p.position));
-        Ok(())
-    }
-}
-
-/// The other layer's instances as discs, bucketed by a grid of the largest radius.
-struct Discs {
-    cell: f64,
-    buckets: HashMap<(i64, i64), Vec<(DVec2, f64)>>,
-}
-
-impl Discs {
-    fn new(points: &[Point], radii: &[f32], reach: f64) -> Self {
-        let mut buckets: HashMap<(i64, i64), Vec<(DVec2, f64)>> = HashMap::new();
-        for p in points {
-            let r = radii.get(p.class as usize).copied().unwrap_or(0.0) as f64;
-            if r > 0.0 {
-                let key = Self::key(p.position, reach);
-                buckets.entry(key).or_default().push((p.position, r * r));
-            }
-        }
-        Self {
-            cell: reach,
-            buckets,
-        }
-    }
-
-    fn key(p: DVec2, cell: f64) -> (i64, i64) {
-        ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64)
-    }
-
-    /// Whether `p` lies strictly within a disc.
-    fn covers(&self, p: DVec2) -> bool {
-        let (x, y) = Self::key(p, self.cell);
-        (x - 1..=x + 1).any(|i| {
-            (y - 1..=y + 1).any(|j| {
-                self.buckets
-                    .get(&(i, j))
-                    .is_some_and(|discs| discs.iter().any(|(c, r2)| c.distance_squared(p) < *r2))
-            })
-        })
-    }
-}
 
 /// What a layer's keep-out needs of every layer: how its points are made and its edits.
 struct Source {

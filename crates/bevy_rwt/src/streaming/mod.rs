@@ -11,6 +11,7 @@
 //! - `repaint`: painted maps mark the chunks they cover stale.
 
 mod collect;
+mod discs;
 mod edit;
 mod footprint;
 mod generate;
@@ -167,7 +168,7 @@ pub(crate) struct LayerState {
     refusal_logged: bool,
     /// The layers that clear this one, as its tasks generate with them; `None` while one
     /// of them is not ready.
-    keep_out: Option<Arc<[keep_out::Clearing]>>,
+    keep_out: Option<Arc<[generate::Clearing]>>,
 }
 
 impl LayerState {
@@ -190,7 +191,7 @@ impl LayerState {
 
     /// The layers that clear this one, as its tasks generate with them; `None` while one
     /// of the layers it names is not ready.
-    fn keep_out_for(&self, layer: &ScatterLayer) -> Option<Arc<[keep_out::Clearing]>> {
+    fn keep_out_for(&self, layer: &ScatterLayer) -> Option<Arc<[generate::Clearing]>> {
         match &self.keep_out {
             Some(k) => Some(k.clone()),
             None => layer.keep_out.is_empty().then(|| Arc::from([])),
