@@ -444,11 +444,11 @@ fn owns_edge(vertices: &[Vec3], i: u32, j: u32, counter_clockwise: bool) -> bool
 
 /// The max/min pyramid of cell bounds, down to one block.
 fn pyramid(base: Vec<CellBounds>, dims: UVec2) -> Vec<Vec<CellBounds>> {
-    let mut levels = vec![base];
+    let mut levels = Vec::new();
+    let mut prev = base;
     let mut size = dims;
     while size.x > 1 || size.y > 1 {
         let next = (size + 1) / 2;
-        let prev = levels.last().expect("non-empty");
         let mut out = vec![CellBounds::EMPTY; (next.x * next.y) as usize];
         for y in 0..size.y {
             for x in 0..size.x {
@@ -456,8 +456,9 @@ fn pyramid(base: Vec<CellBounds>, dims: UVec2) -> Vec<Vec<CellBounds>> {
                 out[at] = out[at].union(prev[(y * size.x + x) as usize]);
             }
         }
-        levels.push(out);
+        levels.push(std::mem::replace(&mut prev, out));
         size = next;
     }
+    levels.push(prev);
     levels
 }

@@ -31,7 +31,9 @@ pub(super) fn collect_results(
             }
         }
         for (chunk, band, result) in finished {
-            let c = state.states.get_mut(&chunk).expect("finished chunks exist");
+            let Some(c) = state.states.get_mut(&chunk) else {
+                continue;
+            };
             let ChunkContent {
                 mut points,
                 packed,

@@ -148,7 +148,9 @@ fn start_tasks(job: &Job, state: &mut LayerState, viewers: &[Viewer], free: usiz
                 .footprints
                 .clearing(job.entity, layer.plane, &chunk.rect(size)),
         };
-        let c = state.states.get_mut(&chunk).expect("listed above");
+        let Some(c) = state.states.get_mut(&chunk) else {
+            continue;
+        };
         c.stale = false;
         c.task_regrounds = std::mem::take(&mut c.reground);
         c.task = Some((start_task(job, chunk, band, changes), band));

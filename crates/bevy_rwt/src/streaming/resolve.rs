@@ -37,8 +37,11 @@ fn snapshot(
     if let Some(d) = density.resolve(images) {
         return Ok(d);
     }
-    let image = density.image().expect("only image densities wait");
-    Err(unreadable(image, images, server))
+    // Only an image density waits; any other resolves at once.
+    Err(match density.image() {
+        Some(image) => unreadable(image, images, server),
+        None => AssetStatus::Waiting(Vec::new()),
+    })
 }
 
 /// Why an image that a layer reads gives no snapshot: loading, failed, or not readable.
@@ -137,12 +140,10 @@ impl Resolved {
             return Err(merge_missing(missing));
         }
         if self.combined.is_none() {
-            self.combined = Some(self.densities());
+            self.combined = self.densities();
         }
-        Ok(Sources {
-            densities: self.combined.clone().expect("made above"),
-            ground: self.ground.clone().expect("made above"),
-        })
+        // With nothing missing, every snapshot is there.
+        self.ready().ok_or(AssetStatus::Waiting(Vec::new()))
     }
 
     /// The task inputs as last made (`None` until every snapshot is there).
@@ -165,12 +166,14 @@ impl Resolved {
         }
     }
 
-    /// Every class's density with the exclusion mask applied.
-    fn densities(&self) -> Vec<SharedDensity> {
-        let classes = self.classes.iter().map(|c| c.clone().expect("made above"));
-        match &self.exclusion {
-            None => classes.collect(),
+    /// Every class's density with the exclusion mask applied, once every class has its
+    /// snapshot.
+    fn densities(&self) -> Option<Vec<SharedDensity>> {
+        let classes: Vec<SharedDensity> = self.classes.iter().cloned().collect::<Option<_>>()?;
+        Some(match &self.exclusion {
+            None => classes,
             Some(mask) => classes
+                .into_iter()
                 .map(|inner| {
                     Arc::new(Exclude {
                         inner,
@@ -179,6 +182,6 @@ impl Resolved {
                     }) as SharedDensity
                 })
                 .collect(),
-        }
+        })
     }
 }

@@ -196,14 +196,15 @@ impl SurfaceMeshes {
 
     /// Takes the builds that finished: their old and new rectangles changed.
     fn collect_builds(&mut self, changed: &mut Changed) {
-        let finished: Vec<Key> = self
+        let finished: Vec<_> = self
             .building
-            .iter_mut()
-            .filter_map(|(k, (_, task))| task.is_finished().then_some(*k))
+            .extract_if(|_, (_, task)| task.is_finished())
             .collect();
-        for key in finished {
-            let (source, task) = self.building.remove(&key).expect("listed above");
-            let result = block_on(future::poll_once(task)).expect("finished");
+        for (key, (source, task)) in finished {
+            // A finished task is ready at its first poll.
+            let Some(result) = block_on(future::poll_once(task)) else {
+                continue;
+            };
             if let Some((_, old)) = self.built.remove(&key) {
                 changed.extend(rect_of(&old).map(|r| (key.1, r)));
             }
