@@ -1,5 +1,6 @@
-//! Imports point one way: no two top-level modules of a crate import each other (what
-//! docs/ARCHITECTURE.md promises for every crate).
+//! Imports point one way: no two top-level modules of a crate import each other, nor two
+//! sibling files or folders at any depth (what docs/ARCHITECTURE.md promises for every
+//! crate); the instanced renderer's `mod.rs` files declare, document and re-export only.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -132,4 +133,198 @@ fn imports_are_read_from_paths_and_groups() {
     let names: Vec<String> = named_modules(uses).into_iter().collect();
     assert_eq!(names, ["a", "b", "c", "f", "h"]);
     assert!(named_modules(&code("// crate::z\n#[cfg(test)]\nuse crate::t;")).is_empty());
+}
+
+/// A file's code with its inline test module (`#[cfg(test)] mod tests { .. }`, at the end
+/// by convention) and comment lines left out; declarations such as `#[cfg(test)] mod x;`
+/// stay, as does what follows them.
+fn code_outside_tests(text: &str) -> String {
+    let text = text.split("#[cfg(test)]\nmod tests {").next().unwrap_or("");
+    text.lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The module path of a file under `src` (`a/b/mod.rs` and `a/b.rs` are both `a::b`).
+fn module_path(src: &Path, file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix(src).unwrap();
+    let mut parts: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    let last = parts.pop().unwrap_or_default();
+    if !matches!(last.as_str(), "mod.rs" | "lib.rs" | "main.rs") {
+        parts.push(last.trim_end_matches(".rs").to_string());
+    }
+    parts
+}
+
+/// The identifiers of a path from `text` on: `a::b::c`, or `a::{b, c::d}` (the group's
+/// top-level names each appended).
+fn paths_from(text: &str) -> Vec<Vec<String>> {
+    let mut prefix = Vec::new();
+    let mut rest = text;
+    loop {
+        let ident = ident_at(rest);
+        if ident.is_empty() {
+            break;
+        }
+        prefix.push(ident.to_string());
+        rest = rest.trim_start()[ident.len()..].trim_start();
+        match rest.strip_prefix("::") {
+            Some(after) => rest = after.trim_start(),
+            None => return vec![prefix],
+        }
+    }
+    let Some(group) = rest.strip_prefix(OPEN) else {
+        return vec![prefix];
+    };
+    // The group alone, to its closing brace.
+    let mut depth = 0;
+    let end = group
+        .char_indices()
+        .find(|&(_, c)| {
+            match c {
+                OPEN => depth += 1,
+                CLOSE if depth == 0 => return true,
+                CLOSE => depth -= 1,
+                _ => {}
+            }
+            false
+        })
+        .map_or(group.len(), |(i, _)| i);
+    named_modules(&format!("crate::{{{}}}", &group[..end]))
+        .into_iter()
+        .map(|n| prefix.iter().cloned().chain([n]).collect())
+        .collect()
+}
+
+/// The module paths a file at `module` names through `crate::`, `super::` and `self::`,
+/// resolved from the crate's root.
+fn resolved_paths(code: &str, module: &[String]) -> Vec<Vec<String>> {
+    let mut out = Vec::new();
+    for start in ["crate::", "super::", "self::"] {
+        for (i, _) in code.match_indices(start) {
+            let before = code[..i].chars().next_back().unwrap_or(' ');
+            if before.is_alphanumeric() || before == '_' || before == ':' {
+                continue;
+            }
+            for path in paths_from(&code[i..]) {
+                let mut base: Vec<String> = module.to_vec();
+                let mut segments = path.into_iter().peekable();
+                match segments.peek().map(String::as_str) {
+                    Some("crate") => {
+                        base.clear();
+                        segments.next();
+                    }
+                    _ => {
+                        while let Some(s) = segments.next_if(|s| s == "super" || s == "self") {
+                            if s == "super" {
+                                base.pop();
+                            }
+                        }
+                    }
+                }
+                base.extend(segments);
+                out.push(base);
+            }
+        }
+    }
+    out
+}
+
+/// Each module (file or folder) of the crate at `src` and the sibling modules it imports:
+/// a file's import of another module counts for the two siblings under their nearest
+/// common parent.
+fn sibling_arrows(src: &Path) -> BTreeSet<(Vec<String>, Vec<String>)> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    let is_module = |m: &[String]| {
+        let path: PathBuf = m.iter().collect();
+        src.join(&path).is_dir() || src.join(path).with_extension("rs").is_file()
+    };
+    let mut arrows = BTreeSet::new();
+    for file in &files {
+        let module = module_path(src, file);
+        let code = code_outside_tests(&fs::read_to_string(file).unwrap());
+        for target in resolved_paths(&code, &module) {
+            let common = module
+                .iter()
+                .zip(&target)
+                .take_while(|(a, b)| a == b)
+                .count();
+            if common >= module.len() || common >= target.len() {
+                continue;
+            }
+            let from = module[..=common].to_vec();
+            let to = target[..=common].to_vec();
+            if is_module(&to) {
+                arrows.insert((from, to));
+            }
+        }
+    }
+    arrows
+}
+
+#[test]
+fn no_two_sibling_files_or_folders_import_each_other() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut pairs = Vec::new();
+    for krate in CRATES {
+        let arrows = sibling_arrows(&root.join(krate));
+        for (a, b) in &arrows {
+            if a < b && arrows.contains(&(b.clone(), a.clone())) {
+                pairs.push(format!("{krate}: {} <-> {}", a.join("/"), b.join("/")));
+            }
+        }
+    }
+    assert!(pairs.is_empty(), "two-way imports:\n{}", pairs.join("\n"));
+}
+
+#[test]
+fn sibling_imports_are_resolved_from_super_and_crate_paths() {
+    let module: Vec<String> = ["x", "render", "draw"].map(String::from).into();
+    let code = "use super::{extract::A, prepare::B};\nuse crate::x::render::slab::C;\nuse super::super::chunk::D;";
+    let paths = resolved_paths(code, &module);
+    let joined: Vec<String> = paths.iter().map(|p| p.join("::")).collect();
+    assert_eq!(
+        joined,
+        [
+            "x::render::slab::C",
+            "x::render::extract",
+            "x::render::prepare",
+            "x::chunk::D"
+        ]
+    );
+}
+
+/// The instanced renderer's `mod.rs` files hold declarations, documentation and
+/// re-exports: every type and function lives in a leaf module of its stage.
+#[test]
+fn the_instanced_renderer_mod_files_define_nothing() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/bevy_rwt/src/instancing");
+    let mut files = Vec::new();
+    rust_files(&root, &mut files);
+    let item = [
+        "struct ", "enum ", "fn ", "impl", "type ", "const ", "static ", "trait ",
+    ];
+    let mut defined = Vec::new();
+    for file in files.iter().filter(|f| f.ends_with("mod.rs")) {
+        for line in code_outside_tests(&fs::read_to_string(file).unwrap()).lines() {
+            let bare = match line.strip_prefix("pub") {
+                Some(rest) => rest.trim_start_matches(|c| c != ' ').trim_start(),
+                None => line,
+            };
+            if item.iter().any(|k| bare.starts_with(k)) {
+                defined.push(format!("{}: {line}", file.display()));
+            }
+        }
+    }
+    assert!(files.len() > 20, "{} files", files.len());
+    assert!(
+        defined.is_empty(),
+        "items in mod.rs:\n{}",
+        defined.join("\n")
+    );
 }

@@ -12,6 +12,7 @@
 //! the main camera do not bend.
 
 use bevy::prelude::*;
+use bevy::render::extract_resource::ExtractResource;
 
 /// Texels along each side of the bend field.
 pub const BEND_FIELD_TEXELS: u32 = 128;
@@ -42,7 +43,7 @@ impl Default for Bender {
 
 /// How far blades lean around the main camera: per texel a lean vector on the ground
 /// (x, z), its length 0..1 (1 lays a blade flat), pointing the way the blade falls.
-#[derive(Resource, Clone, Debug, Reflect)]
+#[derive(Resource, ExtractResource, Clone, Debug, Reflect)]
 #[reflect(Resource, Clone, Debug)]
 pub struct BendField {
     /// Ground position (x, z) of the field's min corner, a multiple of [`BEND_TEXEL`].

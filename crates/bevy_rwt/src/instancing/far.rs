@@ -1,7 +1,8 @@
 //! The far level of detail of instanced classes: each chunk draws its class's far mesh
 //! while its bounds lie farther than the class's distance from every camera.
 
-use super::{InstancedChunk, InstancedMeshes, distance_to_box};
+use super::chunk::{InstancedChunk, distance_to_box};
+use super::mesh::InstancedMeshes;
 use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
 

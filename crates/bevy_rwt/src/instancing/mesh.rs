@@ -1,7 +1,7 @@
 //! What the instanced path needs of a class's mesh, checked once per mesh (and again when it
 //! changes): its bounds for culling and fading, or the reason it cannot be drawn.
 
-use super::InstancedChunk;
+use super::chunk::InstancedChunk;
 use crate::layers::{ScatterLayer, ScatterLayerStatus};
 use crate::look::{
     ClassLook, GroundPlane, InstancedClassError, InstancedFar, InstancedLook, check_instanced_mesh,

@@ -1,7 +1,7 @@
 //! Packing a chunk's points of instanced classes into GPU-ready buffers, in the generation
 //! task (off the main thread).
 
-use super::{GpuInstance, InstanceBuffer};
+use super::chunk::{GpuInstance, InstanceBuffer};
 use crate::ground::{GroundRule, Stands, SurfaceHit};
 use crate::layers::ScatterLayer;
 use crate::look::{ClassLook, GroundPlane, Pose, Stance};

@@ -1,11 +1,11 @@
 //! The instancing feature plugin: the wind resource, and the render-world systems that draw
 //! every [`InstancedChunk`] with one instanced draw.
 
-use super::{
-    BendField, Bender, CascadeCasters, InstanceCulling, InstancedChunk, InstancedMeshes, RwtFadeIn,
-    RwtWind,
-};
-use super::{bend, far, mesh, render};
+use super::bend::{self, BendField, Bender};
+use super::chunk::InstancedChunk;
+use super::mesh::{self, InstancedMeshes};
+use super::settings::{CascadeCasters, InstanceCulling, RwtFadeIn, RwtWind};
+use super::{far, render};
 use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use bevy::core_pipeline::core_3d::Opaque3d;
 use bevy::core_pipeline::mip_generation::experimental::depth::early_downsample_depth;
@@ -89,6 +89,7 @@ fn build_render(app: &mut App) {
     #[cfg(feature = "testing")]
     app.sub_app_mut(RenderApp)
         .init_resource::<render::FrameCheck>()
+        .init_resource::<render::CullSnapshot>()
         .add_systems(ExtractSchedule, render::extract_culling_check)
         .add_systems(
             Render,

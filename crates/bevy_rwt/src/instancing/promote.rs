@@ -4,8 +4,8 @@
 //! instance), and go back beyond it. The buffer change and the entity are commands of one
 //! system, applied together: no frame draws an instance twice or misses it.
 
+use super::chunk::{GpuInstance, InstanceBuffer};
 use super::queue::{ClassBuffer, InstancedQueue, Target, Upload};
-use super::{GpuInstance, InstanceBuffer};
 use crate::layers::{Promotion, ScatterEntity, ScatterLayer};
 use bevy::prelude::*;
 use glam::DVec2;

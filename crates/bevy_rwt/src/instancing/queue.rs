@@ -4,7 +4,9 @@
 //! Instances of a promoted class near a viewer are held by entities instead
 //! ([`super::promote`]); the chunk's buffer draws the others.
 
-use super::{ImpostorDraw, InstanceBuffer, InstancedChunk, InstancedMeshes, PackedClass, pack};
+use super::chunk::{ImpostorDraw, InstanceBuffer, InstancedChunk};
+use super::mesh::InstancedMeshes;
+use super::pack::{self, PackedClass};
 use crate::impostor::{ImpostorAtlas, ImpostorAtlases};
 use crate::layers::ScatterClass;
 use crate::layers::ScatterLayer;

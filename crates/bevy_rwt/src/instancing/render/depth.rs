@@ -5,13 +5,13 @@
 //! written: under a deferred camera chunks are drawn forward.
 
 use super::draw::{DrawChunkInstances, SetChunkBindGroup};
+use super::extract::{ClassFeatures, ExtractedChunk};
 use super::main_pass::{mesh_attributes, mesh_bin};
+use super::pipelines::{ChunkPipelines, instance_layout};
+use super::prepare::{ChunkBindings, MainViewer};
 use super::receivers::CascadeReceivers;
-use super::{
-    ChunkBindings, ChunkPipelines, ClassFeatures, ExtractedChunk, MainViewer, Queued,
-    instance_layout, rebin_cameras,
-};
-use crate::instancing::distance_to_box;
+use super::retained::{Queued, rebin_cameras};
+use crate::instancing::chunk::distance_to_box;
 use crate::look::InstancedShadows;
 use bevy::camera::primitives::{Aabb, Frustum};
 use bevy::camera::visibility::RenderLayers;

@@ -1,8 +1,8 @@
 //! Extraction by change: a chunk is extracted again when it, its transform or its bounds
 //! changed, and otherwise keeps last frame's extraction in the render world.
 
-use super::ExtractedChunk;
-use crate::instancing::{InstanceBuffer, InstancedChunk};
+use super::extract::ExtractedChunk;
+use crate::instancing::chunk::{InstanceBuffer, InstancedChunk};
 use crate::look::InstancedShading;
 use bevy::camera::primitives::Aabb;
 use bevy::ecs::change_detection::Tick;

@@ -1,10 +1,10 @@
 //! The main pass: chunks in the opaque 3-D phase, lit by Bevy's PBR lighting.
 
 use super::draw::DrawInstancedChunk;
-use super::{
-    ChunkBindings, ChunkPipelines, ClassFeatures, ExtractedChunk, Queued, instance_layout,
-    rebin_cameras,
-};
+use super::extract::{ClassFeatures, ExtractedChunk};
+use super::pipelines::{ChunkPipelines, instance_layout};
+use super::prepare::ChunkBindings;
+use super::retained::{Queued, rebin_cameras};
 use bevy::asset::UntypedAssetId;
 use bevy::core_pipeline::core_3d::{Opaque3d, Opaque3dBatchSetKey, Opaque3dBinKey};
 use bevy::mesh::{MeshVertexBufferLayoutRef, VertexAttributeDescriptor};

@@ -12,7 +12,7 @@
 //! its half-spaces casts nothing a fragment reads from the cascade. The test is per
 //! half-space, so it keeps some instances it could drop, never drops one it needs.
 
-use crate::instancing::CascadeCasters;
+use crate::instancing::settings::CascadeCasters;
 use bevy::camera::primitives::{Aabb, Frustum};
 use bevy::light::CascadeShadowConfig;
 use bevy::math::primitives::ViewFrustum;

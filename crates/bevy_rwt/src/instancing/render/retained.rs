@@ -5,13 +5,15 @@
 //! bin; a new one is added; and the chunks the view showed last frame and no longer shows
 //! (culled, unloaded) are taken out.
 
+use crate::instancing::chunk::InstancedChunk;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::render_phase::{
     BinnedPhaseItem, BinnedRenderPhase, BinnedRenderPhaseType, InputUniformIndex,
+    ViewBinnedRenderPhases,
 };
 use bevy::render::sync_world::{MainEntity, MainEntityHashMap};
-use bevy::render::view::RetainedViewEntity;
+use bevy::render::view::{ExtractedView, RenderVisibleEntities, RetainedViewEntity};
 
 /// One phase item of a chunk: its batch set and bin keys, and its render and main entity.
 pub(super) type BinnedChunk<P> = (
@@ -143,6 +145,34 @@ impl<P: BinnedPhaseItem> Queued<P> {
             .map(|(batch_set, bin, entities)| ((batch_set, bin), entities));
         self.0.rebin(view, phase, items)
     }
+}
+
+/// Bins into each camera view's phase the chunks its CPU culling kept (by their `Aabb`)
+/// that `item` makes an item of under the view's key (`key_of`; none binned while a view
+/// has no key), and takes out what the views no longer show.
+pub(super) fn rebin_cameras<P: BinnedPhaseItem, K: Copy>(
+    phases: &mut ViewBinnedRenderPhases<P>,
+    queued: &mut Queued<P>,
+    views: &Query<(&ExtractedView, &RenderVisibleEntities)>,
+    key_of: impl Fn(&RetainedViewEntity) -> Option<K>,
+    mut item: impl FnMut(K, Entity, MainEntity) -> Option<BinnedChunk<P>>,
+) {
+    for (view, visible) in views {
+        let Some(phase) = phases.get_mut(&view.retained_view_entity) else {
+            continue;
+        };
+        let key = key_of(&view.retained_view_entity);
+        let visible = visible
+            .get::<InstancedChunk>()
+            .map(|v| v.entities_cpu_culling.as_slice())
+            .unwrap_or_default();
+        let items: Vec<_> = visible
+            .iter()
+            .filter_map(|&(entity, main_entity)| item(key?, entity, main_entity))
+            .collect();
+        queued.rebin_phase(view.retained_view_entity, phase, items);
+    }
+    queued.end_frame();
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! builds), and its uniform structs' layouts against the Rust structs that fill them.
 
 use super::uniforms::LodUniform;
-use super::{ChunkUniform, FrameUniform};
+use super::uniforms::{ChunkUniform, FrameUniform};
 use bevy::asset::AssetId;
 use bevy::asset::uuid::Uuid;
 use bevy::math::{Vec2, Vec3, Vec4};

@@ -7,7 +7,7 @@
 //! whole. When the chunks hold a quarter of it or less (the camera left a dense area), it
 //! shrinks by halving, the chunks' ranges packed from the start.
 
-use crate::instancing::{GPU_BYTES_PER_INSTANCE, GpuInstance};
+use crate::instancing::chunk::{GPU_BYTES_PER_INSTANCE, GpuInstance};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::render_resource::*;

@@ -1,7 +1,7 @@
 //! The uniforms `instanced.wgsl` reads, as `ShaderType`s: laid out by encase, as WGSL lays
 //! out its `Chunk` and `Frame` structs (the naga check compares the two).
 
-use crate::instancing::ImpostorDraw;
+use crate::instancing::chunk::ImpostorDraw;
 use crate::look::InstancedShading;
 use bevy::prelude::*;
 use bevy::render::render_resource::ShaderType;

@@ -1,40 +1,22 @@
 //! How a frame's culling is laid out: each view's region of the pool of kept instances,
 //! each chunk's record in it (its ranges, marks and workgroups), and buffers large enough.
 
-#[cfg(feature = "testing")]
-use super::CullView;
-use super::{ARGS_WORDS, CullRecord, Dispatch, INSTANCE_BYTES, InstanceCuller, WORKGROUP};
+use super::culler::{
+    ARGS_WORDS, CulledDraw, CulledRange, INSTANCE_BYTES, InstanceCuller, ViewWork, WORKGROUP,
+};
+use super::entries::CullEntry;
+use super::params::{CullRecord, CullView};
 use crate::look::InstancedShadows;
 use bevy::prelude::*;
 use bevy::render::render_resource::*;
 use bevy::render::renderer::RenderDevice;
 use std::ops::Range;
 
-/// Where one chunk's data in a view lies: where it keeps its instances (bytes into the
-/// pool), its draw; and where its late phase keeps them, where the view occludes.
-pub(super) struct Offsets {
-    pub kept: u64,
-    pub draw: u32,
-    pub late: Option<u64>,
-}
-
-/// One view's early dispatch: its records, its workgroups, where its kept instances lie in
-/// the pool, its settings (their dynamic offset, and themselves for the check).
-pub(super) struct ViewWork {
-    pub entity: Entity,
-    pub records: Range<u32>,
-    pub workgroups: u32,
-    /// Byte offset of the view's binding of the pool.
-    pub pool: u64,
-    pub params: u32,
-    #[cfg(feature = "testing")]
-    pub params_value: CullView,
-}
-
-/// This frame's layout: each chunk's offsets in its view, each view's dispatch, the
-/// records, and the size every view's binding of the pool has.
+/// This frame's layout: each entry's culled draw (where its arguments and kept instances
+/// lie, in each phase), each view's dispatch, the records, and the size every view's
+/// binding of the pool has.
 pub(super) struct Plan {
-    pub offsets: Vec<Offsets>,
+    pub draws: Vec<CulledDraw>,
     pub early: Vec<ViewWork>,
     pub records: Vec<CullRecord>,
     pub pool_binding: u64,
@@ -46,40 +28,32 @@ impl InstanceCuller {
     /// range), each chunk's marks and workgroups, and makes the buffers large enough;
     /// `None` when a view's region would pass one binding or the pool the device's largest
     /// buffer (the frame draws directly).
-    pub(super) fn lay_out(
-        &mut self,
-        dispatches: &[Dispatch],
-        device: &RenderDevice,
-    ) -> Option<Plan> {
+    pub(super) fn lay_out(&mut self, entries: &[CullEntry], device: &RenderDevice) -> Option<Plan> {
         let limits = device.limits();
         let align = u64::from(limits.min_storage_buffer_offset_alignment.max(4));
         let mut plan = Plan {
-            offsets: Vec::with_capacity(dispatches.len()),
+            draws: Vec::with_capacity(entries.len()),
             early: Vec::new(),
-            records: Vec::with_capacity(dispatches.len()),
+            records: Vec::with_capacity(entries.len()),
             pool_binding: 0,
         };
         let (mut end, mut marks, mut most) = (0u64, 0u32, 0u64);
         let mut first = 0;
-        while first < dispatches.len() {
-            let view = dispatches[first].view.entity;
-            let last = first + dispatches[first..].partition_point(|d| d.view.entity == view);
+        while first < entries.len() {
+            let view = entries[first].view.entity;
+            let last = first + entries[first..].partition_point(|d| d.view.entity == view);
             let pool = end.next_multiple_of(align);
-            let (region, work) =
-                self.lay_out_view(&dispatches[first..last], first as u32, pool, &mut marks);
-            let (offsets, records) = region;
-            let bytes = offsets
+            let draws = first as u32..entries.len() as u32;
+            let ((draws, records), work) =
+                self.lay_out_view(&entries[first..last], draws, pool, &mut marks);
+            let bytes = draws
                 .iter()
-                .zip(&dispatches[first..last])
-                .map(|(o, d)| {
-                    let range_end = o.late.unwrap_or(o.kept);
-                    range_end + d.bytes() - pool
-                })
+                .map(|d| d.late.as_ref().unwrap_or(&d.early).kept.end - pool)
                 .max()
                 .unwrap_or(0);
             most = most.max(bytes);
             end = pool + bytes;
-            plan.offsets.extend(offsets);
+            plan.draws.extend(draws);
             plan.records.extend(records);
             plan.early.push(work);
             first = last;
@@ -97,21 +71,22 @@ impl InstanceCuller {
             );
             return None;
         }
-        self.grow(dispatches.len() as u64, size, marks, device);
+        self.grow(entries.len() as u64, size, marks, device);
         Some(plan)
     }
 
-    /// Lays out one view's chunks (`dispatches`, the first of them the frame's draw
-    /// `first_draw`) from `pool` (bytes) on: their offsets and records, and the view's
+    /// Lays out one view's entries from `pool` (bytes) on, the first of them the frame's
+    /// draw `draws.start` of `draws.end`: their culled draws and records, and the view's
     /// dispatch (its settings written later).
     fn lay_out_view(
         &self,
-        dispatches: &[Dispatch],
-        first_draw: u32,
+        entries: &[CullEntry],
+        draws: Range<u32>,
         pool: u64,
         marks: &mut u32,
-    ) -> ((Vec<Offsets>, Vec<CullRecord>), ViewWork) {
-        let view = dispatches[0].view;
+    ) -> ((Vec<CulledDraw>, Vec<CullRecord>), ViewWork) {
+        let (first_draw, draw_count) = (draws.start, draws.end);
+        let view = entries[0].view;
         let occludes = view.occluding.is_some_and(|o| o.previous.is_some());
         let mut kept = 0u32;
         let mut place = |count: u32| {
@@ -119,7 +94,7 @@ impl InstanceCuller {
             kept += count;
             at
         };
-        let mut records: Vec<CullRecord> = dispatches
+        let mut records: Vec<CullRecord> = entries
             .iter()
             .map(|d| CullRecord {
                 kept: place(d.gpu.count),
@@ -127,35 +102,41 @@ impl InstanceCuller {
             })
             .collect();
         let mut workgroups = 0;
-        let mut offsets = Vec::with_capacity(dispatches.len());
-        for (i, (d, r)) in dispatches.iter().zip(&mut records).enumerate() {
+        let mut culled = Vec::with_capacity(entries.len());
+        for (i, (d, r)) in entries.iter().zip(&mut records).enumerate() {
             r.first_workgroup = workgroups;
             workgroups += d.gpu.count.div_ceil(WORKGROUP);
-            let at = |instance: u32| pool + u64::from(instance) * INSTANCE_BYTES;
+            let draw = first_draw + i as u32;
+            // The late block of arguments follows the early one, a draw each.
+            let range = |draw: u32, instance: u32| {
+                let at = pool + u64::from(instance) * INSTANCE_BYTES;
+                CulledRange {
+                    args: u64::from(draw * ARGS_WORDS * 4),
+                    kept: at..at + d.bytes(),
+                }
+            };
             let late = occludes.then(|| {
                 r.late_kept = place(d.gpu.count);
                 r.first_mark = *marks;
                 *marks += d.gpu.count.div_ceil(32);
-                at(r.late_kept)
+                range(draw_count + draw, r.late_kept)
             });
-            let draw = first_draw + i as u32;
             r.count_word = draw * ARGS_WORDS + 1;
-            offsets.push(Offsets {
-                kept: at(r.kept),
-                draw,
+            culled.push(CulledDraw {
+                mesh: d.part.mesh,
+                early: range(draw, r.kept),
                 late,
             });
         }
         let work = ViewWork {
             entity: view.entity,
-            records: first_draw..first_draw + dispatches.len() as u32,
+            records: first_draw..first_draw + entries.len() as u32,
             workgroups,
             pool,
             params: 0,
-            #[cfg(feature = "testing")]
-            params_value: CullView::default(),
+            settings: CullView::default(),
         };
-        ((offsets, records), work)
+        ((culled, records), work)
     }
 
     /// Grows the buffers for `draws` draws, a pool of `kept` bytes and `marks` words.
@@ -203,7 +184,7 @@ fn grow(
 
 /// A chunk's record in its view (of one of its meshes: the instances of its band), before
 /// its place in the pool and the arguments is known.
-pub(super) fn record(d: &Dispatch) -> CullRecord {
+pub(super) fn record(d: &CullEntry) -> CullRecord {
     let u = &d.gpu.uniform;
     let shadow_distance = match (d.view.shadow, d.extracted.shadows) {
         (true, InstancedShadows::Within(distance)) => distance,

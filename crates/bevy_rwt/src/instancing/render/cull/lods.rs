@@ -8,8 +8,8 @@
 //! The two meshes must draw under one pipeline (the same vertex layout, topology and index
 //! format), else the chunk keeps its own mesh whole, as the direct path draws it.
 
-use super::ViewCull;
-use crate::instancing::render::{ExtractedChunk, MeshLods};
+use super::views::ViewCulling;
+use crate::instancing::render::extract::{ExtractedChunk, MeshLods};
 use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
 use bevy::render::mesh::RenderMesh;
@@ -52,7 +52,7 @@ impl Part {
 /// The parts `chunk` draws in `view` (one or two): its own mesh whole, or where it may
 /// choose per instance, the near mesh nearer than the distance and the far mesh from it.
 pub(super) fn parts(
-    view: &ViewCull,
+    view: &ViewCulling,
     chunk: &ExtractedChunk,
     meshes: &RenderAssets<RenderMesh>,
 ) -> [Option<Part>; 2] {
@@ -87,7 +87,7 @@ fn split(lods: &MeshLods, bounds: &Aabb, fade_out_to: f32, eye: Vec3) -> [Option
 /// Whether `chunk` has instances on both sides of its class's far distance in `view`
 /// (so that culling, drawing each with its mesh, draws fewer vertices than the chunk
 /// drawn whole).
-pub(super) fn across(view: &ViewCull, chunk: &ExtractedChunk) -> bool {
+pub(super) fn across(view: &ViewCulling, chunk: &ExtractedChunk) -> bool {
     chunk.lods.is_some_and(|lods| {
         let (nearest, farthest) = distances(&chunk.bounds, view.eye);
         nearest < lods.distance && lods.distance <= farthest

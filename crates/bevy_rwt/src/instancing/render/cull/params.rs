@@ -2,7 +2,7 @@
 //! (for the check and the unit tests).
 
 #[cfg(any(test, feature = "testing"))]
-use crate::instancing::GpuInstance;
+use crate::instancing::chunk::GpuInstance;
 use crate::instancing::render::uniforms::LodUniform;
 use bevy::prelude::*;
 use bevy::render::render_resource::ShaderType;

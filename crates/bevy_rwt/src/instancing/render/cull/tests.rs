@@ -1,13 +1,16 @@
 //! The culling shader's layout, its keep rules on the CPU, and the reach it tests.
 
-use super::super::reach;
-use super::super::shader_check::{
+use super::culler::WORKGROUP;
+use super::params::{CullRecord, CullView};
+use crate::instancing::chunk::GpuInstance;
+use crate::instancing::render::extract::reach;
+use crate::instancing::render::shader_check::{
     Space, cache_with_fade, cache_with_fade_reading, mark, marked_layout, marked_lod, struct_layout,
 };
-use super::super::uniforms::LodUniform;
-use super::*;
+use crate::instancing::render::uniforms::LodUniform;
 use bevy::asset::uuid::Uuid;
 use bevy::camera::primitives::Aabb;
+use bevy::prelude::*;
 use bevy::shader::{Shader, ShaderCache, ShaderCacheSource};
 
 #[test]

@@ -5,7 +5,7 @@
 //! its crossfades, in a view that does not occlude, keeps every instance; it is drawn
 //! directly, with no dispatch, no uniform and no pool range (the same pixels, less work).
 
-use super::ViewCull;
+use super::views::ViewCulling;
 use crate::instancing::render::uniforms::ChunkUniform;
 use crate::look::InstancedShadows;
 use bevy::camera::primitives::Aabb;
@@ -14,7 +14,7 @@ use bevy::prelude::*;
 /// Whether culling may drop an instance of a chunk with `bounds` (world space, every root
 /// inside), the level of detail of `chunk` and `shadows` in `view`.
 pub(super) fn may_drop(
-    view: &ViewCull,
+    view: &ViewCulling,
     bounds: &Aabb,
     chunk: &ChunkUniform,
     shadows: InstancedShadows,
@@ -61,8 +61,8 @@ mod tests {
     use crate::instancing::render::uniforms::LodUniform;
 
     /// A camera at the origin looking down +x (x > 0, |z| < x, no far plane).
-    fn view() -> ViewCull {
-        ViewCull {
+    fn view() -> ViewCulling {
+        ViewCulling {
             entity: Entity::PLACEHOLDER,
             planes: looking_down_x(),
             eye: Vec3::ZERO,
@@ -118,7 +118,7 @@ mod tests {
         assert!(may_drop(&view(), &chunk(10.0, -2.0), &meshes, off));
         assert!(!may_drop(&view(), &chunk(5.0, -2.0), &meshes, off));
         // A shadow view drops what lies beyond the class's shadow distance.
-        let shadow = ViewCull {
+        let shadow = ViewCulling {
             shadow: true,
             ..view()
         };
@@ -127,7 +127,7 @@ mod tests {
         assert!(!may_drop(&shadow, &chunk(5.0, -2.0), &plain, within));
         assert!(!may_drop(&view(), &chunk(10.0, -2.0), &plain, within));
         // A cascade read up to 12 m ahead, lit from above: a chunk beyond is culled.
-        let cascade = ViewCull {
+        let cascade = ViewCulling {
             receivers: Some(Receivers {
                 planes: [
                     Vec4::W,

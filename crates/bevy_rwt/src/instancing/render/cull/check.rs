@@ -1,11 +1,15 @@
 //! The check of culling per instance against the CPU (feature `testing`): on request, the
 //! render world reads back a frame's indirect arguments and kept instances and compares,
 //! for every culled draw, the instances it draws with those the same test keeps on the CPU
-//! ([`CullingCheck`]).
+//! ([`CullingCheck`]). The culling pass publishes what it culled into a [`CullSnapshot`];
+//! the check reads that, nothing of the culler itself.
 
-use super::InstanceSlab;
-use super::cull::{ARGS_WORDS, CullRecord, CullView, InstanceCuller};
-use crate::instancing::InstanceBuffer;
+use super::culler::{ARGS_WORDS, CulledDraw, InstanceCuller};
+use super::entries::CullEntry;
+use super::params::{CullRecord, CullView};
+use crate::instancing::chunk::InstanceBuffer;
+use crate::instancing::render::slab::InstanceSlab;
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::render::Extract;
 use bevy::render::render_resource::*;
@@ -95,13 +99,6 @@ pub(in crate::instancing) struct FrameCheck {
     requested: bool,
 }
 
-impl FrameCheck {
-    /// Whether the frame being rendered is to be checked.
-    pub(super) fn requested(&self) -> bool {
-        self.requested
-    }
-}
-
 /// Takes this frame's request, if any.
 pub(in crate::instancing) fn extract_culling_check(
     source: Extract<Option<Res<CullingCheck>>>,
@@ -113,7 +110,7 @@ pub(in crate::instancing) fn extract_culling_check(
 
 /// One culled draw as the check sees it: its view's early dispatch, its record, the chunk's
 /// instances, whether its view occludes and is a light's.
-pub(super) struct Checked {
+struct Checked {
     pub view: CullView,
     pub record: CullRecord,
     pub instances: Arc<InstanceBuffer>,
@@ -129,11 +126,68 @@ pub(super) struct Checked {
     pub late: Option<Range<u64>>,
 }
 
+/// What the culling pass publishes for the check in a frame it was asked to: each culled
+/// draw, in the order of its arguments, and the buffers the GPU writes.
+#[derive(Resource, Default)]
+pub(in crate::instancing) struct CullSnapshot {
+    draws: Vec<Checked>,
+    args: Option<Buffer>,
+    kept: Option<Buffer>,
+}
+
+/// The culling pass's side of the check: the frame's request and the snapshot it fills.
+#[derive(SystemParam)]
+pub(in crate::instancing) struct Publish<'w> {
+    frame: Res<'w, FrameCheck>,
+    snapshot: ResMut<'w, CullSnapshot>,
+}
+
+impl Publish<'_> {
+    /// Forgets the last frame's snapshot.
+    pub(super) fn clear(&mut self) {
+        let snapshot = self.snapshot.as_mut();
+        snapshot.draws.clear();
+        snapshot.args = None;
+        snapshot.kept = None;
+    }
+
+    /// Publishes what culled each of this frame's draws (`entries`, laid out at
+    /// `offsets`), when the frame is to be checked.
+    pub(super) fn publish(
+        &mut self,
+        culler: &InstanceCuller,
+        entries: &[CullEntry],
+        draws: &[CulledDraw],
+    ) {
+        if !self.frame.requested {
+            return;
+        }
+        let snapshot = self.snapshot.as_mut();
+        let records = culler.records.get();
+        for ((d, draw), record) in entries.iter().zip(draws).zip(records) {
+            let view = culler.early.iter().find(|v| v.entity == d.view.entity);
+            snapshot.draws.push(Checked {
+                view: view.map(|v| v.settings).unwrap_or_default(),
+                record: *record,
+                instances: d.extracted.buffer.clone(),
+                occludes: draw.late.is_some(),
+                pyramid: d.view.occluding.is_some(),
+                shadow: d.view.shadow,
+                far: d.part.far,
+                kept: draw.early.kept.clone(),
+                late: draw.late.as_ref().map(|l| l.kept.clone()),
+            });
+        }
+        snapshot.args = culler.args.clone();
+        snapshot.kept = culler.kept.clone();
+    }
+}
+
 /// After the frame's work is submitted: reads the arguments and the kept instances back
 /// when a check was asked for and the frame culled per instance, and answers it.
 pub(in crate::instancing) fn check_culling(
     frame: Res<FrameCheck>,
-    culler: Res<InstanceCuller>,
+    snapshot: Res<CullSnapshot>,
     slab: Res<InstanceSlab>,
     device: Res<RenderDevice>,
     queue: Res<RenderQueue>,
@@ -141,7 +195,7 @@ pub(in crate::instancing) fn check_culling(
     let Some(check) = frame.check.as_ref().filter(|_| frame.requested) else {
         return;
     };
-    let (checked, Some(args), Some(kept)) = (culler.checked(), culler.args(), culler.kept_pool())
+    let (checked, Some(args), Some(kept)) = (&snapshot.draws, &snapshot.args, &snapshot.kept)
     else {
         // Nothing culled per instance this frame: the next frame that does is checked.
         check.request();
