@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The GPU benchmark (examples/gpu_bench.rs): open_world-like grass rendered headless at 1, 5
+# The GPU benchmark (examples/gpu_bench/main.rs): open_world-like grass rendered headless at 1, 5
 # and 10 M live blades, shadows off and on, one line per case:
 #   gpu-bench: blades=B shadows=S cull=C fps_median=F frame_ms_p95=P adapter=NAME
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds the Python package `rwt` (crates/rwt_py) into a fresh virtual environment with what
+# Builds the Python package `rwt-noise` (crates/rwt_py) into a fresh virtual environment with what
 # its tests need, and runs them: `scripts/python_env.sh [pytest args]`. The environment is
 # target/py-venv; `source target/py-venv/bin/activate` to use it afterwards.
 #   RWT_PY_KEEP=1 scripts/python_env.sh   # reuse the environment (only rebuild the package)

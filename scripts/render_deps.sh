@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what a headless real renderer needs (Xvfb and Mesa's lavapipe Vulkan driver),
-# only when missing. Used by scripts/smoke.sh and scripts/screenshots.sh.
+# only when missing. Used by scripts/smoke.sh (and its --docs screenshots).
 set -euo pipefail
 need=()
 command -v Xvfb >/dev/null || need+=(xvfb)

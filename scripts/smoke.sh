@@ -36,14 +36,17 @@ fi
 # The examples the runs need, once each.
 mapfile -t needed < <(printf '%s\n' "${runs[@]%%:*}" | sort -u)
 build=()
-for ex in "${needed[@]}"; do build+=(--example "$ex"); done
+# quickstart is the game a user copies, with nothing but bevy and bevy_rwt: its check runs
+# the same systems under the harness (examples/quickstart_check.rs).
+binary() { if [ "$1" = quickstart ]; then echo quickstart_check; else echo "$1"; fi; }
+for ex in "${needed[@]}"; do build+=(--example "$(binary "$ex")"); done
 if [ $docs = 1 ]; then
     cargo build --release "${build[@]}"
     bin=target/release/examples
 else
     # The binaries `cargo test --workspace` builds (CI's test stage): one build with the
     # workspace's features, not a second one with the examples' own (`cargo build
-    # --example` unifies features over fewer packages and rebuilds much of Bevy).
+    # --example NAME` unifies features over fewer packages and rebuilds much of Bevy).
     cargo test --workspace --no-run
     bin=target/debug/examples
 fi
@@ -66,7 +69,7 @@ failed=0
 # Runs example $ex (log $name) that checks itself: $1 (VAR=folder) names where it saves its
 # screenshots; it passes when it printed `$2: $3...` and no `$2: FAIL` or ERROR line.
 self_checked() {
-    env "$1" timeout 1200 "$bin/$ex" >"$out/$name.log" 2>&1 || true
+    env "$1" timeout 1200 "$bin/$(binary "$ex")" >"$out/$name.log" 2>&1 || true
     line=$(grep -E "^$2: $3" "$out/$name.log" || true)
     echo "$name: ${line:-no result line}, $(( $(date +%s) - start )) s"
     if [ -z "$line" ] || grep -qE "^$2: FAIL|ERROR" "$out/$name.log"; then
@@ -114,7 +117,7 @@ for run in "${runs[@]}"; do
         quickstart | mesh_ground) frames=80 ;;
         esac
     fi
-    if ! RWT_EXIT_AFTER_FRAMES=$frames RWT_VIEW=$view RWT_SCREENSHOT=$png timeout 1200 "$bin/$ex" >"$out/$name.log" 2>&1; then
+    if ! RWT_EXIT_AFTER_FRAMES=$frames RWT_VIEW=$view RWT_SCREENSHOT=$png timeout 1200 "$bin/$(binary "$ex")" >"$out/$name.log" 2>&1; then
         echo "FAIL $name: exited with an error"; tail -20 "$out/$name.log"; failed=1; continue
     fi
     line=$(grep -E '^rwt-smoke: screenshot' "$out/$name.log" || true)

@@ -72,3 +72,33 @@ pub fn textons_dir() -> std::path::PathBuf {
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
+
+/// The guide's Rust examples, compiled (and run, where not `no_run`) as doctests: one item
+/// per page of `docs/guide` (`tests/docs.rs` checks that none is left out).
+#[cfg(doctest)]
+pub mod guide {
+    #[doc = include_str!("../docs/guide/acting.md")]
+    pub struct Acting;
+    #[doc = include_str!("../docs/guide/examples.md")]
+    pub struct Examples;
+    #[doc = include_str!("../docs/guide/ground.md")]
+    pub struct Ground;
+    #[doc = include_str!("../docs/guide/instanced.md")]
+    pub struct Instanced;
+    #[doc = include_str!("../docs/guide/library.md")]
+    pub struct Library;
+    #[doc = include_str!("../docs/guide/plugin.md")]
+    pub struct Plugin;
+    #[doc = include_str!("../docs/guide/python.md")]
+    pub struct Python;
+    #[doc = include_str!("../docs/guide/README.md")]
+    pub struct Contents;
+    #[doc = include_str!("../docs/guide/reliability.md")]
+    pub struct Reliability;
+    #[doc = include_str!("../docs/guide/speed.md")]
+    pub struct Speed;
+    #[doc = include_str!("../docs/guide/stippling.md")]
+    pub struct Stippling;
+    #[doc = include_str!("../docs/guide/tile-set.md")]
+    pub struct TileSet;
+}

@@ -275,6 +275,7 @@ fn is_module_path(span: &str) -> bool {
     ];
     let first = span.split("::").next().unwrap_or("");
     span.contains("::")
+        && !first.is_empty()
         && !span.contains(|c: char| " (<{!.&=".contains(c))
         && first.chars().all(|c| c.is_ascii_lowercase() || c == '_')
         && !EXTERNAL.contains(&first)
@@ -376,4 +377,434 @@ fn the_readme_is_a_front_page() {
     ] {
         assert!(readme.contains(needed), "README.md lacks {needed}");
     }
+}
+
+/// What users read besides the Markdown pages: the scripts (their comments and usage lines)
+/// and the doc comments of the crates, the examples and their harness.
+fn script_and_crate_docs() -> Vec<(PathBuf, String)> {
+    let mut out = Vec::new();
+    for file in files() {
+        let text = || fs::read_to_string(root().join(&file)).unwrap_or_default();
+        if file.starts_with("scripts") {
+            out.push((file.clone(), text()));
+        } else if file.extension().is_some_and(|e| e == "rs")
+            && ["crates", "src", "examples"]
+                .iter()
+                .any(|top| file.starts_with(top))
+        {
+            let docs: Vec<String> = text()
+                .lines()
+                .map(str::trim_start)
+                .filter(|l| l.starts_with("//!") || l.starts_with("///"))
+                .map(|l| l[3..].to_string())
+                .collect();
+            out.push((file.clone(), docs.join("\n")));
+        }
+    }
+    out
+}
+
+/// The words of `text`, split at spaces, quotes, brackets and punctuation that ends a path.
+fn words(text: &str) -> impl Iterator<Item = &str> {
+    text.split(|c: char| c.is_whitespace() || "`'\"()[]{}<>,;|=".contains(c))
+        .map(|w| w.trim_end_matches(['.', ':']))
+        .filter(|w| !w.is_empty())
+}
+
+/// The problems with the repository paths, examples, benches and tests that `text` (of the
+/// file `at`) names: each must exist.
+fn missing_names(text: &str, at: &Path, all: &[PathBuf]) -> Vec<String> {
+    const TOPS: [&str; 8] = [
+        "scripts/",
+        "examples/",
+        "tests/",
+        "docs/",
+        "crates/",
+        "assets/",
+        "fuzz/",
+        "src/",
+    ];
+    const EXTENSIONS: [&str; 9] = [
+        ".rs", ".md", ".sh", ".py", ".ron", ".png", ".toml", ".wgsl", ".pyi",
+    ];
+    let exists = |path: &str| {
+        root().join(path).exists()
+            || at
+                .parent()
+                .is_some_and(|d| root().join(d).join(path).exists())
+            || all.iter().any(|f| f.ends_with(path))
+    };
+    let mut out = Vec::new();
+    let tokens: Vec<&str> = words(text).collect();
+    for (i, word) in tokens.iter().enumerate() {
+        let path = word.trim_start_matches("./");
+        if TOPS.iter().any(|t| path.starts_with(t))
+            && EXTENSIONS.iter().any(|e| path.ends_with(e))
+            && !path.contains(['*', '$'])
+            && !exists(path)
+        {
+            out.push(format!("{}: no file {path}", at.display()));
+        }
+        let target = |kind: &str| match tokens.get(i + 1) {
+            // `NAME` and `$ex` are placeholders.
+            Some(name)
+                if *word == kind
+                    && !name.contains(['$', '-'])
+                    && !name.contains(|c: char| c.is_ascii_uppercase()) =>
+            {
+                Some(*name)
+            }
+            _ => None,
+        };
+        if let Some(name) = target("--example") {
+            let found = all.iter().any(|f| {
+                f.components().any(|c| c.as_os_str() == "examples")
+                    && (f.ends_with(format!("{name}.rs")) || f.ends_with(format!("{name}/main.rs")))
+            });
+            if !found {
+                out.push(format!("{}: no example {name}", at.display()));
+            }
+        }
+        for (kind, folder) in [("--bench", "benches"), ("--test", "tests")] {
+            let Some(name) = target(kind) else { continue };
+            let found = all.iter().any(|f| {
+                f.components().any(|c| c.as_os_str() == folder)
+                    && (f.ends_with(format!("{name}.rs")) || f.ends_with(format!("{name}/main.rs")))
+            });
+            if !found {
+                out.push(format!("{}: no {kind} target {name}", at.display()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn every_script_example_test_and_file_the_docs_name_exists() {
+    let all = files();
+    let sources: String = all
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "rs" || e == "py"))
+        .filter_map(|p| fs::read_to_string(root().join(p)).ok())
+        .collect::<Vec<_>>()
+        .join("\n");
+    let mut missing = Vec::new();
+    let mut texts: Vec<(PathBuf, String)> = pages()
+        .into_iter()
+        .map(|p| {
+            let text = read(&p);
+            (p, text)
+        })
+        .collect();
+    texts.extend(script_and_crate_docs());
+    for (file, text) in &texts {
+        missing.extend(missing_names(text, file, &all));
+        // Tests by name, on the pages that point users and contributors at them (the notes
+        // pages also name functions of Mesa and fields the benches print).
+        let points_at_tests = file.starts_with("docs/guide")
+            || [
+                "README.md",
+                "docs/ARCHITECTURE.md",
+                "TESTING.md",
+                "CONTRIBUTING.md",
+            ]
+            .iter()
+            .any(|p| file == Path::new(p));
+        if points_at_tests {
+            for span in code_spans(text).iter().filter(|s| is_test_name(s)) {
+                if !mentions(&sources, span) {
+                    missing.push(format!("{}: no test or function {span}", file.display()));
+                }
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "named but missing:\n{}",
+        missing.join("\n")
+    );
+}
+
+/// The names of the types, traits and enum variants that `text` (Rust source) defines:
+/// those it makes `pub` go to `public`, all to `defined`.
+fn type_names(text: &str, public: &mut BTreeSet<String>, defined: &mut BTreeSet<String>) {
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut in_enum = 0usize;
+    let mut depth = 0usize;
+    let mut in_public_enum = false;
+    for line in text.lines() {
+        let line = line.trim();
+        let (is_pub, item) = match line.strip_prefix("pub ") {
+            Some(rest) => (true, rest),
+            None => (false, line.split_once(") ").map_or(line, |(_, r)| r)),
+        };
+        for keyword in ["struct ", "enum ", "trait ", "type ", "union "] {
+            if let Some(rest) = item.strip_prefix(keyword) {
+                let name = ident(rest);
+                if is_pub {
+                    public.insert(name.clone());
+                }
+                defined.insert(name);
+                if keyword == "enum " && line.ends_with('{') {
+                    in_enum = depth + 1;
+                    in_public_enum = is_pub;
+                }
+            }
+        }
+        if let Some((_, alias)) = line
+            .strip_prefix("pub use ")
+            .and_then(|l| l.split_once(" as "))
+        {
+            public.insert(ident(alias));
+        }
+        if in_enum > 0 && depth == in_enum && line.starts_with(|c: char| c.is_ascii_uppercase()) {
+            if in_public_enum {
+                public.insert(ident(line));
+            }
+            defined.insert(ident(line));
+        }
+        depth += line.matches('{').count();
+        depth = depth.saturating_sub(line.matches('}').count());
+        if in_enum > 0 && depth < in_enum {
+            in_enum = 0;
+        }
+    }
+}
+
+/// The type names the docs may use.
+struct Known {
+    /// Ours that the crates export, the dependencies' (Bevy's and the others whose sources
+    /// cargo keeps in its registry), Rust's own and SciPy's.
+    public: BTreeSet<String>,
+    /// Besides those, our crates' private types, which contributors' pages and doc comments
+    /// may name.
+    defined: BTreeSet<String>,
+}
+
+fn known_names() -> Known {
+    const OTHERS: [&str; 25] = [
+        "Some",
+        "None",
+        "Ok",
+        "Err",
+        "Option",
+        "Result",
+        "Vec",
+        "Box",
+        "String",
+        "Arc",
+        "Rc",
+        "HashMap",
+        "HashSet",
+        "BTreeMap",
+        "BTreeSet",
+        "Path",
+        "PathBuf",
+        "File",
+        "Instant",
+        "Duration",
+        "Mutex",
+        "Cow",
+        "Default",
+        "Iterator",
+        "PoissonDisk",
+    ];
+    let mut public: BTreeSet<String> = OTHERS.iter().map(|s| s.to_string()).collect();
+    let mut defined = BTreeSet::new();
+    let mut sources = Vec::new();
+    for top in ["crates", "src", "examples", "fuzz"] {
+        walk(&root().join(top), &mut sources);
+    }
+    let home = std::env::var_os("CARGO_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".cargo")));
+    let registries = home
+        .map(|h| h.join("registry/src"))
+        .and_then(|r| fs::read_dir(r).ok());
+    for registry in registries.into_iter().flatten().flatten() {
+        for package in fs::read_dir(registry.path())
+            .into_iter()
+            .flatten()
+            .flatten()
+        {
+            let name = package.file_name().to_string_lossy().into_owned();
+            let ours = [
+                "bevy", "glam-", "avian3d-", "parry3d-", "wgpu-", "naga-", "image-", "noise-",
+            ];
+            if ours.iter().any(|p| name.starts_with(p)) && !name.starts_with("bevy-") {
+                let mut found = Vec::new();
+                walk_absolute(&package.path().join("src"), &mut found);
+                sources.extend(found);
+            }
+        }
+    }
+    for file in sources
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "rs"))
+    {
+        let (path, ours) = match file.is_absolute() {
+            true => (file.clone(), false),
+            false => (root().join(file), true),
+        };
+        let text = fs::read_to_string(path).unwrap_or_default();
+        let mut private = BTreeSet::new();
+        let defined_here = if ours { &mut defined } else { &mut private };
+        type_names(&text, &mut public, defined_here);
+    }
+    defined.extend(public.iter().cloned());
+    Known { public, defined }
+}
+
+/// Every file under an absolute `dir`.
+fn walk_absolute(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in fs::read_dir(dir).into_iter().flatten().flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            walk_absolute(&path, out);
+        } else {
+            out.push(path);
+        }
+    }
+}
+
+/// The capitalised names in the code spans of `text` followed by `::` or `(`, which must
+/// be types, traits or enum variants in `known` (a name with an underscore is not a type:
+/// `F_t(k)` is a formula).
+fn unknown_types(text: &str, at: &Path, known: &BTreeSet<String>) -> Vec<String> {
+    let mut out = Vec::new();
+    for span in code_spans(text) {
+        let mut rest = span.as_str();
+        while let Some(start) = rest.find(|c: char| c.is_ascii_uppercase()) {
+            let before = rest[..start].chars().next_back();
+            rest = &rest[start..];
+            let len = rest
+                .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .unwrap_or(rest.len());
+            let (name, after) = rest.split_at(len);
+            let word_start = !before.is_some_and(|c| c.is_alphanumeric() || c == '_');
+            if word_start
+                && (after.starts_with("::") || after.starts_with('('))
+                && !name.contains('_')
+                && !known.contains(name)
+            {
+                out.push(format!("{}: `{span}` names {name}", at.display()));
+            }
+            rest = after;
+        }
+    }
+    out
+}
+
+#[test]
+fn no_doc_names_a_type_the_crates_do_not_export() {
+    let known = known_names();
+    let mut unknown = Vec::new();
+    // Contributors' pages may name the crates' private types; users' pages only what the
+    // crates export.
+    let contributors = [
+        "docs/ARCHITECTURE.md",
+        "TESTING.md",
+        "CONTRIBUTING.md",
+        "docs/construction-notes.md",
+        "docs/speed-notes.md",
+        "docs/rendering-notes.md",
+        "docs/lavapipe-notes.md",
+        "docs/stippling.md",
+    ];
+    for page in pages() {
+        let names = match contributors.iter().any(|c| page == Path::new(c)) {
+            true => &known.defined,
+            false => &known.public,
+        };
+        unknown.extend(unknown_types(&read(&page), &page, names));
+    }
+    for (file, docs) in script_and_crate_docs() {
+        unknown.extend(unknown_types(&docs, &file, &known.defined));
+    }
+    assert!(unknown.is_empty(), "unknown names:\n{}", unknown.join("\n"));
+}
+
+#[test]
+fn the_name_checks_catch_a_missing_script_and_an_unknown_type() {
+    let all = files();
+    let page = Path::new("docs/guide/x.md");
+    assert!(missing_names("run scripts/smoke.sh", page, &all).is_empty());
+    assert_eq!(
+        missing_names("see scripts/screenshots.sh", page, &all),
+        ["docs/guide/x.md: no file scripts/screenshots.sh"]
+    );
+    assert_eq!(
+        missing_names("cargo run --example nowhere", page, &all).len(),
+        1
+    );
+    assert!(missing_names("cargo run --example open_world --bench ground", page, &all).is_empty());
+    assert_eq!(
+        missing_names("cargo test --test no_such_test", page, &all).len(),
+        1
+    );
+    let known = known_names().public;
+    let good = "`ScatterClass::instanced(..)` `Transform::from_xyz(0.0)` `DVec2::ZERO`";
+    assert!(unknown_types(good, page, &known).is_empty());
+    let stale = "a `SceneRoot(handle)` and `InstancedMaterial::default()`";
+    assert_eq!(unknown_types(stale, page, &known).len(), 2);
+    // Variants count as names: layer files write them.
+    assert!(unknown_types("`Constant(40.0)` `Within(30.0)`", page, &known).is_empty());
+    // A private type is not for users' pages.
+    assert_eq!(unknown_types("`Generator::points`", page, &known).len(), 1);
+}
+
+#[test]
+fn every_guide_page_is_for_users_and_compiled() {
+    let lib = read(Path::new("src/lib.rs"));
+    let mut problems = Vec::new();
+    for page in pages().into_iter().filter(|p| p.starts_with("docs/guide")) {
+        let text = read(&page);
+        let name = page.file_name().unwrap().to_string_lossy();
+        if !lib.contains(&format!("include_str!(\"../docs/guide/{name}\")")) {
+            problems.push(format!(
+                "{}: not included as doctests by src/lib.rs",
+                page.display()
+            ));
+        }
+        let lines = text.lines().count();
+        if lines >= 150 {
+            problems.push(format!("{}: {lines} lines (150 at most)", page.display()));
+        }
+        let months = [
+            "January",
+            "February",
+            "March",
+            "April",
+            "May",
+            "June",
+            "July",
+            "August",
+            "September",
+            "October",
+            "November",
+            "December",
+        ];
+        let mut fenced = false;
+        for (n, line) in text.lines().enumerate() {
+            let at = format!("{}:{}", page.display(), n + 1);
+            if line.trim_start().starts_with("```") {
+                let info = line.trim_start().trim_start_matches('`');
+                if !fenced && (info.is_empty() || info.contains("ignore")) {
+                    problems.push(format!("{at}: a code block without a language, or ignored"));
+                }
+                fenced = !fenced;
+            }
+            if line.contains("this machine") || line.contains("2-core") {
+                problems.push(format!("{at}: names the machine it was measured on"));
+            }
+            if months.iter().any(|m| line.contains(&format!("{m} 20"))) {
+                problems.push(format!("{at}: a date"));
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

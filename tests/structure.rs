@@ -1,6 +1,7 @@
 //! Imports point one way: no two top-level modules of a crate import each other, nor two
 //! sibling files or folders at any depth (what docs/ARCHITECTURE.md promises for every
-//! crate); the instanced renderer's `mod.rs` files declare, document and re-export only.
+//! crate); the instanced renderer's `mod.rs` files declare, document and re-export only;
+//! quickstart, the game users copy, names no crate but `bevy` and `bevy_rwt`.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -327,4 +328,38 @@ fn the_instanced_renderer_mod_files_define_nothing() {
         "items in mod.rs:\n{}",
         defined.join("\n")
     );
+}
+
+/// The crates a file's code names at the start of its paths: `use x::…` and `x::…`.
+fn crates_named(code: &str) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for (i, _) in code.match_indices("::") {
+        let before = &code[..i];
+        let start = before
+            .rfind(|c: char| !(c.is_alphanumeric() || c == '_'))
+            .map_or(0, |s| s + 1);
+        let preceded_by_path = before[..start].ends_with("::");
+        let name = &before[start..];
+        if !preceded_by_path && name.starts_with(|c: char| c.is_ascii_lowercase()) {
+            out.insert(name.to_string());
+        }
+    }
+    out
+}
+
+#[test]
+fn the_smallest_game_uses_only_bevy_and_bevy_rwt() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = fs::read_to_string(root.join("examples/quickstart.rs")).unwrap();
+    let named = crates_named(&code(&text));
+    let allowed: BTreeSet<String> = ["bevy", "bevy_rwt", "std", "self", "super", "crate"]
+        .into_iter()
+        .map(String::from)
+        .collect();
+    assert!(named.contains("bevy") && named.contains("bevy_rwt"));
+    let others: Vec<&String> = named.difference(&allowed).collect();
+    assert!(others.is_empty(), "quickstart names {others:?}");
+    // The check sees a harness import.
+    let harness = crates_named("use rwt_examples::prelude::*; let x = glam::Vec2::ZERO;");
+    assert!(harness.contains("rwt_examples") && harness.contains("glam"));
 }

@@ -197,6 +197,7 @@ pub mod prelude {
     pub use crate::edits::{EditInstance, InstanceEdit, ScatterEdits};
     pub use crate::footprints::{Footprint, FootprintShape};
     pub use crate::gizmos::{RwtGizmos, RwtGizmosPlugin};
+    pub use crate::ground::{ScatterSurface, SurfacePolicy};
     pub use crate::layers::file::{NamedAssets, ScatterLayerAsset, ScatterLayerSource};
     pub use crate::picking::{PickFilter, ScatterHit, ScatterPicking};
     pub use crate::save::{LoadWorld, NamedMap, RwtSavePlugin, SaveWorld, WorldLoaded, WorldSaved};

@@ -1,4 +1,4 @@
-"""The docstrings' and the READMEs' examples run, and the package ships its types."""
+"""The docstrings', the READMEs' and the guide's examples run, and the package ships its types."""
 
 import doctest
 import re
@@ -33,10 +33,15 @@ def test_typed_package():
 
 
 HERE = Path(__file__).resolve().parent
-READMES = [HERE.parent / "README.md", HERE.parents[2] / "README.md"]
+GUIDE = HERE.parents[2] / "docs" / "guide"
+READMES = [HERE.parent / "README.md", HERE.parents[2] / "README.md"] + sorted(
+    page for page in GUIDE.glob("*.md") if "```python" in page.read_text()
+)
 
 
-@pytest.mark.parametrize("readme", READMES, ids=["crate", "repository"])
+@pytest.mark.parametrize(
+    "readme", READMES, ids=["crate", "repository"] + [p.stem for p in READMES[2:]]
+)
 def test_readme_examples_run(readme, capsys):
     blocks = re.findall(r"```python\n(.*?)```", readme.read_text(), flags=re.S)
     assert blocks, f"{readme} has no python example"

@@ -176,12 +176,13 @@ impl ScatterClass {
         Self::with_look(density, ClassLook::Mesh { mesh, material })
     }
 
-    /// A class whose instances get what `insert` puts on them, e.g. a scene:
+    /// A class whose instances get what `insert` puts on them, e.g. a glTF scene (in a game
+    /// with Bevy's `bevy_gltf` feature, which this crate does not enable):
     ///
     /// ```ignore
     /// let tree = asset_server.load(GltfAssetLabel::Scene(0).from_asset("tree.glb"));
     /// ScatterClass::custom(LayerDensity::Constant(0.05), move |e| {
-    ///     e.insert(SceneRoot(tree.clone()));
+    ///     e.insert(WorldAssetRoot(tree.clone()));
     /// })
     /// ```
     pub fn custom(
@@ -440,7 +441,8 @@ pub const DEFAULT_TILE_SIZE: f64 = 8.0;
 pub const DEFAULT_SCALE_VARIATION: f32 = 0.2;
 
 impl ScatterLayer {
-    /// A layer with one class, tiles of [`DEFAULT_TILE_SIZE`] units, default streaming and flat ground.
+    /// A layer of these classes (one point set: class 0 alone is its own blue-noise set),
+    /// tiles of [`DEFAULT_TILE_SIZE`] units, default streaming and flat ground.
     pub fn new(classes: Vec<ScatterClass>) -> Self {
         Self {
             classes,

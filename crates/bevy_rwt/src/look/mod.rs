@@ -43,9 +43,10 @@ pub enum ClassLook {
         /// The material.
         material: Handle<StandardMaterial>,
     },
-    /// Whatever the function inserts: a scene (`SceneRoot(handle.clone())`, with Bevy's
-    /// `bevy_scene` feature in the game), another material type, colliders, markers. Code,
-    /// not data: reflection does not see it (and inserts nothing when it builds this variant).
+    /// Whatever the function inserts: a glTF scene (`WorldAssetRoot(handle.clone())`,
+    /// with Bevy's `bevy_gltf` feature in the game), another material type, colliders,
+    /// markers. Code, not data: reflection does not see it (and inserts nothing when it
+    /// builds this variant).
     Custom(#[reflect(ignore, default = "insert_nothing")] InstanceInserter),
     /// No entity per instance: each chunk's instances are packed into one GPU buffer and
     /// drawn with one instanced draw (grass, flowers, pebbles; see [`crate::instancing`]).
