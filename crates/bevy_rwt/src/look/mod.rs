@@ -4,6 +4,7 @@
 //! a point into a transform ([`Pose`], [`GroundPlane::place`]), which the entity and the
 //! instanced path share so that both put one point in the same place.
 
+pub mod asset;
 mod blade;
 mod check;
 mod impostor;

@@ -14,6 +14,8 @@
 //! assert!(app.world().resource::<RwtStats>().live_entities > 100);
 //! ```
 
+pub mod glb;
+
 pub use crate::instancing::{CullingCheck, CullingReport};
 
 use crate::diagnostics::RwtStats;

@@ -1,0 +1,293 @@
+//! An asset's node tree split into what is drawn at each level of detail and what only
+//! collides, by the names exporters give nodes: `<name>_LOD0`, `_LOD1`… (Unreal's, Unity's
+//! and Blender's convention) and `UCX_<name>` (Unreal), `<name>_collider`, `-colonly` and
+//! `-convcolonly` (Godot). Each part keeps its transform relative to the asset's root.
+
+use bevy::prelude::*;
+
+/// A node of an asset's tree as the file gives it: a name, a transform relative to its
+/// parent, the primitives it draws (`P`: a mesh and its material) and its children.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AssetNode<P> {
+    /// The node's name in the file (empty when it has none).
+    pub name: String,
+    /// Its transform relative to its parent.
+    pub transform: Transform,
+    /// The primitives of its mesh, if it has one.
+    pub primitives: Vec<P>,
+    /// Its children.
+    pub children: Vec<AssetNode<P>>,
+}
+
+impl<P> AssetNode<P> {
+    /// A node with no primitives and no children.
+    pub fn new(name: impl Into<String>, transform: Transform) -> Self {
+        Self {
+            name: name.into(),
+            transform,
+            primitives: Vec::new(),
+            children: Vec::new(),
+        }
+    }
+
+    /// This node, drawing `primitives`.
+    pub fn with_primitives(mut self, primitives: impl IntoIterator<Item = P>) -> Self {
+        self.primitives.extend(primitives);
+        self
+    }
+
+    /// This node, with `children`.
+    pub fn with_children(mut self, children: impl IntoIterator<Item = AssetNode<P>>) -> Self {
+        self.children.extend(children);
+        self
+    }
+}
+
+/// A primitive with its transform relative to the asset's root.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Placed<P> {
+    /// The primitive.
+    pub primitive: P,
+    /// Where it stands in the asset's frame (the root's own transform left out).
+    pub transform: Transform,
+}
+
+/// What a node's name makes of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NodeRole {
+    /// A level of detail: the node and everything under it are drawn at that level only.
+    Level(u32),
+    /// A collision shape: never drawn, handed to promotion's inserter.
+    Collider,
+    /// Anything else: drawn at the level of the nearest level node above it, at every level
+    /// when there is none.
+    Plain,
+}
+
+impl NodeRole {
+    /// The role of a node called `name`.
+    pub fn of(name: &str) -> Self {
+        let lower = name.to_ascii_lowercase();
+        let collider = lower.starts_with("ucx_")
+            || ["_collider", "-colonly", "-convcolonly"]
+                .iter()
+                .any(|suffix| lower.ends_with(suffix));
+        if collider {
+            return NodeRole::Collider;
+        }
+        match lower.rfind("_lod") {
+            Some(at) => {
+                let digits = &lower[at + 4..];
+                match digits.parse::<u32>() {
+                    Ok(level)
+                        if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) =>
+                    {
+                        NodeRole::Level(level)
+                    }
+                    _ => NodeRole::Plain,
+                }
+            }
+            None => NodeRole::Plain,
+        }
+    }
+}
+
+/// An asset's primitives, split by their nodes' names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AssetParts<P> {
+    /// What each level of detail draws, nearest first: the levels the names give, in the
+    /// order of their numbers (numbers need not follow each other), each with the parts
+    /// outside any level node; one level when no node names one.
+    pub levels: Vec<Vec<Placed<P>>>,
+    /// The primitives of collider nodes, never drawn.
+    pub colliders: Vec<Placed<P>>,
+}
+
+impl<P: Clone> AssetParts<P> {
+    /// Splits the tree under `root` (whose own transform is the asset's frame, left out).
+    pub fn split(root: &AssetNode<P>) -> Self {
+        let mut found = Found {
+            levels: Vec::new(),
+            shared: Vec::new(),
+            colliders: Vec::new(),
+        };
+        for child in &root.children {
+            found.walk(child, Transform::IDENTITY, None);
+        }
+        let identity = Transform::IDENTITY;
+        found
+            .shared
+            .extend(root.primitives.iter().cloned().map(|primitive| Placed {
+                primitive,
+                transform: identity,
+            }));
+        found.levels.sort_by_key(|(level, _)| *level);
+        let levels = match found.levels.is_empty() {
+            true => vec![found.shared],
+            false => found
+                .levels
+                .into_iter()
+                .map(|(_, mut parts)| {
+                    parts.extend(found.shared.iter().cloned());
+                    parts
+                })
+                .collect(),
+        };
+        AssetParts {
+            levels,
+            colliders: found.colliders,
+        }
+    }
+}
+
+/// The parts found so far, while walking the tree.
+struct Found<P> {
+    /// Each named level's parts, by level number.
+    levels: Vec<(u32, Vec<Placed<P>>)>,
+    /// Parts under no level node.
+    shared: Vec<Placed<P>>,
+    colliders: Vec<Placed<P>>,
+}
+
+impl<P: Clone> Found<P> {
+    /// Adds `node` (under `parent`, relative to the root) and what is under it; `level` is
+    /// the level node above it, if any. A collider's subtree is all collider.
+    fn walk(&mut self, node: &AssetNode<P>, parent: Transform, level: Option<u32>) {
+        let transform = parent.mul_transform(node.transform);
+        let role = NodeRole::of(&node.name);
+        if role == NodeRole::Collider {
+            self.collect_collider(node, parent);
+            return;
+        }
+        let level = match role {
+            NodeRole::Level(n) => Some(n),
+            _ => level,
+        };
+        let placed = node.primitives.iter().cloned().map(|primitive| Placed {
+            primitive,
+            transform,
+        });
+        match level {
+            Some(n) => {
+                let index = match self.levels.iter().position(|(l, _)| *l == n) {
+                    Some(index) => index,
+                    None => {
+                        self.levels.push((n, Vec::new()));
+                        self.levels.len() - 1
+                    }
+                };
+                self.levels[index].1.extend(placed);
+            }
+            None => self.shared.extend(placed),
+        }
+        for child in &node.children {
+            self.walk(child, transform, level);
+        }
+    }
+
+    fn collect_collider(&mut self, node: &AssetNode<P>, parent: Transform) {
+        let transform = parent.mul_transform(node.transform);
+        self.colliders
+            .extend(node.primitives.iter().cloned().map(|primitive| Placed {
+                primitive,
+                transform,
+            }));
+        for child in &node.children {
+            self.collect_collider(child, transform);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(x: f32) -> Transform {
+        Transform::from_xyz(x, 0.0, 0.0)
+    }
+
+    fn names(parts: &[Placed<&'static str>]) -> Vec<&'static str> {
+        let mut out: Vec<_> = parts.iter().map(|p| p.primitive).collect();
+        out.sort();
+        out
+    }
+
+    #[test]
+    fn names_give_levels_colliders_and_plain_nodes() {
+        assert_eq!(NodeRole::of("Oak_LOD0"), NodeRole::Level(0));
+        assert_eq!(NodeRole::of("oak_lod12"), NodeRole::Level(12));
+        assert_eq!(NodeRole::of("UCX_Oak_00"), NodeRole::Collider);
+        assert_eq!(NodeRole::of("trunk_collider"), NodeRole::Collider);
+        assert_eq!(NodeRole::of("rock-colonly"), NodeRole::Collider);
+        assert_eq!(NodeRole::of("rock-convcolonly"), NodeRole::Collider);
+        for plain in [
+            "Oak",
+            "Oak_LOD",
+            "Oak_LODx",
+            "Oak_LOD-1",
+            "slodge",
+            "LOD0",
+            "",
+        ] {
+            assert_eq!(NodeRole::of(plain), NodeRole::Plain, "{plain}");
+        }
+    }
+
+    #[test]
+    fn a_tree_without_names_is_one_level_with_every_primitive_placed() {
+        let root = AssetNode::new("oak", at(100.0))
+            .with_primitives(["root mesh"])
+            .with_children([AssetNode::new("trunk", at(1.0))
+                .with_primitives(["bark", "leaves"])
+                .with_children([AssetNode::new("branch", at(2.0)).with_primitives(["twig"])])]);
+        let parts = AssetParts::split(&root);
+        assert_eq!(parts.levels.len(), 1);
+        assert!(parts.colliders.is_empty());
+        let level = &parts.levels[0];
+        assert_eq!(names(level), ["bark", "leaves", "root mesh", "twig"]);
+        // Relative to the root: the root's own 100 m is left out, the chain composes.
+        let x = |name| {
+            level
+                .iter()
+                .find(|p| p.primitive == name)
+                .unwrap()
+                .transform
+                .translation
+                .x
+        };
+        assert_eq!((x("root mesh"), x("bark"), x("twig")), (0.0, 1.0, 3.0));
+    }
+
+    #[test]
+    fn level_nodes_split_the_tree_in_their_numbers_order_and_share_the_rest() {
+        let root = AssetNode::new("rock", Transform::IDENTITY).with_children([
+            AssetNode::new("rock_LOD2", at(0.0)).with_primitives(["far"]),
+            AssetNode::new("rock_LOD0", at(0.0))
+                .with_primitives(["near"])
+                .with_children([AssetNode::new("moss", at(0.5)).with_primitives(["moss"])]),
+            AssetNode::new("UCX_rock", at(0.0)).with_primitives(["hull"]),
+            AssetNode::new("base", at(0.0)).with_primitives(["base"]),
+        ]);
+        let parts = AssetParts::split(&root);
+        assert_eq!(parts.levels.len(), 2);
+        assert_eq!(names(&parts.levels[0]), ["base", "moss", "near"]);
+        assert_eq!(names(&parts.levels[1]), ["base", "far"]);
+        assert_eq!(names(&parts.colliders), ["hull"]);
+    }
+
+    #[test]
+    fn everything_under_a_collider_collides_and_is_never_drawn() {
+        let root = AssetNode::new("bush", Transform::IDENTITY).with_children([
+            AssetNode::new("bush_collider", at(1.0)).with_children([AssetNode::new(
+                "piece_LOD0",
+                at(1.0),
+            )
+            .with_primitives(["hull"])]),
+            AssetNode::new("leaves", at(0.0)).with_primitives(["leaves"]),
+        ]);
+        let parts = AssetParts::split(&root);
+        assert_eq!(names(&parts.levels[0]), ["leaves"]);
+        assert_eq!(names(&parts.colliders), ["hull"]);
+        assert_eq!(parts.colliders[0].transform.translation.x, 2.0);
+    }
+}
