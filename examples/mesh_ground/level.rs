@@ -4,6 +4,7 @@
 //! the game can mark each as the ground it is.
 
 use bevy::prelude::*;
+use bevy_rwt::testing::glb::{Glb, GlbMaterial, GlbNode, GlbPrimitive};
 
 /// One named part of the level: a triangle list in world space, with its colour.
 pub struct Part {
@@ -185,88 +186,18 @@ pub const ROCKS: [&str; 5] = ["rock 1", "rock 2", "rock 3", "rock 4", "rock 5"];
 /// The level as a glTF binary: one node and one mesh per part, each with a material of
 /// its colour.
 pub fn glb(parts: &[Part]) -> Vec<u8> {
-    let mut bin: Vec<u8> = Vec::new();
-    let (mut views, mut accessors, mut meshes, mut nodes, mut materials) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut view = |bin: &mut Vec<u8>, bytes: &[u8], target: u32| {
-        let offset = bin.len();
-        bin.extend_from_slice(bytes);
-        bin.resize(bin.len().next_multiple_of(4), 0);
-        views.push(format!(
-            r#"{{"buffer":0,"byteOffset":{offset},"byteLength":{},"target":{target}}}"#,
-            bytes.len()
-        ));
-        views.len() - 1
-    };
-    for (k, p) in parts.iter().enumerate() {
-        let floats = |v: &[[f32; 3]]| {
-            v.iter()
-                .flatten()
-                .flat_map(|f| f.to_le_bytes())
-                .collect::<Vec<u8>>()
-        };
-        let (lo, hi) = p
-            .positions
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), q| {
-                (lo.min(Vec3::from_array(*q)), hi.max(Vec3::from_array(*q)))
-            });
-        let position = view(&mut bin, &floats(&p.positions), 34962);
-        let normal = view(&mut bin, &floats(&p.normals), 34962);
-        let index_bytes: Vec<u8> = p.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-        let index = view(&mut bin, &index_bytes, 34963);
-        let n = p.positions.len();
-        let a = accessors.len();
-        accessors.push(format!(
-            r#"{{"bufferView":{position},"componentType":5126,"count":{n},"type":"VEC3","min":[{},{},{}],"max":[{},{},{}]}}"#,
-            lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
-        ));
-        accessors.push(format!(
-            r#"{{"bufferView":{normal},"componentType":5126,"count":{n},"type":"VEC3"}}"#
-        ));
-        accessors.push(format!(
-            r#"{{"bufferView":{index},"componentType":5125,"count":{},"type":"SCALAR"}}"#,
-            p.indices.len()
-        ));
-        let [r, g, b, al] = p.color;
-        materials.push(format!(
-            r#"{{"pbrMetallicRoughness":{{"baseColorFactor":[{r},{g},{b},{al}],"metallicFactor":0.0,"roughnessFactor":0.9}}}}"#
-        ));
-        meshes.push(format!(
-            r#"{{"primitives":[{{"attributes":{{"POSITION":{a},"NORMAL":{}}},"indices":{},"material":{k}}}]}}"#,
-            a + 1,
-            a + 2
-        ));
-        nodes.push(format!(r#"{{"name":"{}","mesh":{k}}}"#, p.name));
+    let mut file = Glb::default();
+    for p in parts {
+        let material = file.add_material(GlbMaterial::colored(p.color));
+        let mesh = file.add_mesh(vec![GlbPrimitive {
+            positions: p.positions.clone(),
+            normals: p.normals.clone(),
+            indices: p.indices.clone(),
+            material,
+            ..default()
+        }]);
+        let node = file.add_node(GlbNode::named(p.name).with_mesh(mesh));
+        file.add_root(node);
     }
-    let scene: Vec<String> = (0..parts.len()).map(|k| k.to_string()).collect();
-    let json = format!(
-        r#"{{"asset":{{"version":"2.0","generator":"rwt mesh_ground"}},"scene":0,"scenes":[{{"nodes":[{}]}}],"nodes":[{}],"meshes":[{}],"materials":[{}],"accessors":[{}],"bufferViews":[{}],"buffers":[{{"byteLength":{}}}]}}"#,
-        scene.join(","),
-        nodes.join(","),
-        meshes.join(","),
-        materials.join(","),
-        accessors.join(","),
-        views.join(","),
-        bin.len()
-    );
-    container(json.into_bytes(), bin)
-}
-
-/// The binary glTF container: a header, the JSON chunk (padded with spaces) and the binary
-/// chunk.
-fn container(mut json: Vec<u8>, bin: Vec<u8>) -> Vec<u8> {
-    json.resize(json.len().next_multiple_of(4), b' ');
-    let total = 12 + 8 + json.len() + 8 + bin.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
-    out
+    file.to_bytes()
 }
