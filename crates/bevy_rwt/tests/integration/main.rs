@@ -4,6 +4,8 @@
 
 mod common;
 
+#[cfg(feature = "gltf")]
+mod assets;
 #[cfg(feature = "brush")]
 mod brush;
 mod edits;

@@ -2,6 +2,10 @@
 //! its material and its transform relative to the asset's root; levels of detail and
 //! colliders from the nodes' names ([`AssetParts`]).
 
+#[cfg(feature = "gltf")]
+mod file;
 mod parts;
 
+#[cfg(feature = "gltf")]
+pub use file::{AssetPrimitive, AssetTreeError, MAX_ASSET_DEPTH, file_tree, node_tree};
 pub use parts::{AssetNode, AssetParts, NodeRole, Placed};
