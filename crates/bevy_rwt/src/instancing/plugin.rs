@@ -12,7 +12,8 @@ use bevy::core_pipeline::mip_generation::experimental::depth::early_downsample_d
 use bevy::core_pipeline::prepass::Opaque3dPrepass;
 use bevy::core_pipeline::prepass::node::late_prepass;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
-use bevy::ecs::schedule::InternedScheduleLabel;
+use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleConfigs};
+use bevy::ecs::system::ScheduleSystem;
 use bevy::pbr::{
     LATE_SHADOW_PASS, MeshPipelineSystems, Shadow, init_prepass_pipeline, per_view_shadow_pass,
     shared_shadow_pass,
@@ -87,16 +88,7 @@ fn build_render(app: &mut App) {
         ExtractResourcePlugin::<BendField>::default(),
     ));
     #[cfg(feature = "testing")]
-    app.sub_app_mut(RenderApp)
-        .init_resource::<render::FrameCheck>()
-        .init_resource::<render::CullSnapshot>()
-        .add_systems(ExtractSchedule, render::extract_culling_check)
-        .add_systems(
-            Render,
-            render::check_culling
-                .after(RenderSystems::Render)
-                .before(RenderSystems::Cleanup),
-        );
+    build_culling_check(app.sub_app_mut(RenderApp));
     let render_app = app.sub_app_mut(RenderApp);
     render_app
         .add_render_command::<Opaque3d, render::DrawInstancedChunk>()
@@ -145,24 +137,44 @@ fn build_render(app: &mut App) {
                 .in_set(RenderGraphSystems::Begin)
                 .after(begin_diagnostics_frame),
         )
+        .add_systems(Core3d, late_phase());
+}
+
+/// Culling's late phase, between Bevy's early depth pyramid and its late prepass and late
+/// shadow passes, and the brackets that let those passes draw only what it kept.
+fn late_phase() -> ScheduleConfigs<ScheduleSystem> {
+    (
+        render::cull_late
+            .after(early_downsample_depth)
+            .before(late_prepass)
+            .before(per_view_shadow_pass::<LATE_SHADOW_PASS>)
+            .before(shared_shadow_pass::<LATE_SHADOW_PASS>),
+        render::begin_late_passes
+            .after(early_downsample_depth)
+            .before(late_prepass)
+            .before(per_view_shadow_pass::<LATE_SHADOW_PASS>)
+            .before(shared_shadow_pass::<LATE_SHADOW_PASS>),
+        render::end_late_passes
+            .after(late_prepass)
+            .after(per_view_shadow_pass::<LATE_SHADOW_PASS>)
+            .after(shared_shadow_pass::<LATE_SHADOW_PASS>)
+            .before(Core3dSystems::MainPass),
+    )
+        .into_configs()
+}
+
+/// The culling check (feature `testing`): the frame it asks for is extracted, and read
+/// back once the frame is rendered.
+#[cfg(feature = "testing")]
+fn build_culling_check(render_app: &mut SubApp) {
+    render_app
+        .init_resource::<render::FrameCheck>()
+        .init_resource::<render::CullSnapshot>()
+        .add_systems(ExtractSchedule, render::extract_culling_check)
         .add_systems(
-            Core3d,
-            (
-                render::cull_late
-                    .after(early_downsample_depth)
-                    .before(late_prepass)
-                    .before(per_view_shadow_pass::<LATE_SHADOW_PASS>)
-                    .before(shared_shadow_pass::<LATE_SHADOW_PASS>),
-                render::begin_late_passes
-                    .after(early_downsample_depth)
-                    .before(late_prepass)
-                    .before(per_view_shadow_pass::<LATE_SHADOW_PASS>)
-                    .before(shared_shadow_pass::<LATE_SHADOW_PASS>),
-                render::end_late_passes
-                    .after(late_prepass)
-                    .after(per_view_shadow_pass::<LATE_SHADOW_PASS>)
-                    .after(shared_shadow_pass::<LATE_SHADOW_PASS>)
-                    .before(Core3dSystems::MainPass),
-            ),
+            Render,
+            render::check_culling
+                .after(RenderSystems::Render)
+                .before(RenderSystems::Cleanup),
         );
 }

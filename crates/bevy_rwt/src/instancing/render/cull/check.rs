@@ -226,48 +226,54 @@ pub(in crate::instancing) fn check_culling(
     };
     for (i, c) in checked.iter().enumerate() {
         let (early, late) = (count(i), count(checked.len() + i));
-        let mut gpu = kept_words(&pool, &c.kept, early);
-        if let Some(range) = &c.late {
-            gpu.extend(kept_words(&pool, range, late));
-        }
-        let mut cpu: Vec<[u32; 6]> = c
-            .instances
-            .instances
-            .iter()
-            .filter(|g| c.record.keeps(&c.view, g))
-            .map(|g| bytemuck::cast(*g))
-            .collect();
-        if c.view.light.w != 0.0 {
-            let every_caster = CullView {
-                light: Vec4::ZERO,
-                ..c.view
-            };
-            let kept = c.instances.instances.iter();
-            let kept = kept.filter(|g| c.record.keeps(&every_caster, g)).count();
-            report.cascade_dropped += kept.saturating_sub(cpu.len()) as u64;
-        }
-        gpu.sort_unstable();
-        cpu.sort_unstable();
-        report.draws += 1;
-        report.far_draws += usize::from(c.far);
-        report.instances += c.instances.instances.len() as u64;
-        report.occluding_draws += usize::from(c.pyramid);
-        report.cascade_occluding_draws += usize::from(c.pyramid && c.shadow);
-        report.gpu_kept += gpu.len() as u64;
-        report.cpu_kept += cpu.len() as u64;
-        if c.occludes {
-            // What the pyramid hid is dropped from the frustum's instances, never added.
-            report.late_kept += u64::from(late);
-            cpu.dedup();
-            if c.shadow {
-                report.cascade_occluded += cpu.len().saturating_sub(gpu.len()) as u64;
-            }
-            report.mismatched += usize::from(gpu.iter().any(|g| cpu.binary_search(g).is_err()));
-        } else {
-            report.mismatched += usize::from(gpu != cpu || late != 0);
-        }
+        compare_draw(&mut report, c, &pool, early, late);
     }
     check.answer(report);
+}
+
+/// Adds one draw to the report: the instances the GPU kept (early and late phase) against
+/// those the CPU's test keeps.
+fn compare_draw(report: &mut CullingReport, c: &Checked, pool: &[u32], early: u32, late: u32) {
+    let mut gpu = kept_words(pool, &c.kept, early);
+    if let Some(range) = &c.late {
+        gpu.extend(kept_words(pool, range, late));
+    }
+    let mut cpu: Vec<[u32; 6]> = c
+        .instances
+        .instances
+        .iter()
+        .filter(|g| c.record.keeps(&c.view, g))
+        .map(|g| bytemuck::cast(*g))
+        .collect();
+    if c.view.light.w != 0.0 {
+        let every_caster = CullView {
+            light: Vec4::ZERO,
+            ..c.view
+        };
+        let kept = c.instances.instances.iter();
+        let kept = kept.filter(|g| c.record.keeps(&every_caster, g)).count();
+        report.cascade_dropped += kept.saturating_sub(cpu.len()) as u64;
+    }
+    gpu.sort_unstable();
+    cpu.sort_unstable();
+    report.draws += 1;
+    report.far_draws += usize::from(c.far);
+    report.instances += c.instances.instances.len() as u64;
+    report.occluding_draws += usize::from(c.pyramid);
+    report.cascade_occluding_draws += usize::from(c.pyramid && c.shadow);
+    report.gpu_kept += gpu.len() as u64;
+    report.cpu_kept += cpu.len() as u64;
+    if c.occludes {
+        // What the pyramid hid is dropped from the frustum's instances, never added.
+        report.late_kept += u64::from(late);
+        cpu.dedup();
+        if c.shadow {
+            report.cascade_occluded += cpu.len().saturating_sub(gpu.len()) as u64;
+        }
+        report.mismatched += usize::from(gpu.iter().any(|g| cpu.binary_search(g).is_err()));
+    } else {
+        report.mismatched += usize::from(gpu != cpu || late != 0);
+    }
 }
 
 /// The first `size` bytes of `buffer`, as words, once the GPU has done its work.
