@@ -4,7 +4,7 @@
 use crate::common::app_reading_with;
 use bevy::gltf::{Gltf, GltfMesh, GltfNode, GltfPlugin};
 use bevy::prelude::*;
-use bevy_rwt::look::asset::{AssetParts, AssetPrimitive, file_tree};
+use bevy_rwt::look::asset::{AssetParts, AssetPrimitive, AssetRoot, AssetTreeError, asset_tree};
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
 
 /// A tree: two levels (bark and masked leaves near, one card far), a collision hull.
@@ -58,13 +58,31 @@ fn a_written_asset_loads_and_splits_into_levels_and_a_collider() {
     assert!(loaded, "oak.glb did not load");
     let world = app.world();
     let gltf = world.resource::<Assets<Gltf>>().get(&handle).unwrap();
-    let tree = file_tree(
-        gltf,
+    let (nodes, gltf_meshes) = (
         world.resource::<Assets<GltfNode>>(),
         world.resource::<Assets<GltfMesh>>(),
-    )
-    .unwrap();
-    let parts = AssetParts::split(&tree);
+    );
+    let tree = |root: AssetRoot| asset_tree(gltf, &root, nodes, gltf_meshes);
+    // The file, its only scene and its root node name the same tree.
+    let parts = AssetParts::split(&tree(AssetRoot::File).unwrap());
+    let scene = AssetParts::split(&tree(AssetRoot::Scene(0)).unwrap());
+    let oak = AssetParts::split(&tree(AssetRoot::Node("oak".into())).unwrap());
+    assert_eq!((&scene, &oak), (&parts, &parts));
+    // A node alone: one level, no collider.
+    let far = AssetParts::split(&tree(AssetRoot::Node("oak_LOD1".into())).unwrap());
+    assert_eq!(
+        (far.levels.len(), far.levels[0].len(), far.colliders.len()),
+        (1, 1, 0)
+    );
+    let missing = AssetRoot::Node("elm".into());
+    assert_eq!(
+        tree(missing).unwrap_err(),
+        AssetTreeError::NoSuchNode("elm".into())
+    );
+    assert_eq!(
+        tree(AssetRoot::Scene(1)).unwrap_err(),
+        AssetTreeError::NoSuchScene(1)
+    );
     assert_eq!(parts.levels.len(), 2);
     assert_eq!(parts.levels[0].len(), 2, "bark and leaves near");
     assert_eq!(parts.levels[1].len(), 1, "one card far");

@@ -27,6 +27,69 @@ pub enum AssetTreeError {
     /// The tree nests deeper than [`MAX_ASSET_DEPTH`].
     #[error("the asset's nodes nest deeper than {MAX_ASSET_DEPTH}")]
     TooDeep,
+    /// The file has no node of that name.
+    #[error("the asset has no node named {0:?}")]
+    NoSuchNode(String),
+    /// The file has no scene of that index.
+    #[error("the asset has no scene {0}")]
+    NoSuchScene(usize),
+    /// A scene of a file of several is asked for, but the loader kept no source to tell
+    /// which nodes it holds (load it with `GltfLoaderSettings::include_source`).
+    #[error("scene {0} of a file of several scenes needs the file loaded with its source")]
+    SceneWithoutSource(usize),
+}
+
+/// Which part of a file is the asset.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum AssetRoot {
+    /// Every root node of the file.
+    #[default]
+    File,
+    /// The root nodes of a scene (`"oak.glb#Scene0"` is scene 0).
+    Scene(usize),
+    /// A node, by name, and what is under it.
+    Node(String),
+}
+
+/// The tree of `root` in a loaded file: a nameless root at the origin over the scene's or
+/// the file's root nodes, or the named node itself.
+pub fn asset_tree(
+    gltf: &Gltf,
+    root: &AssetRoot,
+    nodes: &Assets<GltfNode>,
+    meshes: &Assets<GltfMesh>,
+) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
+    match root {
+        AssetRoot::File => file_tree(gltf, nodes, meshes),
+        AssetRoot::Node(name) => {
+            let node = gltf
+                .named_nodes
+                .get(name.as_str())
+                .ok_or_else(|| AssetTreeError::NoSuchNode(name.clone()))?;
+            node_tree(node, nodes, meshes)
+        }
+        AssetRoot::Scene(index) => {
+            if *index >= gltf.scenes.len() {
+                return Err(AssetTreeError::NoSuchScene(*index));
+            }
+            let Some(source) = &gltf.source else {
+                return match gltf.scenes.len() {
+                    1 => file_tree(gltf, nodes, meshes),
+                    _ => Err(AssetTreeError::SceneWithoutSource(*index)),
+                };
+            };
+            let scene = source
+                .scenes()
+                .nth(*index)
+                .ok_or(AssetTreeError::NoSuchScene(*index))?;
+            let trees = scene
+                .nodes()
+                .filter_map(|n| gltf.nodes.get(n.index()))
+                .map(|root| node_tree(root, nodes, meshes))
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(AssetNode::new("", Transform::IDENTITY).with_children(trees))
+        }
+    }
 }
 
 /// The tree under `node`, read from the loaded file's node and mesh assets.

@@ -7,5 +7,7 @@ mod file;
 mod parts;
 
 #[cfg(feature = "gltf")]
-pub use file::{AssetPrimitive, AssetTreeError, MAX_ASSET_DEPTH, file_tree, node_tree};
+pub use file::{
+    AssetPrimitive, AssetRoot, AssetTreeError, MAX_ASSET_DEPTH, asset_tree, file_tree, node_tree,
+};
 pub use parts::{AssetNode, AssetParts, NodeRole, Placed};
