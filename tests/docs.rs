@@ -6,13 +6,14 @@
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Every file under `dir` (relative to the root), build outputs and Git's folder left out.
-fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+/// Every file under `dir` (absolute paths), build outputs and Git's folder left out.
+fn walk_absolute(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = fs::read_dir(dir) else {
         return;
     };
@@ -24,11 +25,35 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
             continue;
         }
         if path.is_dir() {
-            walk(&path, out);
+            walk_absolute(&path, out);
         } else {
-            out.push(path.strip_prefix(root()).unwrap().to_path_buf());
+            out.push(path);
         }
     }
+}
+
+/// Every file under `dir` (relative to the root), build outputs and Git's folder left out.
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut found = Vec::new();
+    walk_absolute(dir, &mut found);
+    out.extend(
+        found
+            .into_iter()
+            .map(|p| p.strip_prefix(root()).unwrap().to_path_buf()),
+    );
+}
+
+/// The text of every file in `all` with one of `extensions`, where tests and functions
+/// named by the pages must be found.
+fn sources(all: &[PathBuf], extensions: &[&str]) -> String {
+    all.iter()
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|e| extensions.iter().any(|x| e == *x))
+        })
+        .filter_map(|p| fs::read_to_string(root().join(p)).ok())
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 fn files() -> Vec<PathBuf> {
@@ -292,15 +317,7 @@ fn is_test_name(span: &str) -> bool {
 #[test]
 fn every_file_module_and_test_the_architecture_and_testing_pages_name_exists() {
     let all = files();
-    let sources: String = all
-        .iter()
-        .filter(|p| {
-            p.extension()
-                .is_some_and(|e| e == "rs" || e == "py" || e == "sh")
-        })
-        .filter_map(|p| fs::read_to_string(root().join(p)).ok())
-        .collect::<Vec<_>>()
-        .join("\n");
+    let sources = sources(&all, &["rs", "py", "sh"]);
     let mut missing = Vec::new();
     for page in ["docs/ARCHITECTURE.md", "TESTING.md", "CONTRIBUTING.md"] {
         let page = Path::new(page);
@@ -456,16 +473,12 @@ fn missing_names(text: &str, at: &Path, all: &[PathBuf]) -> Vec<String> {
             }
             _ => None,
         };
-        if let Some(name) = target("--example") {
-            let found = all.iter().any(|f| {
-                f.components().any(|c| c.as_os_str() == "examples")
-                    && (f.ends_with(format!("{name}.rs")) || f.ends_with(format!("{name}/main.rs")))
-            });
-            if !found {
-                out.push(format!("{}: no example {name}", at.display()));
-            }
-        }
-        for (kind, folder) in [("--bench", "benches"), ("--test", "tests")] {
+        let targets = [
+            ("--example", "examples"),
+            ("--bench", "benches"),
+            ("--test", "tests"),
+        ];
+        for (kind, folder) in targets {
             let Some(name) = target(kind) else { continue };
             let found = all.iter().any(|f| {
                 f.components().any(|c| c.as_os_str() == folder)
@@ -482,12 +495,7 @@ fn missing_names(text: &str, at: &Path, all: &[PathBuf]) -> Vec<String> {
 #[test]
 fn every_script_example_test_and_file_the_docs_name_exists() {
     let all = files();
-    let sources: String = all
-        .iter()
-        .filter(|p| p.extension().is_some_and(|e| e == "rs" || e == "py"))
-        .filter_map(|p| fs::read_to_string(root().join(p)).ok())
-        .collect::<Vec<_>>()
-        .join("\n");
+    let sources = sources(&all, &["rs", "py"]);
     let mut missing = Vec::new();
     let mut texts: Vec<(PathBuf, String)> = pages()
         .into_iter()
@@ -499,18 +507,10 @@ fn every_script_example_test_and_file_the_docs_name_exists() {
     texts.extend(script_and_crate_docs());
     for (file, text) in &texts {
         missing.extend(missing_names(text, file, &all));
-        // Tests by name, on the pages that point users and contributors at them (the notes
-        // pages also name functions of Mesa and fields the benches print).
-        let points_at_tests = file.starts_with("docs/guide")
-            || [
-                "README.md",
-                "docs/ARCHITECTURE.md",
-                "TESTING.md",
-                "CONTRIBUTING.md",
-            ]
-            .iter()
-            .any(|p| file == Path::new(p));
-        if points_at_tests {
+        // Tests by name, on the users' pages that point at them (ARCHITECTURE, TESTING and
+        // CONTRIBUTING are read by the test above; the notes pages also name functions of
+        // Mesa and fields the benches print).
+        if file.starts_with("docs/guide") || file == Path::new("README.md") {
             for span in code_spans(text).iter().filter(|s| is_test_name(s)) {
                 if !mentions(&sources, span) {
                     missing.push(format!("{}: no test or function {span}", file.display()));
@@ -585,7 +585,42 @@ struct Known {
     defined: BTreeSet<String>,
 }
 
-fn known_names() -> Known {
+/// The Rust sources of the dependencies whose names the docs use (Bevy's crates, glam,
+/// avian and parry, wgpu and naga, image, noise), from cargo's registry.
+fn dependency_sources() -> Vec<PathBuf> {
+    const DEPENDENCIES: [&str; 8] = [
+        "bevy", "glam-", "avian3d-", "parry3d-", "wgpu-", "naga-", "image-", "noise-",
+    ];
+    let home = std::env::var_os("CARGO_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".cargo")));
+    let registries = home
+        .map(|h| h.join("registry/src"))
+        .and_then(|r| fs::read_dir(r).ok());
+    let mut out = Vec::new();
+    for registry in registries.into_iter().flatten().flatten() {
+        for package in fs::read_dir(registry.path())
+            .into_iter()
+            .flatten()
+            .flatten()
+        {
+            let name = package.file_name().to_string_lossy().into_owned();
+            if DEPENDENCIES.iter().any(|p| name.starts_with(p)) && !name.starts_with("bevy-") {
+                walk_absolute(&package.path().join("src"), &mut out);
+            }
+        }
+    }
+    out.retain(|f| f.extension().is_some_and(|e| e == "rs"));
+    out
+}
+
+/// The names, read once for all the tests that need them.
+fn known_names() -> &'static Known {
+    static KNOWN: OnceLock<Known> = OnceLock::new();
+    KNOWN.get_or_init(read_known_names)
+}
+
+fn read_known_names() -> Known {
     const OTHERS: [&str; 25] = [
         "Some",
         "None",
@@ -615,60 +650,25 @@ fn known_names() -> Known {
     ];
     let mut public: BTreeSet<String> = OTHERS.iter().map(|s| s.to_string()).collect();
     let mut defined = BTreeSet::new();
-    let mut sources = Vec::new();
+    let mut ours = Vec::new();
     for top in ["crates", "src", "examples", "fuzz"] {
-        walk(&root().join(top), &mut sources);
+        walk_absolute(&root().join(top), &mut ours);
     }
-    let home = std::env::var_os("CARGO_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".cargo")));
-    let registries = home
-        .map(|h| h.join("registry/src"))
-        .and_then(|r| fs::read_dir(r).ok());
-    for registry in registries.into_iter().flatten().flatten() {
-        for package in fs::read_dir(registry.path())
-            .into_iter()
-            .flatten()
-            .flatten()
-        {
-            let name = package.file_name().to_string_lossy().into_owned();
-            let ours = [
-                "bevy", "glam-", "avian3d-", "parry3d-", "wgpu-", "naga-", "image-", "noise-",
-            ];
-            if ours.iter().any(|p| name.starts_with(p)) && !name.starts_with("bevy-") {
-                let mut found = Vec::new();
-                walk_absolute(&package.path().join("src"), &mut found);
-                sources.extend(found);
-            }
-        }
-    }
-    for file in sources
+    for file in ours
         .iter()
         .filter(|f| f.extension().is_some_and(|e| e == "rs"))
     {
-        let (path, ours) = match file.is_absolute() {
-            true => (file.clone(), false),
-            false => (root().join(file), true),
-        };
-        let text = fs::read_to_string(path).unwrap_or_default();
-        let mut private = BTreeSet::new();
-        let defined_here = if ours { &mut defined } else { &mut private };
-        type_names(&text, &mut public, defined_here);
+        let text = fs::read_to_string(file).unwrap_or_default();
+        type_names(&text, &mut public, &mut defined);
+    }
+    // The dependencies' private types are none of the docs' business.
+    let mut private = BTreeSet::new();
+    for file in dependency_sources() {
+        let text = fs::read_to_string(file).unwrap_or_default();
+        type_names(&text, &mut public, &mut private);
     }
     defined.extend(public.iter().cloned());
     Known { public, defined }
-}
-
-/// Every file under an absolute `dir`.
-fn walk_absolute(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in fs::read_dir(dir).into_iter().flatten().flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            walk_absolute(&path, out);
-        } else {
-            out.push(path);
-        }
-    }
 }
 
 /// The capitalised names in the code spans of `text` followed by `::` or `(`, which must
@@ -746,15 +746,15 @@ fn the_name_checks_catch_a_missing_script_and_an_unknown_type() {
         missing_names("cargo test --test no_such_test", page, &all).len(),
         1
     );
-    let known = known_names().public;
+    let known = &known_names().public;
     let good = "`ScatterClass::instanced(..)` `Transform::from_xyz(0.0)` `DVec2::ZERO`";
-    assert!(unknown_types(good, page, &known).is_empty());
+    assert!(unknown_types(good, page, known).is_empty());
     let stale = "a `SceneRoot(handle)` and `InstancedMaterial::default()`";
-    assert_eq!(unknown_types(stale, page, &known).len(), 2);
+    assert_eq!(unknown_types(stale, page, known).len(), 2);
     // Variants count as names: layer files write them.
-    assert!(unknown_types("`Constant(40.0)` `Within(30.0)`", page, &known).is_empty());
+    assert!(unknown_types("`Constant(40.0)` `Within(30.0)`", page, known).is_empty());
     // A private type is not for users' pages.
-    assert_eq!(unknown_types("`Generator::points`", page, &known).len(), 1);
+    assert_eq!(unknown_types("`Generator::points`", page, known).len(), 1);
 }
 
 #[test]

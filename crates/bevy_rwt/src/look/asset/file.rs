@@ -5,6 +5,7 @@
 use super::parts::AssetNode;
 use bevy::gltf::{Gltf, GltfMaterial, GltfMesh, GltfNode};
 use bevy::prelude::*;
+use std::collections::HashSet;
 
 /// The deepest node tree read (glTF forbids cycles; a file that nests deeper is refused).
 pub const MAX_ASSET_DEPTH: usize = 64;
@@ -82,12 +83,8 @@ pub fn asset_tree(
                 .scenes()
                 .nth(*index)
                 .ok_or(AssetTreeError::NoSuchScene(*index))?;
-            let trees = scene
-                .nodes()
-                .filter_map(|n| gltf.nodes.get(n.index()))
-                .map(|root| node_tree(root, nodes, meshes))
-                .collect::<Result<Vec<_>, _>>()?;
-            Ok(AssetNode::new("", Transform::IDENTITY).with_children(trees))
+            let roots = scene.nodes().filter_map(|n| gltf.nodes.get(n.index()));
+            roots_tree(roots, nodes, meshes)
         }
     }
 }
@@ -108,7 +105,7 @@ pub fn file_tree(
     nodes: &Assets<GltfNode>,
     meshes: &Assets<GltfMesh>,
 ) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
-    let mut children = Vec::new();
+    let mut children = HashSet::new();
     for handle in &gltf.nodes {
         let node = nodes
             .get(handle)
@@ -116,6 +113,15 @@ pub fn file_tree(
         children.extend(node.children.iter().map(Handle::id));
     }
     let roots = gltf.nodes.iter().filter(|h| !children.contains(&h.id()));
+    roots_tree(roots, nodes, meshes)
+}
+
+/// A nameless root at the origin over the trees of `roots`.
+fn roots_tree<'a>(
+    roots: impl Iterator<Item = &'a Handle<GltfNode>>,
+    nodes: &Assets<GltfNode>,
+    meshes: &Assets<GltfMesh>,
+) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
     let trees = roots
         .map(|root| node_tree(root, nodes, meshes))
         .collect::<Result<Vec<_>, _>>()?;

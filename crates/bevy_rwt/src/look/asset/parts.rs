@@ -4,6 +4,7 @@
 //! `-convcolonly` (Godot). Each part keeps its transform relative to the asset's root.
 
 use bevy::prelude::*;
+use std::collections::BTreeMap;
 
 /// A node of an asset's tree as the file gives it: a name, a transform relative to its
 /// parent, the primitives it draws (`P`: a mesh and its material) and its children.
@@ -107,27 +108,20 @@ impl<P: Clone> AssetParts<P> {
     /// Splits the tree under `root` (whose own transform is the asset's frame, left out).
     pub fn split(root: &AssetNode<P>) -> Self {
         let mut found = Found {
-            levels: Vec::new(),
+            levels: BTreeMap::new(),
             shared: Vec::new(),
             colliders: Vec::new(),
         };
+        found.place(&root.primitives, Transform::IDENTITY, Bin::Shared);
         for child in &root.children {
-            found.walk(child, Transform::IDENTITY, None);
+            found.walk(child, Transform::IDENTITY, Bin::Shared);
         }
-        let identity = Transform::IDENTITY;
-        found
-            .shared
-            .extend(root.primitives.iter().cloned().map(|primitive| Placed {
-                primitive,
-                transform: identity,
-            }));
-        found.levels.sort_by_key(|(level, _)| *level);
         let levels = match found.levels.is_empty() {
             true => vec![found.shared],
             false => found
                 .levels
-                .into_iter()
-                .map(|(_, mut parts)| {
+                .into_values()
+                .map(|mut parts| {
                     parts.extend(found.shared.iter().cloned());
                     parts
                 })
@@ -140,61 +134,52 @@ impl<P: Clone> AssetParts<P> {
     }
 }
 
+/// Where a node's primitives go.
+#[derive(Clone, Copy)]
+enum Bin {
+    /// Drawn at every level: under no level node.
+    Shared,
+    /// Drawn at this level only.
+    Level(u32),
+    /// Never drawn: under a collider node.
+    Collider,
+}
+
 /// The parts found so far, while walking the tree.
 struct Found<P> {
-    /// Each named level's parts, by level number.
-    levels: Vec<(u32, Vec<Placed<P>>)>,
+    /// Each named level's parts, in the order of the levels' numbers.
+    levels: BTreeMap<u32, Vec<Placed<P>>>,
     /// Parts under no level node.
     shared: Vec<Placed<P>>,
     colliders: Vec<Placed<P>>,
 }
 
 impl<P: Clone> Found<P> {
-    /// Adds `node` (under `parent`, relative to the root) and what is under it; `level` is
-    /// the level node above it, if any. A collider's subtree is all collider.
-    fn walk(&mut self, node: &AssetNode<P>, parent: Transform, level: Option<u32>) {
+    /// Adds `node` (under `parent`, relative to the root) and what is under it; `bin` is
+    /// where its parent's primitives went. A collider's subtree is all collider.
+    fn walk(&mut self, node: &AssetNode<P>, parent: Transform, bin: Bin) {
         let transform = parent.mul_transform(node.transform);
-        let role = NodeRole::of(&node.name);
-        if role == NodeRole::Collider {
-            self.collect_collider(node, parent);
-            return;
-        }
-        let level = match role {
-            NodeRole::Level(n) => Some(n),
-            _ => level,
+        let bin = match (bin, NodeRole::of(&node.name)) {
+            (Bin::Collider, _) | (_, NodeRole::Collider) => Bin::Collider,
+            (_, NodeRole::Level(n)) => Bin::Level(n),
+            (bin, NodeRole::Plain) => bin,
         };
-        let placed = node.primitives.iter().cloned().map(|primitive| Placed {
-            primitive,
-            transform,
-        });
-        match level {
-            Some(n) => {
-                let index = match self.levels.iter().position(|(l, _)| *l == n) {
-                    Some(index) => index,
-                    None => {
-                        self.levels.push((n, Vec::new()));
-                        self.levels.len() - 1
-                    }
-                };
-                self.levels[index].1.extend(placed);
-            }
-            None => self.shared.extend(placed),
-        }
+        self.place(&node.primitives, transform, bin);
         for child in &node.children {
-            self.walk(child, transform, level);
+            self.walk(child, transform, bin);
         }
     }
 
-    fn collect_collider(&mut self, node: &AssetNode<P>, parent: Transform) {
-        let transform = parent.mul_transform(node.transform);
-        self.colliders
-            .extend(node.primitives.iter().cloned().map(|primitive| Placed {
-                primitive,
-                transform,
-            }));
-        for child in &node.children {
-            self.collect_collider(child, transform);
-        }
+    fn place(&mut self, primitives: &[P], transform: Transform, bin: Bin) {
+        let parts = match bin {
+            Bin::Shared => &mut self.shared,
+            Bin::Level(n) => self.levels.entry(n).or_default(),
+            Bin::Collider => &mut self.colliders,
+        };
+        parts.extend(primitives.iter().cloned().map(|primitive| Placed {
+            primitive,
+            transform,
+        }));
     }
 }
 
