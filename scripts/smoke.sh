@@ -14,8 +14,10 @@
 # per instance on the GPU is the frame drawn whole and its indirect counts are the CPU's, and
 # gpu_occlusion, which fails unless a camera rising over a hill, occluding, draws the frame
 # drawn whole (the blades peeking over the crest included) and occlusion dropped instances,
-# and impostor_match, which fails unless trees drawn as impostors cover the pixels their
-# meshes cover (silhouette IoU >= 0.8), coloured alike, culled per instance as the CPU does.
+# impostor_match, which fails unless trees drawn as impostors cover the pixels their meshes
+# cover (silhouette IoU >= 0.8), coloured alike, culled per instance as the CPU does, and
+# asset_match, which fails unless a glTF asset drawn instanced covers the pixels Bevy's own
+# scene entities of it cover (silhouette IoU >= 0.98, each primitive's colour in its place).
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -27,10 +29,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match)
+examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -104,6 +106,11 @@ for run in "${runs[@]}"; do
     if [ "$ex" = impostor_match ]; then
         # Impostors: trees as cards cover their meshes' pixels, coloured alike.
         self_checked RWT_IMPOSTOR_DIR=$out/impostor rwt-impostor 'trees'
+        continue
+    fi
+    if [ "$ex" = asset_match ]; then
+        # Assets: rwt's instanced draw of a glTF asset against Bevy's scene entities.
+        self_checked RWT_ASSET_DIR=$out/asset rwt-asset 'instances'
         continue
     fi
     # CI's runs take fewer frames than the 150 of the docs' (the same checks): open_world

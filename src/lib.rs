@@ -79,6 +79,8 @@ pub struct ReadmeDoctests;
 pub mod guide {
     #[doc = include_str!("../docs/guide/acting.md")]
     pub struct Acting;
+    #[doc = include_str!("../docs/guide/assets.md")]
+    pub struct Assets;
     #[doc = include_str!("../docs/guide/examples.md")]
     pub struct Examples;
     #[doc = include_str!("../docs/guide/ground.md")]

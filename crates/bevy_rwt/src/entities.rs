@@ -343,5 +343,7 @@ fn spawn_instance(commands: &mut Commands, spawner: &Spawner, p: &Point) -> Enti
         }
         // Packed in the generation task instead; never queued for spawning.
         (ClassLook::Instanced(_), _) => commands.spawn((instance, transform)).id(),
+        #[cfg(feature = "gltf")]
+        (ClassLook::Asset(_), _) => commands.spawn((instance, transform)).id(),
     }
 }

@@ -113,9 +113,26 @@ pub struct ScatterPicking<'w, 's> {
     layers: Query<'w, 's, (Entity, &'static ScatterLayer, &'static LayerState)>,
     footprints: Res<'w, KnownFootprints>,
     meshes: Option<Res<'w, Assets<Mesh>>>,
+    #[cfg(feature = "gltf")]
+    assets: Option<Res<'w, crate::instancing::ResolvedAssets>>,
 }
 
 impl ScatterPicking<'_, '_> {
+    /// The bounds of a class's look at scale 1 (`None`: not known yet, or code's own).
+    fn look_bounds(&self, look: &ClassLook) -> Option<(Vec3, Vec3)> {
+        let mesh_bounds = |mesh: &Handle<Mesh>| {
+            let aabb = self.meshes.as_deref()?.get(mesh)?.compute_aabb()?;
+            Some((Vec3::from(aabb.min()), Vec3::from(aabb.max())))
+        };
+        match look {
+            ClassLook::Mesh { mesh, .. } => mesh_bounds(mesh),
+            ClassLook::Instanced(look) => mesh_bounds(&look.mesh),
+            ClassLook::Custom(_) => None,
+            #[cfg(feature = "gltf")]
+            ClassLook::Asset(look) => Some(self.assets.as_deref()?.ready(look)?.bounds),
+        }
+    }
+
     /// The nearest instance `ray` enters within the filter's distance.
     pub fn cast_ray(&self, ray: Ray3d, filter: &PickFilter) -> Option<ScatterHit> {
         let mut best: Option<ScatterHit> = None;
@@ -123,7 +140,7 @@ impl ScatterPicking<'_, '_> {
             let Some(shown) = state.shown(layer) else {
                 continue;
             };
-            let bounds = ClassBounds::of(layer, self.meshes.as_deref());
+            let bounds = ClassBounds::of(layer, |look| self.look_bounds(look));
             let segment = ground_segment(ray, filter.max_distance, layer.plane);
             let reach = bounds.reach(layer);
             let near = |r: &Rect| segment_meets(segment, &grow(r, reach));
@@ -233,20 +250,14 @@ impl ClassBounds {
     /// A unit box standing on the ground: the bounds of a class without mesh or pick bounds.
     const UNIT: (Vec3, Vec3) = (Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 1.0, 0.5));
 
-    fn of(layer: &ScatterLayer, meshes: Option<&Assets<Mesh>>) -> Self {
-        let mesh_bounds = |mesh: &Handle<Mesh>| {
-            let aabb = meshes?.get(mesh)?.compute_aabb()?;
-            Some((Vec3::from(aabb.min()), Vec3::from(aabb.max())))
-        };
+    /// The bounds of `layer`'s classes: their pick bounds, else their looks' (`look_bounds`),
+    /// else a unit box.
+    fn of(layer: &ScatterLayer, look_bounds: impl Fn(&ClassLook) -> Option<(Vec3, Vec3)>) -> Self {
         let bounds = layer.classes.iter().map(|class| {
-            class.pick_bounds.unwrap_or_else(|| {
-                match &class.look {
-                    ClassLook::Mesh { mesh, .. } => mesh_bounds(mesh),
-                    ClassLook::Instanced(look) => mesh_bounds(&look.mesh),
-                    ClassLook::Custom(_) => None,
-                }
+            class
+                .pick_bounds
+                .or_else(|| look_bounds(&class.look))
                 .unwrap_or(Self::UNIT)
-            })
         });
         Self(bounds.collect())
     }

@@ -139,6 +139,8 @@ fn baked_look(class: &ScatterClass) -> Option<(&Handle<Mesh>, BakedLook<'_>, &Im
             (mesh, BakedLook::Shading(&look.material), impostor)
         }
         (ClassLook::Custom(_), _) => return None,
+        #[cfg(feature = "gltf")]
+        (ClassLook::Asset(_), _) => return None,
     })
 }
 

@@ -2,6 +2,7 @@
 //! in an [`InstanceBuffer`], carried by an [`InstancedChunk`] entity.
 
 use crate::look::InstancedShading;
+use crate::look::asset::InstancedSurface;
 use bevy::camera::primitives::Aabb;
 use bevy::camera::visibility::{self, VisibilityClass};
 use bevy::prelude::*;
@@ -100,6 +101,10 @@ pub struct InstancedChunk {
     pub far_per_instance: bool,
     /// The shading.
     pub material: InstancedShading,
+    /// An asset's primitive: its material, lit as Bevy's PBR lights a glTF material (then
+    /// `material` gives the colour variation, wind, bend, fade and shadows, and mirrors the
+    /// surface's base colour, texture, roughness and cut-off).
+    pub surface: Option<InstancedSurface>,
     /// Height of the mesh's top above its origin (the tip, which sways most).
     pub mesh_top: f32,
     /// Largest scale of the class's instances (for the chunk's bounds).

@@ -111,7 +111,8 @@ pub(super) fn refit_changed_meshes(
     if changed.is_empty() {
         return;
     }
-    for (mut chunk, mut aabb) in &mut chunks {
+    // An asset's parts are bounded by the whole asset: redrawn when it is resolved again.
+    for (mut chunk, mut aabb) in chunks.iter_mut().filter(|(c, _)| c.surface.is_none()) {
         let (near, far) = &chunk.meshes;
         let drawn = far.as_ref().map(|f| &f.mesh).into_iter().chain([near]);
         if drawn.into_iter().any(|m| changed.contains(&m.id())) {
@@ -130,6 +131,8 @@ pub(super) struct ClassAssets<'w> {
     meshes: Option<Res<'w, Assets<Mesh>>>,
     images: Option<Res<'w, Assets<Image>>>,
     server: Option<Res<'w, AssetServer>>,
+    #[cfg(feature = "gltf")]
+    assets: Option<Res<'w, super::ResolvedAssets>>,
 }
 
 impl ClassAssets<'_> {
@@ -168,8 +171,19 @@ pub(super) fn report_class_errors(
             .iter()
             .enumerate()
             .filter_map(|(i, class)| {
-                let ClassLook::Instanced(look) = &class.look else {
-                    return None;
+                let look = match &class.look {
+                    ClassLook::Instanced(look) => look,
+                    #[cfg(feature = "gltf")]
+                    ClassLook::Asset(look) if layer.plane == GroundPlane::Xz => {
+                        let resolved = assets.assets.as_deref()?.get(look)?;
+                        let e = resolved.as_ref().err()?.clone();
+                        return Some((i as u16, InstancedClassError::Asset(Box::new(e))));
+                    }
+                    #[cfg(feature = "gltf")]
+                    ClassLook::Asset(_) => {
+                        return Some((i as u16, InstancedClassError::Plane(layer.plane)));
+                    }
+                    _ => return None,
                 };
                 if layer.plane != GroundPlane::Xz {
                     return Some((i as u16, InstancedClassError::Plane(layer.plane)));

@@ -13,6 +13,8 @@
 //! layer with a [`Falloff`](rwt_core::streaming::Falloff) neither pops when chunks change
 //! band nor at the streaming edge.
 
+#[cfg(feature = "gltf")]
+mod assets;
 mod bend;
 mod chunk;
 mod far;
@@ -24,6 +26,8 @@ mod queue;
 mod render;
 mod settings;
 
+#[cfg(feature = "gltf")]
+pub use assets::ResolvedAssets;
 pub use bend::{BEND_FIELD_TEXELS, BEND_RECOVERY, BEND_TEXEL, BendField, Bender};
 pub use chunk::{
     GPU_BYTES_PER_INSTANCE, GpuInstance, ImpostorDraw, InstanceBuffer, InstancedChunk,
@@ -32,7 +36,7 @@ pub use mesh::InstancedMeshes;
 pub(crate) use pack::{InstancedClasses, PackedClass};
 pub use plugin::RwtInstancingPlugin;
 pub use promote::PromotedInstance;
-pub(crate) use queue::{InstancedQueue, Upload};
+pub(crate) use queue::{InstancedQueue, UploadSources};
 #[cfg(feature = "testing")]
 pub use render::{CullingCheck, CullingReport};
 pub use settings::{CascadeCasters, InstanceCulling, RwtFadeIn, RwtWind};

@@ -50,7 +50,7 @@ impl InstancedClasses {
             .classes
             .iter()
             .map(|c| match (&c.look, &c.impostor) {
-                (ClassLook::Instanced(_), _) => Some(PackedLook {
+                (look, _) if look.is_instanced() => Some(PackedLook {
                     scale: c.scale,
                     variation: c.scale_variation,
                     stance: c.stance,

@@ -156,7 +156,7 @@ impl Moved<'_> {
         let mut e = commands.spawn((instance, transform, Visibility::default(), PromotedInstance));
         (self.promotion.insert)(&mut e);
         let parent = e.id();
-        if let Some((component, aabb)) = upload.component(self.target, self.class, Arc::new(one)) {
+        for (component, aabb) in upload.parts(self.target, self.class, Arc::new(one)) {
             commands.spawn((component, aabb, undo, ChildOf(parent)));
         }
         parent

@@ -11,7 +11,7 @@ use crate::impostor::{ImpostorAtlas, ImpostorAtlases};
 use crate::layers::ScatterClass;
 use crate::layers::ScatterLayer;
 use crate::look::ClassLook;
-use crate::look::{InstancedShading, InstancedShadows};
+use crate::look::{InstancedLook, InstancedShading, InstancedShadows};
 use bevy::camera::primitives::Aabb;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -22,9 +22,10 @@ use std::sync::Arc;
 
 /// A chunk's instances of one class.
 pub(super) struct ClassBuffer {
-    /// The entity drawing the instances that are not promoted (none when there are none,
-    /// or the class is drawn as entities).
-    pub entity: Option<Entity>,
+    /// The entities drawing the instances that are not promoted: one per part of the
+    /// class's look (one for an instanced class, one per primitive of an asset's level);
+    /// none when no instance is left, or the class is drawn as entities.
+    pub parts: Vec<Entity>,
     /// The entity drawing them as impostors, for a class with an impostor once its atlas is
     /// baked.
     pub impostor: Option<Entity>,
@@ -53,15 +54,16 @@ pub(crate) struct InstancedQueue {
     /// Entities of unloaded chunks (chunk entities, promoted instances): despawned at once,
     /// whatever the budget.
     retired: Vec<Entity>,
-    /// [`ImpostorAtlases::generation`] when impostor chunks were last drawn.
-    impostors_seen: u64,
+    /// [`Upload::generation`] when impostor and asset chunks were last drawn.
+    generation_seen: (u64, u64),
 }
 
 impl ClassBuffer {
     /// Every entity it holds.
     fn entities(&self) -> impl Iterator<Item = Entity> + '_ {
-        self.entity
-            .into_iter()
+        self.parts
+            .iter()
+            .copied()
             .chain(self.impostor)
             .chain(self.promoted.values().copied())
     }
@@ -173,6 +175,9 @@ pub(crate) struct Upload<'a> {
     first: bool,
     /// The impostor atlases baked so far.
     impostors: Option<&'a ImpostorAtlases>,
+    /// The asset classes' looks resolved so far.
+    #[cfg(feature = "gltf")]
+    assets: Option<&'a super::assets::ResolvedAssets>,
 }
 
 /// A layer's chunk: where buffers of its classes go.
@@ -183,34 +188,55 @@ pub(super) struct Target<'a> {
     pub chunk: ChunkCoord,
 }
 
-impl<'a> Upload<'a> {
+/// What a frame's hand-over reads: the meshes and their checks, the baked impostor
+/// atlases, the resolved assets.
+#[derive(bevy::ecs::system::SystemParam)]
+pub(crate) struct UploadSources<'w> {
+    meshes: Option<Res<'w, Assets<Mesh>>>,
+    checked: ResMut<'w, InstancedMeshes>,
+    impostors: Option<Res<'w, ImpostorAtlases>>,
+    #[cfg(feature = "gltf")]
+    assets: Option<Res<'w, super::assets::ResolvedAssets>>,
+}
+
+impl UploadSources<'_> {
     /// A frame's hand-over of up to `budget` instances (at least one chunk).
-    pub fn new(
-        budget: usize,
-        meshes: Option<&'a Assets<Mesh>>,
-        checked: &'a mut InstancedMeshes,
-        impostors: Option<&'a ImpostorAtlases>,
-    ) -> Self {
-        Self {
+    pub fn upload(&mut self, budget: usize) -> Upload<'_> {
+        Upload {
             budget,
-            meshes,
-            checked,
+            meshes: self.meshes.as_deref(),
+            checked: &mut self.checked,
             first: true,
-            impostors,
+            impostors: self.impostors.as_deref(),
+            #[cfg(feature = "gltf")]
+            assets: self.assets.as_deref(),
         }
     }
+}
 
-    /// Draws again the impostor classes of every chunk when atlases were baked since the
-    /// queue last looked (chunks handed over before their class's atlas drew nothing).
-    pub fn refresh_impostors(
+impl<'a> Upload<'a> {
+    /// What the chunks of classes drawn from baked or loaded assets were last drawn with:
+    /// impostor atlases' and resolved assets' generations.
+    fn generation(&self) -> (u64, u64) {
+        let impostors = self.impostors.map_or(0, ImpostorAtlases::generation);
+        #[cfg(feature = "gltf")]
+        let assets = self.assets.map_or(0, |a| a.generation());
+        #[cfg(not(feature = "gltf"))]
+        let assets = 0;
+        (impostors, assets)
+    }
+
+    /// Draws again the impostor and asset classes of every chunk when atlases were baked or
+    /// assets resolved since the queue last looked (chunks handed over before drew nothing).
+    pub fn refresh_classes(
         &mut self,
         commands: &mut Commands,
         entity: Entity,
         layer: &ScatterLayer,
         queue: &mut InstancedQueue,
     ) {
-        let generation = self.impostors.map_or(0, ImpostorAtlases::generation);
-        if std::mem::replace(&mut queue.impostors_seen, generation) == generation {
+        let generation = self.generation();
+        if std::mem::replace(&mut queue.generation_seen, generation) == generation {
             return;
         }
         for (chunk, c) in queue.chunks.iter_mut() {
@@ -220,8 +246,14 @@ impl<'a> Upload<'a> {
                 chunk: *chunk,
             };
             for (class, buffer) in c.classes.iter_mut() {
-                let impostor = layer.classes.get(*class as usize).and_then(|c| c.impostor);
-                if impostor.is_some() {
+                let refreshed = layer.classes.get(*class as usize).is_some_and(|c| {
+                    #[cfg(feature = "gltf")]
+                    if matches!(c.look, ClassLook::Asset(_)) {
+                        return true;
+                    }
+                    c.impostor.is_some()
+                });
+                if refreshed {
                     self.redraw(commands, target, *class, buffer);
                 }
             }
@@ -273,9 +305,10 @@ impl<'a> Upload<'a> {
         slot: Option<ClassBuffer>,
         packed: PackedClass,
     ) -> Option<(u16, ClassBuffer)> {
-        let (entity, impostor, mut promoted) = slot.map_or((None, None, HashMap::new()), |s| {
-            (s.entity, s.impostor, s.promoted)
-        });
+        let (parts, impostor, mut promoted) = slot
+            .map_or((Vec::new(), None, HashMap::new()), |s| {
+                (s.parts, s.impostor, s.promoted)
+            });
         // Promoted instances that are no longer in the buffer go (only promoted classes
         // have any).
         if !promoted.is_empty() {
@@ -289,7 +322,7 @@ impl<'a> Upload<'a> {
             });
         }
         let mut class = ClassBuffer {
-            entity,
+            parts,
             impostor,
             whole: packed.buffer,
             promoted,
@@ -314,14 +347,14 @@ impl<'a> Upload<'a> {
                 buffer.promoted.contains_key(id)
             }))
         };
-        let (mesh, impostor) = match drawn.instances.is_empty() {
-            true => (None, None),
+        let (parts, impostor) = match drawn.instances.is_empty() {
+            true => (Vec::new(), None),
             false => (
-                self.component(target, class, drawn.clone()),
+                self.parts(target, class, drawn.clone()),
                 self.impostor_component(target, class, drawn),
             ),
         };
-        place(commands, target, &mut buffer.entity, mesh);
+        place_all(commands, target, &mut buffer.parts, parts);
         place(commands, target, &mut buffer.impostor, impostor);
     }
 
@@ -340,19 +373,39 @@ impl<'a> Upload<'a> {
         Some((component, aabb))
     }
 
-    /// The component drawing `buffer` of a class of the target's layer, with its bounds
-    /// (`None` when the class is not instanced).
-    pub(super) fn component(
+    /// The components drawing `buffer` of a class of the target's layer, with their bounds:
+    /// one for an instanced class, one per primitive for an asset class once resolved, none
+    /// for other classes.
+    pub(super) fn parts(
         &mut self,
         target: Target,
         class: u16,
         buffer: Arc<InstanceBuffer>,
-    ) -> Option<(InstancedChunk, Aabb)> {
-        let layer = target.layer;
-        let c = layer.classes.get(class as usize)?;
-        let ClassLook::Instanced(look) = &c.look else {
-            return None;
+    ) -> Vec<(InstancedChunk, Aabb)> {
+        let Some(c) = target.layer.classes.get(class as usize) else {
+            return Vec::new();
         };
+        match &c.look {
+            ClassLook::Instanced(look) => vec![self.instanced(target, class, look, buffer)],
+            #[cfg(feature = "gltf")]
+            ClassLook::Asset(look) => match self.assets.and_then(|a| a.ready(look)) {
+                Some(asset) => asset_parts(target, class, (look, asset), buffer),
+                None => Vec::new(),
+            },
+            _ => Vec::new(),
+        }
+    }
+
+    /// The component drawing `buffer` of an instanced class, with its bounds.
+    fn instanced(
+        &mut self,
+        target: Target,
+        class: u16,
+        look: &InstancedLook,
+        buffer: Arc<InstanceBuffer>,
+    ) -> (InstancedChunk, Aabb) {
+        let layer = target.layer;
+        let c = &layer.classes[class as usize];
         // Where its impostors are drawn, the meshes fade out as they fade in.
         let impostors = self.impostors.and_then(|a| a.of(c)).is_some();
         let fade_out = c.impostor.filter(|_| impostors).map(|i| i.band());
@@ -373,10 +426,50 @@ impl<'a> Upload<'a> {
             buffer,
             impostor: None,
             fade_out,
+            surface: None,
         };
         let aabb = component.aabb(self.checked.class_bounds(&component.meshes, self.meshes));
-        Some((component, aabb))
+        (component, aabb)
     }
+}
+
+/// The components drawing `buffer` of an asset class: one per primitive of its nearest
+/// level, each bounded by the whole asset (its top is the wind's and the fade's height).
+#[cfg(feature = "gltf")]
+fn asset_parts(
+    target: Target,
+    class: u16,
+    (look, asset): (
+        &crate::look::asset::AssetLook,
+        &crate::look::asset::ResolvedAsset,
+    ),
+    buffer: Arc<InstanceBuffer>,
+) -> Vec<(InstancedChunk, Aabb)> {
+    let c = &target.layer.classes[class as usize];
+    let level = asset.levels.first().map_or(&[][..], Vec::as_slice);
+    level
+        .iter()
+        .map(|part| {
+            let component = InstancedChunk {
+                layer: target.entity,
+                chunk: target.chunk,
+                class,
+                mesh: part.mesh.clone(),
+                meshes: (part.mesh.clone(), None),
+                far_per_instance: false,
+                material: look.shading(&part.surface),
+                surface: Some(part.surface.clone()),
+                mesh_top: asset.bounds.1.y.max(1e-3),
+                max_scale: c.scale * (1.0 + c.scale_variation.abs()),
+                falloff: layer_falloff(target.layer),
+                buffer: buffer.clone(),
+                impostor: None,
+                fade_out: None,
+            };
+            let aabb = component.aabb(asset.bounds);
+            (component, aabb)
+        })
+        .collect()
 }
 
 /// The layer's level-of-detail fall-off as chunk components carry it.
@@ -427,7 +520,27 @@ fn impostor_chunk(
         falloff: layer_falloff(target.layer),
         buffer,
         impostor: Some(ImpostorDraw { frames, band }),
+        surface: None,
         fade_out: None,
+    }
+}
+
+/// Puts each of `components` on a chunk entity of `slots` (spawned where there are more
+/// components than entities, despawned where there are fewer).
+fn place_all(
+    commands: &mut Commands,
+    target: Target,
+    slots: &mut Vec<Entity>,
+    components: Vec<(InstancedChunk, Aabb)>,
+) {
+    let mut old = std::mem::take(slots).into_iter();
+    for component in components {
+        let mut slot = old.next();
+        place(commands, target, &mut slot, Some(component));
+        slots.extend(slot);
+    }
+    for e in old {
+        commands.entity(e).try_despawn();
     }
 }
 

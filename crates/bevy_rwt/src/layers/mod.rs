@@ -192,6 +192,12 @@ impl ScatterClass {
         Self::with_look(density, ClassLook::Custom(Arc::new(insert)))
     }
 
+    /// A class drawn from a glTF asset, instanced (see [`ClassLook::Asset`]).
+    #[cfg(feature = "gltf")]
+    pub fn asset(density: LayerDensity, look: crate::look::asset::AssetLook) -> Self {
+        Self::with_look(density, ClassLook::Asset(look))
+    }
+
     /// A class drawn from per-chunk instance buffers, without an entity per instance.
     pub fn instanced(
         density: LayerDensity,

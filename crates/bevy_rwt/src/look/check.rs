@@ -53,6 +53,11 @@ pub enum InstancedClassError {
     /// The texture did not load.
     #[error("the class's texture did not load")]
     TextureNotLoaded,
+    /// An asset class's file cannot be drawn (missing, garbled, or a part the instanced
+    /// path cannot draw faithfully).
+    #[cfg(feature = "gltf")]
+    #[error("the class's asset cannot be drawn: {0}")]
+    Asset(Box<super::asset::AssetLookError>),
 }
 
 /// Whether an image of this shape and format can be a class's texture.

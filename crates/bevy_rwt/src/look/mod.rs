@@ -1,8 +1,9 @@
 //! How instances look, below every module that places or draws them: a class's look
-//! ([`ClassLook`]: a shared mesh, a game's own components, or instanced), the instanced
-//! look's mesh and shading, the checks an instanced mesh must pass, and the rule that turns
-//! a point into a transform ([`Pose`], [`GroundPlane::place`]), which the entity and the
-//! instanced path share so that both put one point in the same place.
+//! ([`ClassLook`]: a shared mesh, a game's own components, instanced, or a glTF asset drawn
+//! instanced), the instanced look's mesh and shading, the checks an instanced mesh must
+//! pass, and the rule that turns a point into a transform ([`Pose`],
+//! [`GroundPlane::place`]), which the entity and the instanced path share so that both put
+//! one point in the same place.
 
 pub mod asset;
 mod blade;
@@ -53,6 +54,23 @@ pub enum ClassLook {
     /// drawn with one instanced draw (grass, flowers, pebbles; see [`crate::instancing`]).
     /// Only on the [`GroundPlane::Xz`] plane.
     Instanced(InstancedLook),
+    /// A game's own glTF asset, drawn instanced as [`ClassLook::Instanced`] is: one draw per
+    /// primitive per chunk and view, each with its own material. Only on the
+    /// [`GroundPlane::Xz`] plane.
+    #[cfg(feature = "gltf")]
+    Asset(asset::AssetLook),
+}
+
+impl ClassLook {
+    /// Whether instances of this look are packed and drawn instanced rather than spawned.
+    pub fn is_instanced(&self) -> bool {
+        match self {
+            ClassLook::Instanced(_) => true,
+            #[cfg(feature = "gltf")]
+            ClassLook::Asset(_) => true,
+            ClassLook::Mesh { .. } | ClassLook::Custom(_) => false,
+        }
+    }
 }
 
 impl std::fmt::Debug for ClassLook {
@@ -65,6 +83,8 @@ impl std::fmt::Debug for ClassLook {
                 .finish(),
             ClassLook::Custom(_) => f.write_str("Custom(..)"),
             ClassLook::Instanced(look) => look.fmt(f),
+            #[cfg(feature = "gltf")]
+            ClassLook::Asset(look) => look.fmt(f),
         }
     }
 }

@@ -5,7 +5,6 @@ use super::{LayerState, RwtTileSet};
 use crate::edits::{EditError, EditInstance, EditSet, InstanceEdit, ScatterEdits};
 use crate::entities::Spawner;
 use crate::layers::ScatterLayer;
-use crate::look::ClassLook;
 use crate::settings::RwtSettings;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -103,8 +102,7 @@ fn apply_edit(
         Arc::make_mut(state.chunk_edits.entry(chunk).or_default()),
         id,
     )?;
-    let entity_class =
-        class.filter(|c| !matches!(layer.classes[*c as usize].look, ClassLook::Instanced(_)));
+    let entity_class = class.filter(|c| !layer.classes[*c as usize].look.is_instanced());
     let generator = state.generator(layer);
     let shown = match (message.edit, entity_class, generator.as_ref()) {
         (InstanceEdit::Remove, _, _) => {

@@ -3,8 +3,7 @@
 
 use super::LayerState;
 use crate::entities::{ImpostorReach, Spawner};
-use crate::impostor::ImpostorAtlases;
-use crate::instancing::{InstancedMeshes, Upload};
+use crate::instancing::UploadSources;
 use crate::layers::ScatterLayer;
 use crate::settings::RwtSettings;
 use crate::viewers::Viewers;
@@ -16,19 +15,12 @@ pub(super) fn apply_budget(
     mut commands: Commands,
     mut layers: Query<(Entity, &ScatterLayer, &mut LayerState)>,
     settings: Res<RwtSettings>,
-    meshes: Option<Res<Assets<Mesh>>>,
-    mut checked: ResMut<InstancedMeshes>,
+    mut looks: UploadSources,
     viewers: Res<Viewers>,
-    impostors: Option<Res<ImpostorAtlases>>,
 ) {
     let mut spawn_budget = settings.spawn_budget;
     let mut despawn_budget = settings.despawn_budget;
-    let mut upload = Upload::new(
-        settings.upload_budget,
-        meshes.as_deref(),
-        &mut checked,
-        impostors.as_deref(),
-    );
+    let mut upload = looks.upload(settings.upload_budget);
     for (entity, layer, mut state) in &mut layers {
         let state = &mut *state;
         state.instanced.despawn_retired(&mut commands);
@@ -51,7 +43,7 @@ pub(super) fn apply_budget(
                 .spawn_queued(&mut commands, &spawner, &mut spawn_budget);
         }
         upload.chunks(&mut commands, entity, layer, &mut state.instanced);
-        upload.refresh_impostors(&mut commands, entity, layer, &mut state.instanced);
+        upload.refresh_classes(&mut commands, entity, layer, &mut state.instanced);
         let viewers = viewers.on(layer.plane);
         upload.promote(&mut commands, entity, layer, &mut state.instanced, viewers);
     }

@@ -1,10 +1,19 @@
 //! glTF assets: a file written by `testing::glb`, loaded by Bevy's glTF loader headless,
-//! read back as a node tree and split into levels of detail and colliders.
+//! read back as a node tree, split into levels of detail and colliders, resolved for the
+//! instanced path, and streamed as an asset class beside a class whose file is broken.
 
-use crate::common::app_reading_with;
+use crate::common::{app_reading_with, layer, run_until, spawn_viewer};
+use bevy::camera::primitives::MeshAabb;
 use bevy::gltf::{Gltf, GltfMesh, GltfNode, GltfPlugin};
+use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
-use bevy_rwt::look::asset::{AssetParts, AssetPrimitive, AssetRoot, AssetTreeError, asset_tree};
+use bevy_rwt::instancing::InstancedChunk;
+use bevy_rwt::look::InstancedClassError;
+use bevy_rwt::look::asset::{
+    AssetLook, AssetLookError, AssetParts, AssetPrimitive, AssetRoot, AssetTreeError, GltfAssets,
+    SurfaceAlpha, asset_tree, resolve_asset,
+};
+use bevy_rwt::prelude::*;
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
 
 /// A tree: two levels (bark and masked leaves near, one card far), a collision hull.
@@ -26,8 +35,14 @@ fn tree() -> Glb {
         leaves,
     )]);
     let hull = file.add_mesh(vec![mesh(Cylinder::new(0.35, 4.0).mesh().build(), bark)]);
-    let lod0 = file.add_node(GlbNode::named("oak_LOD0").with_mesh(near));
-    let lod1 = file.add_node(GlbNode::named("oak_LOD1").with_mesh(far));
+    // Both levels stand on the asset's origin once their nodes' transforms are applied.
+    let up = Transform::from_xyz(0.0, 2.0, 0.0);
+    let lod0 = file.add_node(
+        GlbNode::named("oak_LOD0")
+            .with_mesh(near)
+            .with_transform(up),
+    );
+    let lod1 = file.add_node(GlbNode::named("oak_LOD1").with_mesh(far).with_transform(up));
     let collider = file.add_node(
         GlbNode::named("UCX_oak")
             .with_mesh(hull)
@@ -56,6 +71,7 @@ fn a_written_asset_loads_and_splits_into_levels_and_a_collider() {
             .is_loaded_with_dependencies(&handle)
     });
     assert!(loaded, "oak.glb did not load");
+    check_resolved(&mut app, &handle);
     let world = app.world();
     let gltf = world.resource::<Assets<Gltf>>().get(&handle).unwrap();
     let (nodes, gltf_meshes) = (
@@ -106,5 +122,94 @@ fn a_written_asset_loads_and_splits_into_levels_and_a_collider() {
         material(&parts.levels[0][0].primitive).alpha_mode,
         AlphaMode::Opaque
     );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The tree resolved for drawing: its levels' meshes moved by their nodes into the asset's
+/// frame, their surfaces, the collider's mesh, the bounds of every level.
+fn check_resolved(app: &mut App, handle: &Handle<Gltf>) {
+    let world = app.world_mut();
+    let resolved = world.resource_scope(|world, mut meshes: Mut<Assets<Mesh>>| {
+        let from = GltfAssets {
+            nodes: world.resource(),
+            meshes: world.resource(),
+            materials: world.resource(),
+        };
+        let gltf = world.resource::<Assets<Gltf>>().get(handle).unwrap();
+        resolve_asset(gltf, &AssetRoot::File, from, &mut meshes).unwrap()
+    });
+    let sizes: Vec<usize> = resolved.levels.iter().map(Vec::len).collect();
+    assert_eq!((sizes, resolved.colliders.len()), (vec![2, 1], 1));
+    let (lo, hi) = resolved.bounds;
+    assert!(
+        (lo.y + 0.5).abs() < 1e-4 && (hi.y - 4.5).abs() < 1e-4,
+        "{lo} {hi}"
+    );
+    let meshes = world.resource::<Assets<Mesh>>();
+    let lowest = |mesh: &Handle<Mesh>| meshes.get(mesh).unwrap().compute_aabb().unwrap().min().y;
+    let [bark, leaves] = &resolved.levels[0][..] else {
+        unreachable!()
+    };
+    // The node's 2 m lift is in the meshes: the trunk stands on the origin.
+    assert!(lowest(&bark.mesh).abs() < 1e-4 && (lowest(&leaves.mesh) - 0.5).abs() < 1e-4);
+    assert_eq!(bark.surface.alpha, SurfaceAlpha::Opaque);
+    assert_eq!(leaves.surface.alpha, SurfaceAlpha::Mask(0.5));
+    assert!(leaves.surface.double_sided && !bark.surface.double_sided);
+    assert!((lowest(&resolved.colliders[0]) - 0.0).abs() < 1e-4);
+}
+
+#[test]
+fn an_asset_class_draws_each_primitive_and_a_bad_file_fails_alone() {
+    let dir = std::env::temp_dir().join(format!("bevy_rwt_asset_class_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bytes = tree().to_bytes();
+    std::fs::write(dir.join("oak.glb"), &bytes).unwrap();
+    std::fs::write(dir.join("broken.glb"), &bytes[..bytes.len() / 3]).unwrap();
+    let mut app = app_reading_with(&dir, |app| {
+        app.add_plugins(GltfPlugin::default())
+            .init_asset::<bevy::world_serialization::WorldAsset>();
+    });
+    let server = app.world().resource::<AssetServer>().clone();
+    let oak = AssetLook::new(server.load("oak.glb"));
+    let broken = AssetLook::new(server.load("broken.glb"));
+    let density = LayerDensity::Constant(0.05);
+    let mut l = layer(density.clone());
+    l.classes = vec![
+        ScatterClass::asset(density.clone(), oak),
+        ScatterClass::asset(density, broken),
+    ];
+    let layer_entity = app.world_mut().spawn(l).id();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let drawn = run_until(&mut app, 2_000, |app| {
+        let any = app
+            .world()
+            .iter_entities()
+            .any(|e| e.contains::<InstancedChunk>());
+        let status = app.world().get::<ScatterLayerStatus>(layer_entity).unwrap();
+        any && !status.class_errors.is_empty() && status.pending_tasks == 0
+    });
+    assert!(
+        drawn,
+        "the asset class drew nothing, or the broken one reported nothing"
+    );
+    let status = app.world().get::<ScatterLayerStatus>(layer_entity).unwrap();
+    let [(1, InstancedClassError::Asset(e))] = &status.class_errors[..] else {
+        panic!("{:?}", status.class_errors);
+    };
+    assert!(matches!(**e, AssetLookError::Load(_)), "{e}");
+    // Per chunk, one entity per primitive of the nearest level, sharing one buffer.
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    let mut per_chunk: HashMap<_, Vec<&InstancedChunk>> = HashMap::new();
+    for c in chunks.iter(app.world()) {
+        assert_eq!(c.class, 0, "the broken class draws nothing");
+        per_chunk.entry(c.chunk).or_default().push(c);
+    }
+    for parts in per_chunk.values() {
+        assert_eq!(parts.len(), 2, "bark and leaves");
+        assert!(std::sync::Arc::ptr_eq(&parts[0].buffer, &parts[1].buffer));
+        let surfaces: Vec<_> = parts.iter().map(|p| p.surface.as_ref().unwrap()).collect();
+        assert_eq!(surfaces.iter().filter(|s| s.double_sided).count(), 1);
+        assert!(parts.iter().all(|p| (p.mesh_top - 4.5).abs() < 1e-4));
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

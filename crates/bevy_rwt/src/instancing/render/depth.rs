@@ -136,8 +136,7 @@ impl SpecializedMeshPipeline for InstancedDepthPipeline {
                 strip_index_format: k.strip_index_format(),
                 unclipped_depth: k.contains(MeshPipelineKey::UNCLIPPED_DEPTH_ORTHO)
                     && self.prepass.depth_clip_control_supported,
-                // Blades are seen from both sides.
-                cull_mode: None,
+                cull_mode: key.features.cull_mode(),
                 ..default()
             },
             depth_stencil: Some(DepthStencilState {

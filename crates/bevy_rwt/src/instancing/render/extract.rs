@@ -4,10 +4,12 @@
 use super::uniforms::ChunkUniform;
 use crate::instancing::chunk::{InstanceBuffer, InstancedChunk};
 use crate::look::InstancedShadows;
+use crate::look::asset::InstancedSurface;
 use bevy::camera::primitives::Aabb;
 use bevy::ecs::query::QueryItem;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponent;
+use bevy::render::render_resource::Face;
 use bevy::render::sync_component::SyncComponent;
 use std::sync::Arc;
 
@@ -27,18 +29,53 @@ pub struct ExtractedChunk {
     /// or swaying any way: the radius culling per instance tests.
     pub(super) reach: f32,
     pub(super) shadows: InstancedShadows,
-    /// The base-colour texture, if the class has one.
-    pub(super) texture: Option<AssetId<Image>>,
+    /// The textures, in binding order: base colour (the class's texture), then an asset
+    /// surface's normal map, metallic-roughness, emissive and occlusion.
+    pub(super) textures: [Option<AssetId<Image>>; 5],
+    /// What an asset's surface compiles in (`None`: a class's own instanced look).
+    pub(super) surface: Option<SurfaceFeatures>,
 }
 
 impl ExtractedChunk {
     /// What its class's pipelines compile in: a texture, and a bend response other than 0.
     pub(super) fn features(&self) -> ClassFeatures {
+        let textured = self.textures.iter().any(Option::is_some);
         ClassFeatures {
-            textured: self.texture.is_some(),
+            textured,
             bends: self.uniform.bend_response != 0.0,
-            impostor: self.uniform.impostor_views != 0 && self.texture.is_some(),
+            impostor: self.uniform.impostor_views != 0 && textured,
             fades_out: self.uniform.fade_out_to > 0.0,
+            surface: self.surface,
+        }
+    }
+}
+
+impl ClassFeatures {
+    /// The faces not drawn: none of blades (seen from both sides) and of double-sided
+    /// surfaces, the back of other surfaces.
+    pub(super) fn cull_mode(&self) -> Option<Face> {
+        match self.surface {
+            Some(s) if !s.double_sided => Some(Face::Back),
+            _ => None,
+        }
+    }
+}
+
+/// What an asset's surface compiles in: its normal map (and the mesh's tangents), whether
+/// both sides are drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub(super) struct SurfaceFeatures {
+    /// `RWT_NORMAL_MAP`.
+    pub(super) normal_map: bool,
+    /// `RWT_DOUBLE_SIDED`, and no face culled.
+    pub(super) double_sided: bool,
+}
+
+impl SurfaceFeatures {
+    fn of(surface: &InstancedSurface) -> Self {
+        Self {
+            normal_map: surface.normal_map.is_some(),
+            double_sided: surface.double_sided,
         }
     }
 }
@@ -78,6 +115,8 @@ pub(super) struct ClassFeatures {
     pub(super) impostor: bool,
     /// The chunk's meshes fade out where its class's impostors take over (`RWT_FADE_OUT`).
     pub(super) fades_out: bool,
+    /// The chunk draws an asset's primitive (`RWT_SURFACE`).
+    pub(super) surface: Option<SurfaceFeatures>,
 }
 
 impl SyncComponent for InstancedChunk {
@@ -114,14 +153,30 @@ impl ExtractComponent for InstancedChunk {
             mesh: chunk.mesh.id(),
             lods: MeshLods::of(chunk),
             uniform: ChunkUniform::new(origin, chunk.mesh_top, &chunk.material, chunk.falloff)
-                .with_impostor(chunk.impostor.as_ref(), chunk.fade_out),
+                .with_impostor(chunk.impostor.as_ref(), chunk.fade_out)
+                .with_surface(chunk.surface.as_ref()),
             bounds: Aabb {
                 center: local.center + origin.to_vec3a(),
                 half_extents: local.half_extents,
             },
             shadows: chunk.material.shadows,
-            texture: chunk.material.texture.as_ref().map(Handle::id),
+            textures: textures(chunk),
+            surface: chunk.surface.as_ref().map(SurfaceFeatures::of),
         })
+    }
+}
+
+/// The textures a chunk binds: its class's texture, and its surface's maps.
+fn textures(chunk: &InstancedChunk) -> [Option<AssetId<Image>>; 5] {
+    match &chunk.surface {
+        Some(surface) => surface.textures().map(|t| t.map(Handle::id)),
+        None => [
+            chunk.material.texture.as_ref().map(Handle::id),
+            None,
+            None,
+            None,
+            None,
+        ],
     }
 }
 

@@ -1,5 +1,6 @@
 // Instanced foliage: one chunk's instances of one mesh, swayed by a world-space wind field
-// and grown in or out by level of detail. The main pass lights it with Bevy's PBR lighting
+// and grown in or out by level of detail; with `RWT_SURFACE`, a primitive of a game's asset
+// lit as Bevy lights its glTF material (normal map, metallic-roughness, emissive, occlusion). The main pass lights it with Bevy's PBR lighting
 // (scene lights, ambient light, received shadows, distance fog); the prepass pipeline
 // (`PREPASS_PIPELINE`) writes its depth, normals and motion vectors (the previous frame's
 // sway included) and its depth into shadow maps.
@@ -53,6 +54,10 @@ struct Chunk {
     impostor_views: u32,
     // Elevations baked.
     impostor_rows: u32,
+    // An asset's surface: its metallic and reflectance factors, and the light it emits.
+    metallic: f32,
+    reflectance: f32,
+    emissive: vec4<f32>,
 };
 
 @group(2) @binding(0) var<uniform> chunk: Chunk;
@@ -77,6 +82,20 @@ struct Frame {
 @group(2) @binding(4) var base_texture: texture_2d<f32>;
 @group(2) @binding(5) var base_sampler: sampler;
 #endif
+#ifdef RWT_SURFACE
+#ifdef RWT_TEXTURE
+// An asset's maps (white where it has none): normals, metallic-roughness, emission,
+// occlusion.
+@group(2) @binding(6) var normal_texture: texture_2d<f32>;
+@group(2) @binding(7) var normal_sampler: sampler;
+@group(2) @binding(8) var metallic_roughness_texture: texture_2d<f32>;
+@group(2) @binding(9) var metallic_roughness_sampler: sampler;
+@group(2) @binding(10) var emissive_texture: texture_2d<f32>;
+@group(2) @binding(11) var emissive_sampler: sampler;
+@group(2) @binding(12) var occlusion_texture: texture_2d<f32>;
+@group(2) @binding(13) var occlusion_sampler: sampler;
+#endif
+#endif
 
 struct Vertex {
     @location(0) position: vec3<f32>,
@@ -85,6 +104,12 @@ struct Vertex {
 #endif
 #ifdef RWT_TEXTURE
     @location(2) uv: vec2<f32>,
+#endif
+#ifdef RWT_NORMAL_MAP
+    @location(3) tangent: vec4<f32>,
+#endif
+#ifdef RWT_VERTEX_COLORS
+    @location(4) vertex_color: vec4<f32>,
 #endif
     // Offset from the chunk corner (xyz), scale (w).
     @location(8) offset_scale: vec4<f32>,
@@ -114,6 +139,9 @@ struct VertexOutput {
 #ifdef RWT_FADE_OUT
     // The mesh's dither level as impostors take over (0..16).
     @location(7) @interpolate(flat) fade_out: f32,
+#endif
+#ifdef RWT_NORMAL_MAP
+    @location(8) world_tangent: vec4<f32>,
 #endif
 };
 
@@ -200,6 +228,9 @@ struct Placed {
     tint: f32,
     height: f32,
     calm: f32,
+#ifdef RWT_NORMAL_MAP
+    tangent: vec4<f32>,
+#endif
 };
 
 // The instance's up axis from its packed tilt (0: straight up).
@@ -278,6 +309,7 @@ fn place(in: Vertex, time: f32) -> Placed {
     let scale = in.offset_scale.w * growth(chunk.lod, eye, root, in.yaw_appear_tint.y, kept) * shown;
     let c = cos(yaw);
     let s = sin(yaw);
+    let up = instance_up(in.yaw_appear_tint.w);
     // A thinned field's instances are widened to cover as the whole field did (seen from
     // the side, an instance's cover grows with its width).
     let widen = 1.0 / kept;
@@ -289,8 +321,12 @@ fn place(in: Vertex, time: f32) -> Placed {
 #else
     var normal = vec3<f32>(0.0, 1.0, 0.0);
 #endif
+#ifdef RWT_NORMAL_MAP
+    let m = in.tangent.xyz;
+    var tangent = vec3<f32>(c * m.x + s * m.z, m.y, -s * m.x + c * m.z);
+    tangent = tilt(tangent, up);
+#endif
     // Standing along the surface (a class's stance); upright instances turn by nothing.
-    let up = instance_up(in.yaw_appear_tint.w);
     turned = tilt(turned, up);
     normal = tilt(normal, up);
     // Where a bender passed, the blade falls away from it, up to 80 degrees.
@@ -301,6 +337,9 @@ fn place(in: Vertex, time: f32) -> Placed {
         let angle = amount * 1.4;
         turned = fall(turned, dir, sin(angle), cos(angle));
         normal = fall(normal, dir, sin(angle), cos(angle));
+#ifdef RWT_NORMAL_MAP
+        tangent = fall(tangent, dir, sin(angle), cos(angle));
+#endif
     }
     var out: Placed;
     out.t = clamp(in.position.y / chunk.mesh_top, 0.0, 1.0);
@@ -310,8 +349,15 @@ fn place(in: Vertex, time: f32) -> Placed {
     out.calm = 1.0 - amount;
     out.wind = sway(root, out.t, tint, out.height, time) * out.calm;
     out.world = root + turned + out.wind;
+#ifdef RWT_SURFACE
+    out.normal = normalize(normal);
+#else
     // Blades read as blades when their normals lean towards the sky.
     out.normal = normalize(mix(normal, vec3<f32>(0.0, 1.0, 0.0), 0.45));
+#endif
+#ifdef RWT_NORMAL_MAP
+    out.tangent = vec4<f32>(normalize(tangent), in.tangent.w);
+#endif
     return out;
 }
 
@@ -399,14 +445,26 @@ fn vertex(in: Vertex) -> VertexOutput {
     let tint = in.yaw_appear_tint.z;
     let variation = (tint - 0.5) * chunk.color_variation;
     let tip_start = chunk.tip_from;
-    let shade = mix(chunk.base_color, chunk.tip_color, clamp((placed.t - tip_start) / (1.0 - tip_start), 0.0, 1.0));
+    var shade = mix(chunk.base_color, chunk.tip_color, clamp((placed.t - tip_start) / (1.0 - tip_start), 0.0, 1.0));
+#ifdef RWT_VERTEX_COLORS
+    shade = shade * in.vertex_color;
+#endif
     var out: VertexOutput;
     out.world_position = vec4<f32>(placed.world, 1.0);
     out.clip_position = position_world_to_clip(placed.world);
     out.world_normal = placed.normal;
-    out.color = vec4<f32>(shade.rgb * (1.0 + variation) + vec3<f32>(variation * 0.15, variation * 0.05, 0.0), 1.0);
+    // The alpha is the cut-out's factor: 1 but for an asset's surface.
+#ifdef RWT_SURFACE
+    let alpha = shade.a;
+#else
+    let alpha = 1.0;
+#endif
+    out.color = vec4<f32>(shade.rgb * (1.0 + variation) + vec3<f32>(variation * 0.15, variation * 0.05, 0.0), alpha);
 #ifdef MOTION_VECTOR_PREPASS
     out.previous_world_position = vec4<f32>(placed_at(placed, globals.time - globals.delta_time), 1.0);
+#endif
+#ifdef RWT_NORMAL_MAP
+    out.world_tangent = placed.tangent;
 #endif
 #ifdef RWT_TEXTURE
     out.uv = in.uv;
@@ -423,10 +481,11 @@ fn vertex(in: Vertex) -> VertexOutput {
 }
 
 #ifdef RWT_TEXTURE
-// The texture at the fragment, which is cut out where its alpha is below the cut-off.
-fn cut_out(uv: vec2<f32>) -> vec4<f32> {
+// The texture at the fragment, which is cut out where its alpha times `alpha` (the vertex
+// colour's) is below the cut-off.
+fn cut_out(uv: vec2<f32>, alpha: f32) -> vec4<f32> {
     let texel = textureSample(base_texture, base_sampler, uv);
-    if texel.a < chunk.alpha_cutoff {
+    if texel.a * alpha < chunk.alpha_cutoff {
         discard;
     }
     return texel;
@@ -455,7 +514,7 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> Fragment
     let n = facing_normal(in.world_normal, is_front);
 #endif
 #ifdef RWT_TEXTURE
-    _ = cut_out(in.uv);
+    _ = cut_out(in.uv, in.color.a);
 #endif
     crossfade(in);
     var out: FragmentOutput;
@@ -477,7 +536,7 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> Fragment
 // Depth alone (a shadow map, a depth prepass): only the cut-out and the crossfades.
 @fragment
 fn fragment(in: VertexOutput) {
-    _ = cut_out(in.uv);
+    _ = cut_out(in.uv, in.color.a);
     crossfade(in);
 }
 #else
@@ -496,18 +555,25 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @locatio
 #ifdef RWT_IMPOSTOR
     let n = impostor_normal(in.uv, in.impostor);
 #else
+#ifdef RWT_NORMAL_MAP
+    let n = mapped_normal(in, is_front);
+#else
     let n = facing_normal(in.world_normal, is_front);
+#endif
 #endif
     var color = in.color;
 #ifdef RWT_TEXTURE
-    color = vec4<f32>(color.rgb * cut_out(in.uv).rgb, 1.0);
+    color = vec4<f32>(color.rgb * cut_out(in.uv, in.color.a).rgb, 1.0);
 #endif
     crossfade(in);
     var pbr_input = pbr_types::pbr_input_new();
-    pbr_input.material.base_color = color;
+    pbr_input.material.base_color = vec4<f32>(color.rgb, 1.0);
     pbr_input.material.perceptual_roughness = chunk.roughness;
     pbr_input.material.reflectance = vec3<f32>(0.2);
     pbr_input.material.flags = pbr_types::STANDARD_MATERIAL_FLAGS_FOG_ENABLED_BIT;
+#ifdef RWT_SURFACE
+    surface_maps(&pbr_input, in);
+#endif
     pbr_input.frag_coord = in.clip_position;
     pbr_input.world_position = in.world_position;
     pbr_input.world_normal = n;
@@ -519,11 +585,55 @@ fn fragment(in: VertexOutput, @builtin(front_facing) is_front: bool) -> @locatio
 }
 #endif
 
-// The normal of the side seen: blades are seen from both sides.
+// The normal of the side seen: blades are seen from both sides, their normals leaning
+// towards the sky; a single-sided surface's back is never drawn, a double-sided one's
+// turns its normal round.
 fn facing_normal(world_normal: vec3<f32>, is_front: bool) -> vec3<f32> {
     let n = normalize(world_normal);
+#ifdef RWT_SURFACE
+    return select(-n, n, is_front);
+#else
     if is_front {
         return n;
     }
     return vec3<f32>(-n.x, n.y, -n.z);
+#endif
 }
+
+#ifndef PREPASS_PIPELINE
+#ifdef RWT_SURFACE
+// An asset's maps at the fragment, into its lighting's input: roughness, metallic,
+// emission and occlusion, and the normal map's normal.
+fn surface_maps(pbr_input: ptr<function, pbr_types::PbrInput>, in: VertexOutput) {
+#ifdef RWT_TEXTURE
+    let mr = textureSample(metallic_roughness_texture, metallic_roughness_sampler, in.uv);
+    let emitted = textureSample(emissive_texture, emissive_sampler, in.uv).rgb;
+    let occlusion = textureSample(occlusion_texture, occlusion_sampler, in.uv).r;
+#else
+    let mr = vec4<f32>(1.0);
+    let emitted = vec3<f32>(1.0);
+    let occlusion = 1.0;
+#endif
+    (*pbr_input).material.perceptual_roughness = chunk.roughness * mr.g;
+    (*pbr_input).material.metallic = chunk.metallic * mr.b;
+    (*pbr_input).material.reflectance = vec3<f32>(chunk.reflectance);
+    (*pbr_input).material.emissive = vec4<f32>(chunk.emissive.rgb * emitted, 1.0);
+    (*pbr_input).diffuse_occlusion = vec3<f32>(occlusion);
+}
+
+#ifdef RWT_NORMAL_MAP
+// The normal map's normal, in the world (mikktspace, as Bevy's `StandardMaterial` reads it).
+fn mapped_normal(in: VertexOutput, is_front: bool) -> vec3<f32> {
+    // The back of a double-sided surface turns the map's normal round.
+#ifdef RWT_DOUBLE_SIDED
+    let double_sided = true;
+#else
+    let double_sided = false;
+#endif
+    let tbn = pbr_functions::calculate_tbn_mikktspace(in.world_normal, in.world_tangent);
+    let nt = textureSample(normal_texture, normal_sampler, in.uv).rgb;
+    return pbr_functions::apply_normal_mapping(0u, tbn, double_sided, is_front, nt);
+}
+#endif
+#endif
+#endif

@@ -62,8 +62,7 @@ impl SpecializedMeshPipeline for InstancedPipeline {
         }
         descriptor.layout.truncate(2);
         descriptor.layout.push(self.bindings.layout.clone());
-        // Blades are seen from both sides.
-        descriptor.primitive.cull_mode = None;
+        descriptor.primitive.cull_mode = key.features.cull_mode();
         descriptor.label = Some("rwt_instanced_pipeline".into());
         Ok(descriptor)
     }
@@ -94,6 +93,21 @@ pub(super) fn mesh_attributes(
     }
     if features.fades_out {
         defs.push("RWT_FADE_OUT".into());
+    }
+    if let Some(surface) = features.surface {
+        defs.push("RWT_SURFACE".into());
+        if surface.normal_map {
+            // A mesh without tangents fails the layout, and the class is reported once.
+            attributes.push(Mesh::ATTRIBUTE_TANGENT.at_shader_location(3));
+            defs.push("RWT_NORMAL_MAP".into());
+        }
+        if surface.double_sided {
+            defs.push("RWT_DOUBLE_SIDED".into());
+        }
+        if layout.0.contains(Mesh::ATTRIBUTE_COLOR) {
+            attributes.push(Mesh::ATTRIBUTE_COLOR.at_shader_location(4));
+            defs.push("RWT_VERTEX_COLORS".into());
+        }
     }
     attributes
 }

@@ -39,12 +39,14 @@ pub(in crate::instancing) struct GpuChunk {
     pub(super) uniform: ChunkUniform,
     pub(super) uniform_buffer: Buffer,
     pub(super) bind_group: BindGroup,
-    /// The texture view bound (the fallback's until the class's texture is ready).
-    pub(super) texture_view: TextureViewId,
+    /// The texture views bound (the fallback's until a texture is ready).
+    pub(super) texture_views: [TextureViewId; 5],
 }
 
 /// What every instanced pipeline shares: the shader and the layout of group 2 (the chunk's
-/// uniform, the frame's, the bend field and its sampler), and the shared resources.
+/// uniform, the frame's, the bend field and its sampler, then five textures and their
+/// samplers: base colour, and an asset's normal, metallic-roughness, emissive and occlusion
+/// maps), and the shared resources.
 #[derive(Resource, Clone)]
 pub(in crate::instancing) struct ChunkBindings {
     pub(super) shader: Handle<Shader>,
@@ -64,15 +66,25 @@ pub(in crate::instancing) fn init_bindings(
     device: Res<RenderDevice>,
     asset_server: Res<AssetServer>,
 ) {
+    let texture = || texture_2d(TextureSampleType::Float { filterable: true });
+    let filtering = || sampler(SamplerBindingType::Filtering);
     let entries = BindGroupLayoutEntries::sequential(
         ShaderStages::VERTEX_FRAGMENT,
         (
             uniform_buffer_sized(false, None),
             uniform_buffer_sized(false, None),
-            texture_2d(TextureSampleType::Float { filterable: true }),
-            sampler(SamplerBindingType::Filtering),
-            texture_2d(TextureSampleType::Float { filterable: true }),
-            sampler(SamplerBindingType::Filtering),
+            texture(),
+            filtering(),
+            texture(),
+            filtering(),
+            texture(),
+            filtering(),
+            texture(),
+            filtering(),
+            texture(),
+            filtering(),
+            texture(),
+            filtering(),
         ),
     );
     let frame = device.create_buffer_with_data(&BufferInitDescriptor {
@@ -173,18 +185,24 @@ pub(in crate::instancing) struct ChunkTextures<'w> {
 }
 
 impl ChunkTextures<'_> {
-    /// The texture `chunk` binds: its class's when it is ready and drawable, the fallback
-    /// image (white) otherwise.
-    fn of(&self, chunk: &ExtractedChunk) -> &GpuImage {
-        chunk
-            .texture
-            .and_then(|id| self.images.get(id))
-            .filter(|image| {
-                let d = &image.texture_descriptor;
-                check_texture(d.dimension, d.size.depth_or_array_layers, d.format).is_ok()
-            })
-            .unwrap_or(&self.fallback.d2)
+    /// The textures `chunk` binds: each where it is ready and drawable, the fallback image
+    /// (white) otherwise.
+    fn of(&self, chunk: &ExtractedChunk) -> [&GpuImage; 5] {
+        chunk.textures.map(|texture| {
+            texture
+                .and_then(|id| self.images.get(id))
+                .filter(|image| {
+                    let d = &image.texture_descriptor;
+                    check_texture(d.dimension, d.size.depth_or_array_layers, d.format).is_ok()
+                })
+                .unwrap_or(&self.fallback.d2)
+        })
     }
+}
+
+/// The ids of the views of `textures`.
+fn view_ids(textures: &[&GpuImage; 5]) -> [TextureViewId; 5] {
+    textures.map(|t| t.texture_view.id())
 }
 
 /// Makes the GPU resources of new or changed chunks (and the bind group again when the
@@ -225,16 +243,16 @@ pub(in crate::instancing) fn prepare_chunks(
                     queue.write_buffer(&gpu.uniform_buffer, 0, &uniform_bytes(&uniform));
                     gpu.uniform = uniform;
                 }
-                if gpu.texture_view != texture.texture_view.id() {
+                if gpu.texture_views != view_ids(&texture) {
                     gpu.bind_group =
-                        bind_chunk(&device, &bindings, &cache, &gpu.uniform_buffer, texture);
-                    gpu.texture_view = texture.texture_view.id();
+                        bind_chunk(&device, &bindings, &cache, &gpu.uniform_buffer, &texture);
+                    gpu.texture_views = view_ids(&texture);
                 }
             }
             _ => {
                 let own = (!slab.place(entity, &chunk.buffer.instances, &device, &queue))
                     .then(|| own_buffer(&device, chunk));
-                let gpu = upload(&device, &bindings, &cache, (chunk, uniform), texture, own);
+                let gpu = upload(&device, &bindings, &cache, (chunk, uniform), &texture, own);
                 commands.entity(entity).insert(gpu);
             }
         }
@@ -258,7 +276,7 @@ fn upload(
     bindings: &ChunkBindings,
     cache: &PipelineCache,
     (chunk, uniform): (&ExtractedChunk, ChunkUniform),
-    texture: &GpuImage,
+    textures: &[&GpuImage; 5],
     own: Option<Buffer>,
 ) -> GpuChunk {
     let uniform_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
@@ -271,20 +289,21 @@ fn upload(
         own,
         count: chunk.buffer.instances.len() as u32,
         uniform,
-        bind_group: bind_chunk(device, bindings, cache, &uniform_buffer, texture),
+        bind_group: bind_chunk(device, bindings, cache, &uniform_buffer, textures),
         uniform_buffer,
-        texture_view: texture.texture_view.id(),
+        texture_views: view_ids(textures),
     }
 }
 
-/// A chunk's bind group: its uniform, the frame's, the bend field, its texture.
+/// A chunk's bind group: its uniform, the frame's, the bend field, its textures.
 fn bind_chunk(
     device: &RenderDevice,
     bindings: &ChunkBindings,
     cache: &PipelineCache,
     uniform: &Buffer,
-    texture: &GpuImage,
+    textures: &[&GpuImage; 5],
 ) -> BindGroup {
+    let [base, normal, metallic_roughness, emissive, occlusion] = textures;
     device.create_bind_group(
         "rwt_instanced_chunk",
         &cache.get_bind_group_layout(&bindings.layout),
@@ -293,8 +312,16 @@ fn bind_chunk(
             bindings.frame.as_entire_binding(),
             &bindings.bend_view,
             &bindings.bend_sampler,
-            &texture.texture_view,
-            &texture.sampler,
+            &base.texture_view,
+            &base.sampler,
+            &normal.texture_view,
+            &normal.sampler,
+            &metallic_roughness.texture_view,
+            &metallic_roughness.sampler,
+            &emissive.texture_view,
+            &emissive.sampler,
+            &occlusion.texture_view,
+            &occlusion.sampler,
         )),
     )
 }

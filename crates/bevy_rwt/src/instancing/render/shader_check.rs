@@ -129,17 +129,43 @@ fn cache_with_library() -> ShaderCache<String, ()> {
     cache
 }
 
+/// The class features the pipelines combine: a class's own look's, then an asset
+/// surface's.
+const FEATURES: [&str; 9] = [
+    "RWT_NORMALS",
+    "RWT_BEND",
+    "RWT_TEXTURE",
+    "RWT_IMPOSTOR",
+    "RWT_FADE_OUT",
+    "RWT_SURFACE",
+    "RWT_NORMAL_MAP",
+    "RWT_DOUBLE_SIDED",
+    "RWT_VERTEX_COLORS",
+];
+
+/// Whether the pipelines can combine the features of `bits` (bit `i`: `FEATURES[i]`).
+fn possible(bits: usize) -> bool {
+    let has = |name: &str| bits >> FEATURES.iter().position(|f| *f == name).unwrap() & 1 == 1;
+    // Impostors are always textured (their atlas), and never fade out.
+    let impostor = !has("RWT_IMPOSTOR") || (has("RWT_TEXTURE") && !has("RWT_FADE_OUT"));
+    // An asset's surface has no impostor and no fade-out of its own; its normal map needs
+    // normals and UVs; its other features exist only with it.
+    let surface = match has("RWT_SURFACE") {
+        true => {
+            !has("RWT_IMPOSTOR")
+                && !has("RWT_FADE_OUT")
+                && (!has("RWT_NORMAL_MAP") || (has("RWT_TEXTURE") && has("RWT_NORMALS")))
+        }
+        false => bits >> 6 == 0,
+    };
+    impostor && surface
+}
+
 /// The definitions of the main pass and of the depth passes (prepass and shadows), for
 /// every class feature and pass option the pipelines combine.
 fn permutations() -> Vec<Vec<ShaderDefVal>> {
     let global = ShaderDefVal::UInt("AVAILABLE_STORAGE_BUFFER_BINDINGS".into(), 8);
-    let features = [
-        "RWT_NORMALS",
-        "RWT_BEND",
-        "RWT_TEXTURE",
-        "RWT_IMPOSTOR",
-        "RWT_FADE_OUT",
-    ];
+    let features = FEATURES;
     let passes = [
         "NORMAL_PREPASS",
         "MOTION_VECTOR_PREPASS",
@@ -151,9 +177,7 @@ fn permutations() -> Vec<Vec<ShaderDefVal>> {
         on.map(|(_, n)| ShaderDefVal::from(*n)).collect()
     };
     let mut all = Vec::new();
-    // Impostors are always textured (their atlas), and never fade out.
-    let impossible = |f: usize| f & 0b1100 == 0b1000 || f & 0b11000 == 0b11000;
-    for f in (0..1 << features.len()).filter(|f| !impossible(*f)) {
+    for f in (0..1 << features.len()).filter(|f| possible(*f)) {
         let mut main = vec![
             global.clone(),
             ShaderDefVal::UInt("MATERIAL_BIND_GROUP".into(), 3),
@@ -288,6 +312,9 @@ fn marked_chunk() -> (Vec<(String, usize)>, usize) {
         impostor_center: Vec3::splat(mark(21)),
         impostor_views: 22,
         impostor_rows: 23,
+        metallic: mark(24),
+        reflectance: mark(25),
+        emissive: Vec4::splat(mark(26)),
     };
     let names = [
         "origin",
@@ -314,6 +341,9 @@ fn marked_chunk() -> (Vec<(String, usize)>, usize) {
         "impostor_center",
         "impostor_views",
         "impostor_rows",
+        "metallic",
+        "reflectance",
+        "emissive",
     ];
     marked_layout(&marked, Space::Uniform, &names, |k| {
         matches!(k, 15 | 22 | 23)
@@ -391,7 +421,8 @@ fn every_permutation_composes_and_validates_with_the_uniform_layouts() {
         failed.len(),
         failed.join("\n")
     );
-    assert_eq!(composed.len(), 20 * 17);
+    // 20 combinations of a class's own look's features, 40 of an asset surface's.
+    assert_eq!(composed.len(), (20 + 40) * 17);
     let (chunk, frame, lod) = (marked_chunk(), marked_frame(), marked_lod());
     for types in &composed {
         assert_eq!(struct_layout(types, "Chunk"), chunk);

@@ -3,6 +3,7 @@
 
 use crate::instancing::chunk::ImpostorDraw;
 use crate::look::InstancedShading;
+use crate::look::asset::InstancedSurface;
 use bevy::prelude::*;
 use bevy::render::render_resource::ShaderType;
 use bevy::render::render_resource::encase::UniformBuffer;
@@ -48,6 +49,11 @@ pub(super) struct ChunkUniform {
     pub impostor_center: Vec3,
     pub impostor_views: u32,
     pub impostor_rows: u32,
+    /// An asset's surface: its metallic and reflectance factors, and the light it emits
+    /// (linear, alpha unused).
+    pub metallic: f32,
+    pub reflectance: f32,
+    pub emissive: Vec4,
 }
 
 impl ChunkUniform {
@@ -73,6 +79,18 @@ impl ChunkUniform {
             alpha_cutoff: m.alpha_cutoff,
             textured: u32::from(m.texture.is_some()),
             ..default()
+        }
+    }
+
+    /// The uniform drawing a primitive of `surface` (its other factors are in the
+    /// shading the uniform was made with).
+    pub fn with_surface(self, surface: Option<&InstancedSurface>) -> Self {
+        let Some(s) = surface else { return self };
+        Self {
+            metallic: s.metallic,
+            reflectance: s.reflectance,
+            emissive: Vec4::from_array(s.emissive.to_f32_array()),
+            ..self
         }
     }
 

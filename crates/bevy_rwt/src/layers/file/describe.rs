@@ -163,6 +163,8 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
                 )
             }
             ClassLook::Custom(_) => return Err(Undescribable::CustomLook),
+            #[cfg(feature = "gltf")]
+            ClassLook::Asset(_) => return Err(Undescribable::AssetLook),
         };
         let far = match look {
             ClassLook::Instanced(look) => look.far.as_ref(),

@@ -152,6 +152,9 @@ pub enum Undescribable {
     /// A look made in code.
     #[error("a custom look (code) has no file form")]
     CustomLook,
+    /// A glTF asset's look (layer files do not name assets yet).
+    #[error("an asset class's look has no file form yet")]
+    AssetLook,
     /// A density made in code.
     #[error("a custom density (code) has no file form")]
     CustomDensity,

@@ -41,7 +41,8 @@ pub enum AssetTreeError {
 }
 
 /// Which part of a file is the asset.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash, Reflect)]
+#[reflect(Clone, Debug, Default, PartialEq, Hash)]
 pub enum AssetRoot {
     /// Every root node of the file.
     #[default]

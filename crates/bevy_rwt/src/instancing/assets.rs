@@ -1,0 +1,109 @@
+//! Asset classes' side of the instanced path: each [`AssetLook`] of a layer is resolved once
+//! its file has loaded with everything it names, again when the file changes (hot reload),
+//! and its chunks drawn again then ([`ResolvedAssets::generation`]).
+
+use crate::layers::ScatterLayer;
+use crate::look::ClassLook;
+use crate::look::asset::{AssetLook, AssetLookError, AssetRoot, GltfAssets, ResolvedAsset};
+use bevy::asset::LoadState;
+use bevy::ecs::message::MessageCursor;
+use bevy::gltf::{Gltf, GltfMaterial, GltfMesh, GltfNode};
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use std::sync::Arc;
+
+/// Every asset look of the layers, resolved (or why it cannot be drawn).
+#[derive(Resource, Default)]
+pub struct ResolvedAssets {
+    looks: HashMap<(AssetId<Gltf>, AssetRoot), Result<Arc<ResolvedAsset>, AssetLookError>>,
+    generation: u64,
+}
+
+impl ResolvedAssets {
+    /// `look` resolved: `None` while its file loads.
+    pub fn get(&self, look: &AssetLook) -> Option<&Result<Arc<ResolvedAsset>, AssetLookError>> {
+        self.looks.get(&(look.gltf.id(), look.root.clone()))
+    }
+
+    /// `look` ready to draw, if it is.
+    pub fn ready(&self, look: &AssetLook) -> Option<&Arc<ResolvedAsset>> {
+        self.get(look)?.as_ref().ok()
+    }
+
+    /// Counts the changes: chunks drawn before a change are drawn again after it.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+}
+
+/// What resolving reads and writes.
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct AssetSources<'w> {
+    server: Res<'w, AssetServer>,
+    files: Res<'w, Assets<Gltf>>,
+    nodes: Res<'w, Assets<GltfNode>>,
+    gltf_meshes: Res<'w, Assets<GltfMesh>>,
+    materials: Res<'w, Assets<GltfMaterial>>,
+    meshes: ResMut<'w, Assets<Mesh>>,
+}
+
+impl AssetSources<'_> {
+    /// `look` resolved, or `None` while its file (or something it names) is loading.
+    fn resolve(&mut self, look: &AssetLook) -> Option<Result<Arc<ResolvedAsset>, AssetLookError>> {
+        let id = look.gltf.id();
+        if let Some(LoadState::Failed(e)) = self.server.get_load_state(id) {
+            return Some(Err(AssetLookError::Load(e.to_string())));
+        }
+        let loaded = self.server.is_loaded_with_dependencies(id);
+        let gltf = self.files.get(id).filter(|_| loaded)?;
+        let from = GltfAssets {
+            nodes: &self.nodes,
+            meshes: &self.gltf_meshes,
+            materials: &self.materials,
+        };
+        let resolved = crate::look::asset::resolve_asset(gltf, &look.root, from, &mut self.meshes);
+        if let Err(e) = &resolved {
+            error!("asset class {:?} cannot be drawn: {e}", look.gltf.path());
+        }
+        Some(resolved.map(Arc::new))
+    }
+}
+
+/// Resolves the layers' asset looks that are not yet, and again those whose file changed.
+pub(super) fn resolve_asset_looks(
+    layers: Query<&ScatterLayer>,
+    events: Option<Res<Messages<AssetEvent<Gltf>>>>,
+    mut cursor: Local<MessageCursor<AssetEvent<Gltf>>>,
+    sources: Option<AssetSources>,
+    mut resolved: ResMut<ResolvedAssets>,
+) {
+    let Some(mut sources) = sources else { return };
+    if let Some(events) = events {
+        for event in cursor.read(&events) {
+            if let AssetEvent::Modified { id } | AssetEvent::Removed { id } = event {
+                let before = resolved.looks.len();
+                resolved.looks.retain(|(file, _), _| file != id);
+                if resolved.looks.len() != before {
+                    resolved.generation += 1;
+                }
+            }
+        }
+    }
+    let looks = layers
+        .iter()
+        .flat_map(|l| &l.classes)
+        .filter_map(|c| match &c.look {
+            ClassLook::Asset(look) => Some(look),
+            _ => None,
+        });
+    for look in looks {
+        let key = (look.gltf.id(), look.root.clone());
+        if resolved.looks.contains_key(&key) {
+            continue;
+        }
+        if let Some(result) = sources.resolve(look) {
+            resolved.looks.insert(key, result);
+            resolved.generation += 1;
+        }
+    }
+}

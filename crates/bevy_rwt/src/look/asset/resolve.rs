@@ -1,0 +1,214 @@
+//! An asset class's look ([`AssetLook`]: a glTF file, or a scene or node of it) made ready
+//! to draw instanced ([`ResolvedAsset`]): each level's primitives as meshes in the asset's
+//! frame (their node transforms applied once, here) with their surfaces, the colliders'
+//! meshes, and the asset's bounds.
+
+use super::file::{AssetPrimitive, AssetRoot, AssetTreeError, asset_tree};
+use super::parts::{AssetParts, Placed};
+use super::surface::{InstancedSurface, SurfaceError};
+use crate::look::{InstancedClassError, InstancedShading, InstancedShadows, check_instanced_mesh};
+use bevy::gltf::{Gltf, GltfMaterial, GltfMesh, GltfNode};
+use bevy::prelude::*;
+
+/// The look of a class drawn from a game's own glTF asset: every primitive under
+/// [`AssetLook::root`], with its material, drawn instanced (one draw per primitive per chunk
+/// and view). Nodes named `_LOD0`, `_LOD1`… give levels of detail; nodes named `UCX_…`,
+/// `…_collider`, `…-colonly` collide and are never drawn ([`super::NodeRole`]).
+///
+/// The asset's frame is its root's: y up, standing on its origin.
+#[derive(Clone, Debug, Reflect)]
+#[reflect(Clone, Debug)]
+pub struct AssetLook {
+    /// The file (loaded with the asset server: `asset_server.load("trees/oak.glb")`).
+    pub gltf: Handle<Gltf>,
+    /// Which part of the file is the asset.
+    pub root: AssetRoot,
+    /// Strength of the per-instance colour variation, hashed from its point (0..1).
+    pub color_variation: f32,
+    /// How far the top sways in the wind, in asset heights per unit of wind strength,
+    /// weighted by height in the asset (0: rigid, rocks).
+    pub wind_response: f32,
+    /// How far instances lean where a [`Bender`](crate::instancing::Bender) passed (0: they
+    /// do not).
+    pub bend_response: f32,
+    /// Width of the fade-in band, as for [`InstancedShading::fade_band`](crate::look::InstancedShading::fade_band).
+    pub fade_band: f32,
+    /// Whether the class casts shadows.
+    pub shadows: InstancedShadows,
+}
+
+impl AssetLook {
+    /// The whole file `gltf`, rigid, casting shadows.
+    pub fn new(gltf: Handle<Gltf>) -> Self {
+        Self {
+            gltf,
+            root: AssetRoot::File,
+            color_variation: 0.0,
+            wind_response: 0.0,
+            bend_response: 0.0,
+            fade_band: 0.1,
+            shadows: InstancedShadows::On,
+        }
+    }
+
+    /// This look, of `root` in the file.
+    pub fn with_root(mut self, root: AssetRoot) -> Self {
+        self.root = root;
+        self
+    }
+
+    /// The shading of a primitive of `surface` in this look: the class's motion, fade,
+    /// shadows and colour variation; the surface's base colour (root and tip alike),
+    /// texture, roughness and cut-off.
+    pub fn shading(&self, surface: &InstancedSurface) -> InstancedShading {
+        InstancedShading {
+            base_color: surface.base_color,
+            tip_color: surface.base_color,
+            color_variation: self.color_variation,
+            roughness: surface.perceptual_roughness,
+            wind_response: self.wind_response,
+            fade_band: self.fade_band,
+            tip_from: 0.0,
+            shadows: self.shadows,
+            texture: surface.base_color_texture.clone(),
+            alpha_cutoff: surface.alpha_cutoff(),
+            bend_response: self.bend_response,
+            thinning: None,
+        }
+    }
+}
+
+/// One primitive of an asset as drawn: its mesh in the asset's frame, and its surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AssetPart {
+    /// The mesh, its node's transform applied.
+    pub mesh: Handle<Mesh>,
+    /// Its material.
+    pub surface: InstancedSurface,
+}
+
+/// An asset ready to draw instanced.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResolvedAsset {
+    /// What each level of detail draws, nearest first (at least one level, none empty).
+    pub levels: Vec<Vec<AssetPart>>,
+    /// The collider nodes' meshes, in the asset's frame.
+    pub colliders: Vec<Handle<Mesh>>,
+    /// The bounds of every level (min, max), in the asset's frame.
+    pub bounds: (Vec3, Vec3),
+}
+
+/// Why an asset class cannot be drawn. The class draws nothing; the other classes stream on.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum AssetLookError {
+    /// The file did not load (missing, truncated, not glTF).
+    #[error("the asset did not load: {0}")]
+    Load(String),
+    /// Its node tree cannot be read.
+    #[error(transparent)]
+    Tree(#[from] AssetTreeError),
+    /// A primitive's material cannot be drawn instanced.
+    #[error("a primitive's material cannot be drawn instanced: {0}")]
+    Surface(#[from] SurfaceError),
+    /// A primitive's mesh cannot be drawn instanced.
+    #[error("a primitive's mesh cannot be drawn instanced: {0}")]
+    Mesh(#[from] InstancedClassError),
+    /// A primitive's mesh keeps its data in the render world only (load the file with
+    /// `RenderAssetUsages::MAIN_WORLD` in its meshes' usages).
+    #[error("a primitive's mesh is not in the main world")]
+    MeshNotInMainWorld,
+    /// Nothing under the root is drawn.
+    #[error("the asset has no primitive to draw")]
+    NothingDrawn,
+}
+
+/// The loaded assets an asset's tree is read from.
+#[derive(Clone, Copy)]
+pub struct GltfAssets<'a> {
+    /// The files' nodes.
+    pub nodes: &'a Assets<GltfNode>,
+    /// The files' meshes.
+    pub meshes: &'a Assets<GltfMesh>,
+    /// The files' materials.
+    pub materials: &'a Assets<GltfMaterial>,
+}
+
+/// `root` of the loaded file `gltf` made ready to draw: its primitives' meshes moved into
+/// the asset's frame (added to `meshes`, shared where a node does not move its mesh).
+pub fn resolve_asset(
+    gltf: &Gltf,
+    root: &AssetRoot,
+    from: GltfAssets,
+    meshes: &mut Assets<Mesh>,
+) -> Result<ResolvedAsset, AssetLookError> {
+    let tree = asset_tree(gltf, root, from.nodes, from.meshes)?;
+    let parts = AssetParts::split(&tree);
+    let mut bounds = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    let mut levels = Vec::with_capacity(parts.levels.len());
+    for level in &parts.levels {
+        let mut drawn = Vec::with_capacity(level.len());
+        for placed in level {
+            let surface = surface_of(&placed.primitive, from.materials)?;
+            let (mesh, (lo, hi)) = placed_mesh(placed, meshes)?;
+            bounds = (bounds.0.min(lo), bounds.1.max(hi));
+            drawn.push(AssetPart { mesh, surface });
+        }
+        levels.push(drawn);
+    }
+    if levels.iter().any(Vec::is_empty) {
+        return Err(AssetLookError::NothingDrawn);
+    }
+    let colliders = parts
+        .colliders
+        .iter()
+        .map(|placed| placed_mesh(placed, meshes).map(|(mesh, _)| mesh))
+        .collect::<Result<_, _>>()?;
+    Ok(ResolvedAsset {
+        levels,
+        colliders,
+        bounds,
+    })
+}
+
+/// The surface of a primitive (glTF's default material where it names none).
+fn surface_of(
+    primitive: &AssetPrimitive,
+    materials: &Assets<GltfMaterial>,
+) -> Result<InstancedSurface, AssetLookError> {
+    let default = GltfMaterial::default();
+    let material = match &primitive.material {
+        Some(handle) => materials
+            .get(handle)
+            .ok_or_else(|| AssetTreeError::NotLoaded(format!("{handle:?}")))?,
+        None => &default,
+    };
+    Ok(InstancedSurface::try_from(material)?)
+}
+
+/// The primitive's mesh in the asset's frame, and its bounds there.
+fn placed_mesh(
+    placed: &Placed<AssetPrimitive>,
+    meshes: &mut Assets<Mesh>,
+) -> Result<(Handle<Mesh>, (Vec3, Vec3)), AssetLookError> {
+    let handle = &placed.primitive.mesh;
+    let mesh = meshes
+        .get(handle)
+        .ok_or_else(|| AssetTreeError::NotLoaded(format!("{handle:?}")))?;
+    if mesh.try_attribute(Mesh::ATTRIBUTE_POSITION).is_err() && mesh.try_attributes().is_err() {
+        return Err(AssetLookError::MeshNotInMainWorld);
+    }
+    if placed.transform == Transform::IDENTITY {
+        let bounds = check(mesh)?;
+        return Ok((handle.clone(), bounds));
+    }
+    let moved = mesh.clone().transformed_by(placed.transform);
+    let bounds = check(&moved)?;
+    Ok((meshes.add(moved), bounds))
+}
+
+fn check(mesh: &Mesh) -> Result<(Vec3, Vec3), AssetLookError> {
+    match check_instanced_mesh(mesh) {
+        Some(checked) => Ok(checked?),
+        None => Err(AssetLookError::MeshNotInMainWorld),
+    }
+}
