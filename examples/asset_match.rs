@@ -64,7 +64,7 @@ impl Density for Patch {
 }
 
 fn main() -> AppExit {
-    write_asset();
+    rwt_examples::generated::write_asset(FILE, &asset().to_bytes());
     let mut app = App::new();
     app.add_plugins(rwt_examples::example_plugins("rwt asset_match"))
         .add_plugins(RwtPlugins::default())
@@ -136,18 +136,6 @@ fn leaf_png() -> Vec<u8> {
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .expect("a PNG encodes in memory");
     png
-}
-
-/// Writes the asset where the asset server reads it (only when it changed).
-fn write_asset() {
-    let root =
-        std::env::var("BEVY_ASSET_ROOT").unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").into());
-    let path = std::path::Path::new(&root).join("assets").join(FILE);
-    let bytes = asset().to_bytes();
-    if std::fs::read(&path).ok().as_deref() != Some(bytes.as_slice()) {
-        std::fs::create_dir_all(path.parent().expect("a folder")).expect("assets/generated");
-        bevy_rwt::rwt_core::files::write_atomic(&path, &bytes).expect("the asset is written");
-    }
 }
 
 fn setup(mut commands: Commands, server: Res<AssetServer>) {

@@ -17,7 +17,10 @@
 # impostor_match, which fails unless trees drawn as impostors cover the pixels their meshes
 # cover (silhouette IoU >= 0.8), coloured alike, culled per instance as the CPU does, and
 # asset_match, which fails unless a glTF asset drawn instanced covers the pixels Bevy's own
-# scene entities of it cover (silhouette IoU >= 0.98, each primitive's colour in its place).
+# scene entities of it cover (silhouette IoU >= 0.98, each primitive's colour in its place),
+# and asset_lods, which fails unless an asset's levels of detail, chosen per instance on the
+# GPU, draw fewer vertices as the camera moves away, each instance the level its distance
+# calls for.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -29,10 +32,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match)
+examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_lods)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_lods)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -111,6 +114,11 @@ for run in "${runs[@]}"; do
     if [ "$ex" = asset_match ]; then
         # Assets: rwt's instanced draw of a glTF asset against Bevy's scene entities.
         self_checked RWT_ASSET_DIR=$out/asset rwt-asset 'instances'
+        continue
+    fi
+    if [ "$ex" = asset_lods ]; then
+        # Levels of detail per instance: the vertices the indirect arguments draw.
+        self_checked RWT_LODS=1 rwt-lods 'vertices'
         continue
     fi
     # CI's runs take fewer frames than the 150 of the docs' (the same checks): open_world

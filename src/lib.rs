@@ -2,7 +2,8 @@
 //! real renderer ([`smoke`]), a fly camera ([`fly_camera`]), a text HUD ([`hud`]) and the
 //! brush's last answer for it ([`brush_status`]), the field of grass the cost benchmarks
 //! time ([`grass_field`]) and their frame timing ([`frame_clock`]), and frames captured and
-//! compared by the examples that check themselves ([`frame_check`]).
+//! compared by the examples that check themselves ([`frame_check`]), and the files they
+//! write for the asset server ([`generated`]).
 //!
 //! Run an example as a user would (`cargo run --release --example open_world`), or as CI
 //! does: `RWT_SCREENSHOT=out.png cargo run --example open_world` plays the example's script,
@@ -14,6 +15,7 @@ pub mod foliage;
 pub mod forest;
 pub mod frame_check;
 pub mod frame_clock;
+pub mod generated;
 pub mod grass_field;
 pub mod hud;
 pub mod smoke;

@@ -33,14 +33,7 @@ fn main() {
 
 /// Writes the level's `.glb` where the asset server reads it (only when it changed).
 fn write_level() {
-    let root =
-        std::env::var("BEVY_ASSET_ROOT").unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").into());
-    let path = std::path::Path::new(&root).join("assets/levels/island.glb");
-    let bytes = level::glb(&level::parts());
-    if std::fs::read(&path).ok().as_deref() != Some(bytes.as_slice()) {
-        std::fs::create_dir_all(path.parent().expect("a folder")).expect("assets/levels");
-        bevy_rwt::rwt_core::files::write_atomic(&path, &bytes).expect("the level is written");
-    }
+    rwt_examples::generated::write_asset("levels/island.glb", &level::glb(&level::parts()));
 }
 
 /// The moss layer, whose ground the rocks are.

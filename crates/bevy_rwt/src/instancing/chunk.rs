@@ -122,6 +122,10 @@ pub struct InstancedChunk {
     /// The crossfade band (distance from the camera to an instance's root) over which the
     /// instances fade out, dithered, where the class's impostors take over.
     pub fade_out: Option<(f32, f32)>,
+    /// The crossfade band over which the instances fade in, dithered, where a nearer level
+    /// of detail of the class hands over to this one (the same band as that level's
+    /// `fade_out`).
+    pub fade_in: Option<(f32, f32)>,
 }
 
 /// How a chunk of impostors is drawn: where the atlas's views lie, and the crossfade band

@@ -426,6 +426,7 @@ impl<'a> Upload<'a> {
             buffer,
             impostor: None,
             fade_out,
+            fade_in: None,
             surface: None,
         };
         let aabb = component.aabb(self.checked.class_bounds(&component.meshes, self.meshes));
@@ -433,8 +434,9 @@ impl<'a> Upload<'a> {
     }
 }
 
-/// The components drawing `buffer` of an asset class: one per primitive of its nearest
-/// level, each bounded by the whole asset (its top is the wind's and the fade's height).
+/// The components drawing `buffer` of an asset class: one per primitive of each level,
+/// each level fading in where the one before hands over and out where the next takes over,
+/// each part bounded by the whole asset (its top is the wind's and the fade's height).
 #[cfg(feature = "gltf")]
 fn asset_parts(
     target: Target,
@@ -446,10 +448,14 @@ fn asset_parts(
     buffer: Arc<InstanceBuffer>,
 ) -> Vec<(InstancedChunk, Aabb)> {
     let c = &target.layer.classes[class as usize];
-    let level = asset.levels.first().map_or(&[][..], Vec::as_slice);
-    level
-        .iter()
-        .map(|part| {
+    let switches = look.lods.switches(asset.levels.len(), asset.bounds);
+    let band = |level: usize| switches.get(level).map(|d| look.lods.band(*d));
+    let parts = asset.levels.iter().enumerate().flat_map(|(level, parts)| {
+        let fades = (level.checked_sub(1).and_then(band), band(level));
+        parts.iter().map(move |part| (part, fades))
+    });
+    parts
+        .map(|(part, (fade_in, fade_out))| {
             let component = InstancedChunk {
                 layer: target.entity,
                 chunk: target.chunk,
@@ -464,7 +470,8 @@ fn asset_parts(
                 falloff: layer_falloff(target.layer),
                 buffer: buffer.clone(),
                 impostor: None,
-                fade_out: None,
+                fade_out,
+                fade_in,
             };
             let aabb = component.aabb(asset.bounds);
             (component, aabb)
@@ -521,6 +528,7 @@ fn impostor_chunk(
         buffer,
         impostor: Some(ImpostorDraw { frames, band }),
         surface: None,
+        fade_in: None,
         fade_out: None,
     }
 }

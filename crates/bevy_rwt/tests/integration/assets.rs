@@ -197,7 +197,8 @@ fn an_asset_class_draws_each_primitive_and_a_bad_file_fails_alone() {
         panic!("{:?}", status.class_errors);
     };
     assert!(matches!(**e, AssetLookError::Load(_)), "{e}");
-    // Per chunk, one entity per primitive of the nearest level, sharing one buffer.
+    // Per chunk, one entity per primitive of each level, sharing one buffer; the near
+    // level fades out over the band the far one fades in over.
     let mut chunks = app.world_mut().query::<&InstancedChunk>();
     let mut per_chunk: HashMap<_, Vec<&InstancedChunk>> = HashMap::new();
     for c in chunks.iter(app.world()) {
@@ -205,11 +206,23 @@ fn an_asset_class_draws_each_primitive_and_a_bad_file_fails_alone() {
         per_chunk.entry(c.chunk).or_default().push(c);
     }
     for parts in per_chunk.values() {
-        assert_eq!(parts.len(), 2, "bark and leaves");
-        assert!(std::sync::Arc::ptr_eq(&parts[0].buffer, &parts[1].buffer));
+        assert_eq!(parts.len(), 3, "bark and leaves near, a card far");
+        assert!(
+            parts
+                .iter()
+                .all(|p| std::sync::Arc::ptr_eq(&p.buffer, &parts[0].buffer))
+        );
         let surfaces: Vec<_> = parts.iter().map(|p| p.surface.as_ref().unwrap()).collect();
-        assert_eq!(surfaces.iter().filter(|s| s.double_sided).count(), 1);
+        assert_eq!(surfaces.iter().filter(|s| s.double_sided).count(), 2);
         assert!(parts.iter().all(|p| (p.mesh_top - 4.5).abs() < 1e-4));
+        let near: Vec<_> = parts.iter().filter(|p| p.fade_in.is_none()).collect();
+        let far: Vec<_> = parts.iter().filter(|p| p.fade_in.is_some()).collect();
+        assert_eq!((near.len(), far.len()), (2, 1));
+        assert!(
+            near.iter()
+                .all(|p| p.fade_out == far[0].fade_in && p.fade_out.is_some())
+        );
+        assert_eq!(far[0].fade_out, None, "the last level is drawn to the edge");
     }
     std::fs::remove_dir_all(&dir).ok();
 }

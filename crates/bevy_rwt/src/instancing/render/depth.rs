@@ -106,12 +106,13 @@ impl SpecializedMeshPipeline for InstancedDepthPipeline {
         // A textured class needs the fragment stage to cut out, even for depth alone, and a
         // class fading out to dither.
         let fragment =
-            (writes || key.features.textured || key.features.fades_out).then(|| FragmentState {
-                shader: self.bindings.shader.clone(),
-                shader_defs: defs.clone(),
-                targets: if normals || motion { targets } else { vec![] },
-                ..default()
-            });
+            (writes || key.features.textured || key.features.fades_out || key.features.fades_in)
+                .then(|| FragmentState {
+                    shader: self.bindings.shader.clone(),
+                    shader_defs: defs.clone(),
+                    targets: if normals || motion { targets } else { vec![] },
+                    ..default()
+                });
         let view_layout = if motion {
             self.prepass.view_layout_motion_vectors.clone()
         } else {

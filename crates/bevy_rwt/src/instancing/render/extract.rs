@@ -45,6 +45,7 @@ impl ExtractedChunk {
             bends: self.uniform.bend_response != 0.0,
             impostor: self.uniform.impostor_views != 0 && textured,
             fades_out: self.uniform.fade_out_to > 0.0,
+            fades_in: self.uniform.fade_in_to > 0.0 && self.uniform.impostor_views == 0,
             surface: self.surface,
         }
     }
@@ -113,8 +114,11 @@ pub(super) struct ClassFeatures {
     pub(super) bends: bool,
     /// The chunk draws impostors, cards showing its texture's atlas (`RWT_IMPOSTOR`).
     pub(super) impostor: bool,
-    /// The chunk's meshes fade out where its class's impostors take over (`RWT_FADE_OUT`).
+    /// The chunk's meshes fade out where its class's impostors or a farther level of detail
+    /// take over (`RWT_FADE_OUT`).
     pub(super) fades_out: bool,
+    /// The chunk's meshes fade in where a nearer level of detail hands over (`RWT_FADE_IN`).
+    pub(super) fades_in: bool,
     /// The chunk draws an asset's primitive (`RWT_SURFACE`).
     pub(super) surface: Option<SurfaceFeatures>,
 }
@@ -153,7 +157,7 @@ impl ExtractComponent for InstancedChunk {
             mesh: chunk.mesh.id(),
             lods: MeshLods::of(chunk),
             uniform: ChunkUniform::new(origin, chunk.mesh_top, &chunk.material, chunk.falloff)
-                .with_impostor(chunk.impostor.as_ref(), chunk.fade_out)
+                .with_impostor(chunk.impostor.as_ref(), chunk.fade_in, chunk.fade_out)
                 .with_surface(chunk.surface.as_ref()),
             bounds: Aabb {
                 center: local.center + origin.to_vec3a(),

@@ -36,6 +36,7 @@ fn app_with_a_chunk() -> (App, Entity) {
         buffer: Arc::new(InstanceBuffer::default()),
         impostor: None,
         fade_out: None,
+        fade_in: None,
         surface: None,
     };
     let aabb = Aabb::from_min_max(Vec3::ZERO, Vec3::ONE);

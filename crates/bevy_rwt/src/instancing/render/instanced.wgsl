@@ -143,6 +143,10 @@ struct VertexOutput {
 #ifdef RWT_NORMAL_MAP
     @location(8) world_tangent: vec4<f32>,
 #endif
+#ifdef RWT_FADE_IN
+    // The mesh's dither level as it takes over from a nearer level of detail (-16..0).
+    @location(9) @interpolate(flat) fade_in: f32,
+#endif
 };
 
 fn hash2(p: vec2<f32>) -> f32 {
@@ -275,15 +279,37 @@ fn dither(frag_coord: vec4<f32>, level: f32) {
     }
 }
 
-// The crossfades between a class's meshes and its impostors this fragment takes part in:
-// an impostor fading in, a mesh fading out.
+// The crossfades between a class's levels of detail and its impostors this fragment takes
+// part in: an impostor or a mesh fading in, a mesh fading out.
 fn crossfade(in: VertexOutput) {
 #ifdef RWT_IMPOSTOR
     dither(in.clip_position, in.impostor.z);
 #endif
+#ifdef RWT_FADE_IN
+    dither(in.clip_position, in.fade_in);
+#endif
 #ifdef RWT_FADE_OUT
     dither(in.clip_position, in.fade_out);
 #endif
+}
+
+// The dither level of a look (an impostor, a farther level of detail) `d` from the eye as
+// it takes over: -16 (not drawn) before its crossfade band, rising to 0 (whole) at its
+// end. The look it takes over from fades out over the same band with the level 16 more
+// (Bevy's visibility range, or `fade_out_level`), so every pixel shows one of the two.
+fn fade_in_level(d: f32) -> f32 {
+    let span = max(chunk.fade_in_to - chunk.fade_in_from, 1e-3);
+    return -16.0 + clamp(round((d - chunk.fade_in_from) / span * 16.0), 0.0, 16.0);
+}
+
+// Whether the mesh of an instance at `root` is drawn at all: not once a farther look took
+// over, nor before its own crossfade in begins.
+fn mesh_shown(root: vec3<f32>) -> bool {
+    var shown = fade_out_level(root) < 16.0;
+#ifdef RWT_FADE_IN
+    shown = shown && fade_in_level(distance(lod_eye(), root)) > -16.0;
+#endif
+    return shown;
 }
 
 // The dither level of a class's mesh at `root` as its impostors take over: 0 (whole)
@@ -304,8 +330,8 @@ fn place(in: Vertex, time: f32) -> Placed {
     let tint = in.yaw_appear_tint.z;
     let eye = eye_xz();
     let kept = kept_fraction(chunk.lod, eye, root);
-    // A mesh its impostor replaced collapses to its root.
-    let shown = select(1.0, 0.0, fade_out_level(root) >= 16.0);
+    // A mesh another look replaced collapses to its root.
+    let shown = select(0.0, 1.0, mesh_shown(root));
     let scale = in.offset_scale.w * growth(chunk.lod, eye, root, in.yaw_appear_tint.y, kept) * shown;
     let c = cos(yaw);
     let s = sin(yaw);
@@ -369,15 +395,6 @@ fn placed_at(placed: Placed, time: f32) -> vec3<f32> {
 }
 
 #ifdef RWT_IMPOSTOR
-// The dither level of an impostor `d` from the eye: -16 (not drawn) before the crossfade
-// band, rising to 0 (whole) at its end. The mesh fades out over the same band with the
-// level 16 more (Bevy's visibility range, or `fade_out_level`), so every pixel shows one of
-// the two.
-fn fade_in_level(d: f32) -> f32 {
-    let span = max(chunk.fade_in_to - chunk.fade_in_from, 1e-3);
-    return -16.0 + clamp(round((d - chunk.fade_in_from) / span * 16.0), 0.0, 16.0);
-}
-
 // An impostor's card: centred on the baked views' centre (turned with the instance), facing
 // the eye, pulled towards it by half its width (so that the ground around the root does
 // not cut it) and shrunk to keep its size on screen. It shows the view nearest to the
@@ -472,6 +489,9 @@ fn vertex(in: Vertex) -> VertexOutput {
 #ifdef RWT_FADE_OUT
     out.fade_out = fade_out_level(chunk.origin + in.offset_scale.xyz);
 #endif
+#ifdef RWT_FADE_IN
+    out.fade_in = fade_in_level(distance(lod_eye(), chunk.origin + in.offset_scale.xyz));
+#endif
 #ifdef UNCLIPPED_DEPTH_ORTHO_EMULATION
     out.unclipped_depth = out.clip_position.z;
     out.clip_position.z = min(out.clip_position.z, 1.0);
@@ -541,11 +561,18 @@ fn fragment(in: VertexOutput) {
 }
 #else
 #ifdef RWT_FADE_OUT
-// Depth alone of an untextured class: only the crossfade with its impostors.
+// Depth alone of an untextured class: only the crossfades with its other looks.
 @fragment
 fn fragment(in: VertexOutput) {
     crossfade(in);
 }
+#else
+#ifdef RWT_FADE_IN
+@fragment
+fn fragment(in: VertexOutput) {
+    crossfade(in);
+}
+#endif
 #endif
 #endif
 #endif

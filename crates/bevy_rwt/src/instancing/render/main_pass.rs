@@ -94,6 +94,9 @@ pub(super) fn mesh_attributes(
     if features.fades_out {
         defs.push("RWT_FADE_OUT".into());
     }
+    if features.fades_in {
+        defs.push("RWT_FADE_IN".into());
+    }
     if let Some(surface) = features.surface {
         defs.push("RWT_SURFACE".into());
         if surface.normal_map {

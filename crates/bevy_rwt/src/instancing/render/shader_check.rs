@@ -131,7 +131,7 @@ fn cache_with_library() -> ShaderCache<String, ()> {
 
 /// The class features the pipelines combine: a class's own look's, then an asset
 /// surface's.
-const FEATURES: [&str; 9] = [
+const FEATURES: [&str; 10] = [
     "RWT_NORMALS",
     "RWT_BEND",
     "RWT_TEXTURE",
@@ -141,6 +141,7 @@ const FEATURES: [&str; 9] = [
     "RWT_NORMAL_MAP",
     "RWT_DOUBLE_SIDED",
     "RWT_VERTEX_COLORS",
+    "RWT_FADE_IN",
 ];
 
 /// Whether the pipelines can combine the features of `bits` (bit `i`: `FEATURES[i]`).
@@ -148,15 +149,18 @@ fn possible(bits: usize) -> bool {
     let has = |name: &str| bits >> FEATURES.iter().position(|f| *f == name).unwrap() & 1 == 1;
     // Impostors are always textured (their atlas), and never fade out.
     let impostor = !has("RWT_IMPOSTOR") || (has("RWT_TEXTURE") && !has("RWT_FADE_OUT"));
-    // An asset's surface has no impostor and no fade-out of its own; its normal map needs
-    // normals and UVs; its other features exist only with it.
+    // An asset's surface has no impostor; its normal map needs normals and UVs; its other
+    // features, and fading in (a farther level of detail), exist only with it. Its levels'
+    // crossfades are composed with every extra or none (the features are independent).
+    let extras = ["RWT_NORMAL_MAP", "RWT_DOUBLE_SIDED", "RWT_VERTEX_COLORS"].map(has);
+    let fades = has("RWT_FADE_IN") || has("RWT_FADE_OUT");
     let surface = match has("RWT_SURFACE") {
         true => {
             !has("RWT_IMPOSTOR")
-                && !has("RWT_FADE_OUT")
                 && (!has("RWT_NORMAL_MAP") || (has("RWT_TEXTURE") && has("RWT_NORMALS")))
+                && (!fades || extras.iter().all(|e| *e) || extras.iter().all(|e| !e))
         }
-        false => bits >> 6 == 0,
+        false => !has("RWT_FADE_IN") && extras.iter().all(|e| !e),
     };
     impostor && surface
 }
@@ -421,8 +425,9 @@ fn every_permutation_composes_and_validates_with_the_uniform_layouts() {
         failed.len(),
         failed.join("\n")
     );
-    // 20 combinations of a class's own look's features, 40 of an asset surface's.
-    assert_eq!(composed.len(), (20 + 40) * 17);
+    // 20 combinations of a class's own look's features, 40 of an asset surface's without
+    // crossfades, 30 with them.
+    assert_eq!(composed.len(), (20 + 40 + 30) * 17);
     let (chunk, frame, lod) = (marked_chunk(), marked_frame(), marked_lod());
     for types in &composed {
         assert_eq!(struct_layout(types, "Chunk"), chunk);

@@ -94,11 +94,19 @@ impl ChunkUniform {
         }
     }
 
-    /// The uniform drawing impostors as `draw` says, or a mesh fading out over
-    /// `fade_out`.
-    pub fn with_impostor(self, draw: Option<&ImpostorDraw>, fade_out: Option<(f32, f32)>) -> Self {
+    /// The uniform drawing impostors as `draw` says, or a mesh fading in and out over the
+    /// bands `fade_in` and `fade_out`.
+    pub fn with_impostor(
+        self,
+        draw: Option<&ImpostorDraw>,
+        fade_in: Option<(f32, f32)>,
+        fade_out: Option<(f32, f32)>,
+    ) -> Self {
+        let (fade_in_from, fade_in_to) = fade_in.unwrap_or((0.0, 0.0));
         let (fade_out_from, fade_out_to) = fade_out.unwrap_or((0.0, 0.0));
         let this = Self {
+            fade_in_from,
+            fade_in_to,
             fade_out_from,
             fade_out_to,
             ..self

@@ -35,6 +35,61 @@ pub struct AssetLook {
     pub fade_band: f32,
     /// Whether the class casts shadows.
     pub shadows: InstancedShadows,
+    /// Where each level of detail takes over from the one before.
+    pub lods: AssetLods,
+}
+
+/// Where an asset's levels of detail switch: each instance draws the level its own distance
+/// from the camera calls for, crossfading (dithered) into the next over a band.
+#[derive(Clone, Debug, PartialEq, Reflect)]
+#[reflect(Clone, Debug, PartialEq)]
+pub struct AssetLods {
+    /// The distance at which level `i + 1` takes over from level `i` (metres from the
+    /// camera to an instance's root); levels beyond the list switch where the asset
+    /// covers [`AssetLods::COVERAGE`] of the screen's height, halving at each level.
+    pub distances: Vec<f32>,
+    /// Width of each crossfade band, as a fraction of its distance (centred on it).
+    pub crossfade: f32,
+}
+
+impl Default for AssetLods {
+    fn default() -> Self {
+        Self {
+            distances: Vec::new(),
+            crossfade: 0.1,
+        }
+    }
+}
+
+impl AssetLods {
+    /// The fraction of the screen's height (under a 45-degree lens) an asset covers where
+    /// its second level takes over, unless [`AssetLods::distances`] says where.
+    pub const COVERAGE: f32 = 0.25;
+
+    /// The switch distances of an asset of `levels` levels within `bounds`, nearest first
+    /// (one fewer than the levels, rising).
+    pub fn switches(&self, levels: usize, bounds: (Vec3, Vec3)) -> Vec<f32> {
+        let radius = 0.5 * (bounds.1 - bounds.0).length().max(1e-3);
+        let mut last = 0.0f32;
+        (1..levels)
+            .map(|level| {
+                let covered = Self::COVERAGE / (1u64 << (level - 1).min(30)) as f32;
+                let derived = radius / (covered * (std::f32::consts::PI / 8.0).tan());
+                let given = self.distances.get(level - 1).copied();
+                let d = given
+                    .filter(|d| d.is_finite() && *d > 0.0)
+                    .unwrap_or(derived);
+                last = d.max(last * 1.01);
+                last
+            })
+            .collect()
+    }
+
+    /// The crossfade band around the switch at `distance`.
+    pub fn band(&self, distance: f32) -> (f32, f32) {
+        let half = 0.5 * self.crossfade.clamp(0.0, 1.0) * distance;
+        (distance - half, distance + half.max(1e-3))
+    }
 }
 
 impl AssetLook {
@@ -48,6 +103,7 @@ impl AssetLook {
             bend_response: 0.0,
             fade_band: 0.1,
             shadows: InstancedShadows::On,
+            lods: AssetLods::default(),
         }
     }
 
@@ -210,5 +266,37 @@ fn check(mesh: &Mesh) -> Result<(Vec3, Vec3), AssetLookError> {
     match check_instanced_mesh(mesh) {
         Some(checked) => Ok(checked?),
         None => Err(AssetLookError::MeshNotInMainWorld),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn levels_switch_where_given_else_where_the_asset_covers_less_of_the_screen() {
+        // A 2 m box: radius sqrt(3), a quarter of a 45-degree screen at about 16.7 m.
+        let bounds = (Vec3::splat(-1.0), Vec3::splat(1.0));
+        let derived = AssetLods::default().switches(3, bounds);
+        assert_eq!(derived.len(), 2);
+        let first = 3f32.sqrt() / (0.25 * (std::f32::consts::PI / 8.0).tan());
+        assert!((derived[0] - first).abs() < 1e-3, "{derived:?}");
+        assert!(
+            (derived[1] - 2.0 * first).abs() < 1e-3,
+            "half the cover, twice as far"
+        );
+        // Given distances first, the rest derived; never falling, never nonsense.
+        let given = AssetLods {
+            distances: vec![50.0, 20.0, f32::NAN],
+            crossfade: 0.2,
+        };
+        let switches = given.switches(4, bounds);
+        assert_eq!(switches[0], 50.0);
+        assert!(
+            switches[1] > 50.0 && switches[2] > switches[1],
+            "{switches:?}"
+        );
+        assert_eq!(given.band(50.0), (45.0, 55.0));
+        assert!(AssetLods::default().switches(1, bounds).is_empty());
     }
 }

@@ -65,6 +65,9 @@ pub struct CullingReport {
     /// Instances of those draws that the rest of the test keeps and the cascade's depth hid
     /// (neither phase kept them; the CPU's count less the GPU's).
     pub cascade_occluded: u64,
+    /// Vertices the culled draws of cameras' views draw: each draw's index (or vertex)
+    /// count times the instances it kept, read back from the indirect arguments.
+    pub camera_vertices: u64,
 }
 
 impl CullingCheck {
@@ -219,7 +222,8 @@ pub(in crate::instancing) fn check_culling(
     ) else {
         return;
     };
-    let count = |draw: usize| words[draw * ARGS_WORDS as usize + 1];
+    let word = |draw: usize, k: usize| words[draw * ARGS_WORDS as usize + k];
+    let count = |draw: usize| word(draw, 1);
     let mut report = CullingReport {
         slab_capacity: u64::from(slab.capacity()),
         ..default()
@@ -227,6 +231,11 @@ pub(in crate::instancing) fn check_culling(
     for (i, c) in checked.iter().enumerate() {
         let (early, late) = (count(i), count(checked.len() + i));
         compare_draw(&mut report, c, &pool, early, late);
+        if !c.shadow {
+            // The first word of an indexed or a direct draw's arguments: its vertices.
+            let vertices = u64::from(word(i, 0));
+            report.camera_vertices += vertices * u64::from(early + late);
+        }
     }
     check.answer(report);
 }
