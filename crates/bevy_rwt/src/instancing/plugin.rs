@@ -70,14 +70,16 @@ impl Plugin for RwtInstancingPlugin {
                 ),
             );
         #[cfg(feature = "gltf")]
-        app.init_resource::<super::ResolvedAssets>().add_systems(
-            self.schedule,
-            // It adds meshes: before the bake and planning read them.
-            super::assets::resolve_asset_looks
-                .after(RwtSystems::Viewers)
-                .before(crate::impostor::bake_impostors)
-                .before(RwtSystems::Plan),
-        );
+        app.init_resource::<super::ResolvedAssets>()
+            .register_type::<crate::look::asset::AssetCollider>()
+            .add_systems(
+                self.schedule,
+                // It adds meshes: before the bake and planning read them.
+                super::assets::resolve_asset_looks
+                    .after(RwtSystems::Viewers)
+                    .before(crate::impostor::bake_impostors)
+                    .before(RwtSystems::Plan),
+            );
         if app.get_sub_app(RenderApp).is_some() {
             build_render(app);
         }

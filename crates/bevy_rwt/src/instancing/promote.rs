@@ -37,6 +37,7 @@ impl Upload<'_> {
                     .classes
                     .get(*class as usize)
                     .and_then(|c| c.promotion.as_ref())
+                    .filter(|_| self.promotes(layer, *class))
                 else {
                     continue;
                 };
@@ -154,6 +155,10 @@ impl Moved<'_> {
             class: self.class,
         };
         let mut e = commands.spawn((instance, transform, Visibility::default(), PromotedInstance));
+        #[cfg(feature = "gltf")]
+        if let Some(collider) = upload.asset_collider(self.target, self.class) {
+            e.insert(collider);
+        }
         (self.promotion.insert)(&mut e);
         let parent = e.id();
         for (component, aabb) in upload.parts(self.target, self.class, Arc::new(one)) {

@@ -236,9 +236,11 @@ impl<'a> Upload<'a> {
         queue: &mut InstancedQueue,
     ) {
         let generation = self.generation();
-        if std::mem::replace(&mut queue.generation_seen, generation) == generation {
+        let seen = std::mem::replace(&mut queue.generation_seen, generation);
+        if seen == generation {
             return;
         }
+        let assets_changed = seen.1 != generation.1;
         for (chunk, c) in queue.chunks.iter_mut() {
             let target = Target {
                 entity,
@@ -246,17 +248,31 @@ impl<'a> Upload<'a> {
                 chunk: *chunk,
             };
             for (class, buffer) in c.classes.iter_mut() {
-                let refreshed = layer.classes.get(*class as usize).is_some_and(|c| {
-                    #[cfg(feature = "gltf")]
-                    if matches!(c.look, ClassLook::Asset(_)) {
-                        return true;
+                let Some(c) = layer.classes.get(*class as usize) else {
+                    continue;
+                };
+                let asset = c.look.is_instanced() && !matches!(c.look, ClassLook::Instanced(_));
+                if asset && assets_changed {
+                    // Promoted instances show the asset as it was: promoted again as it is.
+                    for (_, e) in buffer.promoted.drain() {
+                        commands.entity(e).try_despawn();
                     }
-                    c.impostor.is_some()
-                });
-                if refreshed {
+                }
+                if asset || c.impostor.is_some() {
                     self.redraw(commands, target, *class, buffer);
                 }
             }
+        }
+    }
+
+    /// Whether instances of `class` may be promoted: its look is ready to draw them (an
+    /// asset class once its file is resolved).
+    pub(super) fn promotes(&self, layer: &ScatterLayer, class: u16) -> bool {
+        match layer.classes.get(class as usize).map(|c| &c.look) {
+            #[cfg(feature = "gltf")]
+            Some(ClassLook::Asset(look)) => self.assets.and_then(|a| a.ready(look)).is_some(),
+            Some(_) => true,
+            None => false,
         }
     }
 
@@ -394,6 +410,22 @@ impl<'a> Upload<'a> {
             },
             _ => Vec::new(),
         }
+    }
+
+    /// The collider a promoted instance of `class` gets from its asset (`None`: not an
+    /// asset class, not resolved yet, or a class that asks for none).
+    #[cfg(feature = "gltf")]
+    pub(super) fn asset_collider(
+        &self,
+        target: Target,
+        class: u16,
+    ) -> Option<crate::look::asset::AssetCollider> {
+        let c = target.layer.classes.get(class as usize)?;
+        let ClassLook::Asset(look) = &c.look else {
+            return None;
+        };
+        let asset = self.assets?.ready(look).filter(|_| look.collider)?;
+        Some(asset.collider())
     }
 
     /// The component drawing `buffer` of an instanced class, with its bounds.

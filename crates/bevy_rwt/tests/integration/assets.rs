@@ -7,11 +7,11 @@ use bevy::camera::primitives::MeshAabb;
 use bevy::gltf::{Gltf, GltfMesh, GltfNode, GltfPlugin};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
-use bevy_rwt::instancing::InstancedChunk;
+use bevy_rwt::instancing::{InstancedChunk, PromotedInstance};
 use bevy_rwt::look::InstancedClassError;
 use bevy_rwt::look::asset::{
-    AssetLook, AssetLookError, AssetParts, AssetPrimitive, AssetRoot, AssetTreeError, GltfAssets,
-    SurfaceAlpha, asset_tree, resolve_asset,
+    AssetCollider, AssetLook, AssetLookError, AssetParts, AssetPrimitive, AssetRoot,
+    AssetTreeError, GltfAssets, SurfaceAlpha, asset_tree, resolve_asset,
 };
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
@@ -55,15 +55,7 @@ fn tree() -> Glb {
 
 #[test]
 fn a_written_asset_loads_and_splits_into_levels_and_a_collider() {
-    let dir = std::env::temp_dir().join(format!("bevy_rwt_assets_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("oak.glb"), tree().to_bytes()).unwrap();
-    let mut app = app_reading_with(&dir, |app| {
-        // The loader also makes the file's scenes: their asset type, without the scene
-        // plugins a game has.
-        app.add_plugins(GltfPlugin::default())
-            .init_asset::<bevy::world_serialization::WorldAsset>();
-    });
+    let (mut app, dir) = gltf_app("assets", &[("oak.glb", &tree().to_bytes())]);
     let handle: Handle<Gltf> = app.world().resource::<AssetServer>().load("oak.glb");
     let loaded = bevy_rwt::testing::run_until(&mut app, 2_000, |app| {
         app.world()
@@ -158,17 +150,30 @@ fn check_resolved(app: &mut App, handle: &Handle<Gltf>) {
     assert!((lowest(&resolved.colliders[0]) - 0.0).abs() < 1e-4);
 }
 
-#[test]
-fn an_asset_class_draws_each_primitive_and_a_bad_file_fails_alone() {
-    let dir = std::env::temp_dir().join(format!("bevy_rwt_asset_class_{}", std::process::id()));
+/// A headless app with Bevy's glTF loader, reading a fresh folder holding `files`.
+fn gltf_app(name: &str, files: &[(&str, &[u8])]) -> (App, std::path::PathBuf) {
+    let dir = std::env::temp_dir().join(format!("bevy_rwt_{name}_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let bytes = tree().to_bytes();
-    std::fs::write(dir.join("oak.glb"), &bytes).unwrap();
-    std::fs::write(dir.join("broken.glb"), &bytes[..bytes.len() / 3]).unwrap();
-    let mut app = app_reading_with(&dir, |app| {
+    for (file, bytes) in files {
+        std::fs::write(dir.join(file), bytes).unwrap();
+    }
+    let app = app_reading_with(&dir, |app| {
+        // The loader also makes the file's scenes: their asset type, without the scene
+        // plugins a game has.
         app.add_plugins(GltfPlugin::default())
             .init_asset::<bevy::world_serialization::WorldAsset>();
     });
+    (app, dir)
+}
+
+#[test]
+fn an_asset_class_draws_each_primitive_and_a_bad_file_fails_alone() {
+    let bytes = tree().to_bytes();
+    let broken = &bytes[..bytes.len() / 3];
+    let (mut app, dir) = gltf_app(
+        "asset_class",
+        &[("oak.glb", &bytes), ("broken.glb", broken)],
+    );
     let server = app.world().resource::<AssetServer>().clone();
     let oak = AssetLook::new(server.load("oak.glb"));
     let broken = AssetLook::new(server.load("broken.glb"));
@@ -223,6 +228,72 @@ fn an_asset_class_draws_each_primitive_and_a_bad_file_fails_alone() {
                 .all(|p| p.fade_out == far[0].fade_in && p.fade_out.is_some())
         );
         assert_eq!(far[0].fade_out, None, "the last level is drawn to the edge");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_promoted_asset_instance_gets_the_files_collider_or_its_hull() {
+    let (mut app, dir) = gltf_app("promoted", &[("oak.glb", &tree().to_bytes())]);
+    let server = app.world().resource::<AssetServer>().clone();
+    let oak = AssetLook::new(server.load("oak.glb"));
+    // The far card alone has no collider node: its hull stands for it.
+    let card = oak.clone().with_root(AssetRoot::Node("oak_LOD1".into()));
+    let bare = AssetLook {
+        collider: false,
+        ..oak.clone()
+    };
+    let density = LayerDensity::Constant(0.05);
+    let mut l = layer(density.clone());
+    l.classes = [oak, card, bare]
+        .map(|look| ScatterClass::asset(density.clone(), look).with_promotion(20.0, |_| {}))
+        .into();
+    app.world_mut().spawn(l);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let promoted = |app: &mut App| {
+        let mut q = app
+            .world_mut()
+            .query_filtered::<(&ScatterEntity, Option<&AssetCollider>, &Children), With<PromotedInstance>>();
+        q.iter(app.world())
+            .map(|(e, c, children)| (e.class, c.cloned(), children.len()))
+            .collect::<Vec<_>>()
+    };
+    let all = run_until(&mut app, 2_000, |app| {
+        let classes: std::collections::HashSet<u16> = app
+            .world()
+            .iter_entities()
+            .filter(|e| e.contains::<PromotedInstance>())
+            .filter_map(|e| e.get::<ScatterEntity>().map(|s| s.class))
+            .collect();
+        classes.len() == 3
+    });
+    assert!(all, "every class promoted an instance");
+    let meshes_of = |app: &App, handles: &[Handle<Mesh>]| -> Vec<f32> {
+        let meshes = app.world().resource::<Assets<Mesh>>();
+        handles
+            .iter()
+            .map(|h| meshes.get(h).unwrap().compute_aabb().unwrap().min().y)
+            .collect()
+    };
+    for (class, collider, children) in promoted(&mut app) {
+        match (class, collider) {
+            (0, Some(AssetCollider::Meshes(hull))) => {
+                // The UCX node's hull, lifted 2 m by its node: it stands on the origin.
+                let lowest = meshes_of(&app, &hull);
+                assert!(lowest.len() == 1 && lowest[0].abs() < 1e-4, "{lowest:?}");
+                assert_eq!(children, 3, "a child per primitive of each level");
+            }
+            (1, Some(AssetCollider::Hull(points))) => {
+                // The card: a box of 8 corners 5 m tall, in its own node's frame (the
+                // root's transform is the asset's frame), so centred on the origin.
+                assert_eq!(points.len(), 8);
+                let lowest = points.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
+                assert!((lowest + 2.5).abs() < 1e-4, "{lowest}");
+                assert_eq!(children, 1);
+            }
+            (2, None) => {}
+            other => panic!("class {class}: {other:?}"),
+        }
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -16,6 +16,7 @@ pub use file::{
 pub use parts::{AssetNode, AssetParts, NodeRole, Placed};
 #[cfg(feature = "gltf")]
 pub use resolve::{
-    AssetLods, AssetLook, AssetLookError, AssetPart, GltfAssets, ResolvedAsset, resolve_asset,
+    AssetCollider, AssetLods, AssetLook, AssetLookError, AssetPart, GltfAssets, ResolvedAsset,
+    resolve_asset,
 };
 pub use surface::{InstancedSurface, SurfaceAlpha, SurfaceError};

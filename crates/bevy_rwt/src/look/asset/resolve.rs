@@ -37,6 +37,24 @@ pub struct AssetLook {
     pub shadows: InstancedShadows,
     /// Where each level of detail takes over from the one before.
     pub lods: AssetLods,
+    /// Whether a promoted instance gets the asset's [`AssetCollider`] (before the
+    /// promotion's inserter, which turns it into a physics engine's collider).
+    pub collider: bool,
+}
+
+/// The collision shape of a promoted instance of an asset class, from its file, in the
+/// entity's frame (its transform carries the instance's place, turn and scale). Turn it
+/// into your physics engine's collider with an observer or a system on
+/// `Added<AssetCollider>` (avian: `Collider::convex_hull` of each mesh's positions, or of
+/// the hull's points).
+#[derive(Component, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Component, Clone, Debug, PartialEq)]
+pub enum AssetCollider {
+    /// The meshes of the asset's collider nodes (`UCX_…`: convex pieces; `…_collider`).
+    Meshes(Vec<Handle<Mesh>>),
+    /// The asset has no collider node: the vertices of its nearest level, whose convex hull
+    /// stands for it.
+    Hull(Vec<Vec3>),
 }
 
 /// Where an asset's levels of detail switch: each instance draws the level its own distance
@@ -104,6 +122,7 @@ impl AssetLook {
             fade_band: 0.1,
             shadows: InstancedShadows::On,
             lods: AssetLods::default(),
+            collider: true,
         }
     }
 
@@ -152,6 +171,18 @@ pub struct ResolvedAsset {
     pub colliders: Vec<Handle<Mesh>>,
     /// The bounds of every level (min, max), in the asset's frame.
     pub bounds: (Vec3, Vec3),
+    /// The vertices of the nearest level (each position once), in the asset's frame.
+    pub hull: Vec<Vec3>,
+}
+
+impl ResolvedAsset {
+    /// The collider a promoted instance gets: the collider nodes' meshes, else the hull.
+    pub fn collider(&self) -> AssetCollider {
+        match self.colliders.is_empty() {
+            true => AssetCollider::Hull(self.hull.clone()),
+            false => AssetCollider::Meshes(self.colliders.clone()),
+        }
+    }
 }
 
 /// Why an asset class cannot be drawn. The class draws nothing; the other classes stream on.
@@ -219,11 +250,27 @@ pub fn resolve_asset(
         .iter()
         .map(|placed| placed_mesh(placed, meshes).map(|(mesh, _)| mesh))
         .collect::<Result<_, _>>()?;
+    let hull = vertices(&levels[0], meshes);
     Ok(ResolvedAsset {
         levels,
         colliders,
         bounds,
+        hull,
     })
+}
+
+/// Each vertex position of `parts`' meshes once.
+fn vertices(parts: &[AssetPart], meshes: &Assets<Mesh>) -> Vec<Vec3> {
+    let mut seen = std::collections::HashSet::new();
+    let positions = parts
+        .iter()
+        .filter_map(|p| meshes.get(&p.mesh)?.attribute(Mesh::ATTRIBUTE_POSITION))
+        .filter_map(|values| values.as_float3())
+        .flatten();
+    positions
+        .filter(|p| seen.insert(p.map(f32::to_bits)))
+        .map(|p| Vec3::from_array(*p))
+        .collect()
 }
 
 /// The surface of a primitive (glTF's default material where it names none).
