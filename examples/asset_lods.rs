@@ -20,16 +20,19 @@ use bevy::prelude::*;
 use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy_rwt::look::asset::{AssetLods, AssetLook};
 use bevy_rwt::prelude::*;
-use bevy_rwt::rwt_core::density::Density;
 use bevy_rwt::testing::glb::{Glb, GlbMaterial, GlbNode, GlbPrimitive};
 use bevy_rwt::testing::{CullingCheck, CullingReport};
-use rwt_examples::frame_check::{out_of_patience, passed};
+use rwt_examples::frame_check::{Disc, out_of_patience, passed};
 use std::sync::Arc;
 
 /// Where the coarse sphere takes over (metres from the camera to an instance's root).
 const SWITCH: f32 = 40.0;
-/// The patch: its centre ahead (+x), its radius.
-const PATCH: (f64, f64) = (25.0, 7.0);
+/// The patch, ahead of the camera (+x).
+const PATCH: Disc = Disc {
+    center: DVec2::new(25.0, 0.0),
+    radius: 7.0,
+    density: 0.3,
+};
 /// The camera's x at each step: the patch at 18..32 m, 38..52 m, 78..92 m.
 const STEPS: [f32; 3] = [0.0, -20.0, -60.0];
 /// Frames each step waits once streaming settled.
@@ -38,20 +41,6 @@ const WAIT: u32 = 10;
 const PATIENCE: u32 = 900;
 /// The file, under the asset folder.
 const FILE: &str = "generated/asset_lods.glb";
-
-/// A disc of constant density.
-struct Patch;
-
-impl Density for Patch {
-    fn density(&self, p: DVec2) -> f64 {
-        let inside = p.distance(DVec2::new(PATCH.0, 0.0)) <= PATCH.1;
-        if inside { 0.3 } else { 0.0 }
-    }
-
-    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
-        self.density(DVec2::new(PATCH.0, 0.0).clamp(min, max))
-    }
-}
 
 /// The two levels' meshes: a fine sphere and a coarse one, standing on the origin.
 fn levels() -> [Mesh; 2] {
@@ -101,7 +90,8 @@ fn setup(mut commands: Commands, server: Res<AssetServer>) {
         DepthPrepass,
         OcclusionCulling,
         RwtViewer::all_around(),
-        Transform::from_xyz(STEPS[0], 4.0, 0.0).looking_at(Vec3::new(25.0, 0.0, 0.0), Vec3::Y),
+        Transform::from_xyz(STEPS[0], 4.0, 0.0)
+            .looking_at(Vec3::new(PATCH.center.x as f32, 0.0, 0.0), Vec3::Y),
     ));
     commands.spawn((
         DirectionalLight::default(),
@@ -115,7 +105,7 @@ fn setup(mut commands: Commands, server: Res<AssetServer>) {
         },
         ..AssetLook::new(server.load(FILE))
     };
-    let class = ScatterClass::asset(LayerDensity::Custom(Arc::new(Patch)), look);
+    let class = ScatterClass::asset(LayerDensity::Custom(Arc::new(PATCH)), look);
     commands.spawn(ScatterLayer::new(vec![class]).with_tile_size(16.0));
 }
 
@@ -157,7 +147,7 @@ fn run_check(
     let Some(report) = culling.report() else {
         return;
     };
-    let eye = PATCH.0 as f32 - STEPS[check.step];
+    let eye = PATCH.center.x as f32 - STEPS[check.step];
     println!(
         "rwt-lods: step {}, eye to patch {eye:.0} m, kept {}, vertices {}",
         check.step, report.gpu_kept, report.camera_vertices

@@ -20,10 +20,10 @@ use bevy::prelude::*;
 use bevy_rwt::instancing::InstancedChunk;
 use bevy_rwt::look::asset::AssetLook;
 use bevy_rwt::prelude::*;
-use bevy_rwt::rwt_core::density::Density;
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
 use rwt_examples::frame_check::{
-    COMPARED_MSAA, Captures, HIGH_SUN, out_of_patience, output_dir, passed, spawn_shadow_sun,
+    CHECK_SKY as SKY, COMPARED_MSAA, Captures, Disc, HIGH_SUN, off_sky, out_of_patience,
+    output_dir, passed, spawn_shadow_sun,
 };
 use std::sync::Arc;
 
@@ -33,35 +33,20 @@ const LEAST_IOU: f64 = 0.98;
 const LEAST_PART_IOU: f64 = 0.95;
 /// Most mean colour difference (0..255 a channel) where both frames show the asset.
 const MOST_COLOUR: f64 = 6.0;
-/// The sky, which is not the asset.
-const SKY: Color = Color::srgb(0.62, 0.75, 0.92);
 /// What a channel must differ from the sky's by for a pixel to be the asset's.
 const BY: u8 = 30;
 /// Frames each step waits once its frame has settled.
 const WAIT: u32 = 12;
 /// Most frames the check may take.
 const PATIENCE: u32 = 900;
-/// The patch the asset stands in: its centre ahead of the camera (+x), its radius.
-const PATCH: (f64, f64) = (24.0, 7.0);
-/// Instances per square metre in the patch (about 50 in all).
-const DENSITY: f64 = 0.32;
+/// The patch the asset stands in, ahead of the camera (+x): about 50 instances.
+const PATCH: Disc = Disc {
+    center: DVec2::new(24.0, 0.0),
+    radius: 7.0,
+    density: 0.32,
+};
 /// The file, under the asset folder.
 const FILE: &str = "generated/asset_match.glb";
-
-/// A disc of constant density.
-struct Patch;
-
-impl Density for Patch {
-    fn density(&self, p: DVec2) -> f64 {
-        let inside = p.distance(DVec2::new(PATCH.0, 0.0)) <= PATCH.1;
-        if inside { DENSITY } else { 0.0 }
-    }
-
-    fn max_over(&self, min: DVec2, max: DVec2) -> f64 {
-        let nearest = DVec2::new(PATCH.0, 0.0).clamp(min, max);
-        self.density(nearest)
-    }
-}
 
 fn main() -> AppExit {
     rwt_examples::generated::write_asset(FILE, &asset().to_bytes());
@@ -147,11 +132,12 @@ fn setup(mut commands: Commands, server: Res<AssetServer>) {
             ..default()
         }),
         RwtViewer::all_around(),
-        Transform::from_xyz(0.0, 3.0, 0.0).looking_at(Vec3::new(PATCH.0 as f32, 0.8, 0.0), Vec3::Y),
+        Transform::from_xyz(0.0, 3.0, 0.0)
+            .looking_at(Vec3::new(PATCH.center.x as f32, 0.8, 0.0), Vec3::Y),
     ));
     spawn_shadow_sun(&mut commands, HIGH_SUN);
     let look = AssetLook::new(server.load(FILE));
-    let mut class = ScatterClass::asset(LayerDensity::Custom(Arc::new(Patch)), look);
+    let mut class = ScatterClass::asset(LayerDensity::Custom(Arc::new(PATCH)), look);
     class.scale_variation = 0.3;
     commands.spawn(ScatterLayer::new(vec![class]).with_tile_size(16.0));
 }
@@ -248,8 +234,7 @@ fn spawn_scenes(
 
 /// Which primitive's colour a pixel shows: 0 red, 1 green, 2 blue; `None` for the sky.
 fn part(p: &image::Rgb<u8>) -> Option<usize> {
-    let sky = SKY.to_srgba().to_u8_array();
-    let asset = p.0.iter().zip(sky).any(|(c, s)| c.abs_diff(s) > BY);
+    let asset = off_sky(p, BY);
     let strongest = (0..3).max_by_key(|&i| p.0[i])?;
     asset.then_some(strongest)
 }

@@ -21,7 +21,8 @@ use bevy_rwt::rwt_core::density::Density;
 use bevy_rwt::testing::{CullingCheck, CullingReport};
 use rwt_examples::foliage;
 use rwt_examples::frame_check::{
-    COMPARED_MSAA, Captures, HIGH_SUN, out_of_patience, output_dir, passed, spawn_shadow_sun,
+    CHECK_SKY as SKY, COMPARED_MSAA, Captures, HIGH_SUN, off_sky, out_of_patience, output_dir,
+    passed, spawn_shadow_sun,
 };
 use std::sync::Arc;
 
@@ -29,8 +30,6 @@ use std::sync::Arc;
 const LEAST_IOU: f64 = 0.8;
 /// Most mean colour difference (0..255 a channel) where both frames show a tree.
 const MOST_COLOUR: f64 = 24.0;
-/// The sky, which is not a tree.
-const SKY: Color = Color::srgb(0.62, 0.75, 0.92);
 /// What a channel must differ from the sky's by for a pixel to be a tree's.
 const BY: u8 = 40;
 /// Frames each step waits once streaming has settled.
@@ -216,8 +215,7 @@ fn run_check(
 
 /// Whether a pixel is a tree's (not the sky's).
 fn tree(p: &image::Rgb<u8>) -> bool {
-    let sky = SKY.to_srgba().to_u8_array();
-    p.0.iter().zip(sky).any(|(c, s)| c.abs_diff(s) > BY)
+    off_sky(p, BY)
 }
 
 /// Prints the result line; whether every check passed.

@@ -153,3 +153,36 @@ pub fn out_of_patience(
     exit.write(AppExit::error());
     true
 }
+
+/// The sky the checks that count an object's pixels clear to: a pixel of another colour is
+/// the object's.
+pub const CHECK_SKY: Color = Color::srgb(0.62, 0.75, 0.92);
+
+/// A disc of constant density on the ground: where the checks scatter what they compare.
+#[derive(Clone, Copy, Debug)]
+pub struct Disc {
+    /// Its centre.
+    pub center: bevy::math::DVec2,
+    /// Its radius.
+    pub radius: f64,
+    /// Points per square unit inside.
+    pub density: f64,
+}
+
+impl bevy_rwt::rwt_core::density::Density for Disc {
+    fn density(&self, p: bevy::math::DVec2) -> f64 {
+        let inside = p.distance(self.center) <= self.radius;
+        if inside { self.density } else { 0.0 }
+    }
+
+    fn max_over(&self, min: bevy::math::DVec2, max: bevy::math::DVec2) -> f64 {
+        self.density(self.center.clamp(min, max))
+    }
+}
+
+/// Whether a pixel shows something other than [`CHECK_SKY`]: a channel differs from the
+/// sky's by more than `by` (of 255).
+pub fn off_sky(p: &image::Rgb<u8>, by: u8) -> bool {
+    let sky = CHECK_SKY.to_srgba().to_u8_array();
+    p.0.iter().zip(sky).any(|(c, s)| c.abs_diff(s) > by)
+}
