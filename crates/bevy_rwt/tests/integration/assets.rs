@@ -297,3 +297,47 @@ fn a_promoted_asset_instance_gets_the_files_collider_or_its_hull() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_changed_file_is_drawn_again_as_it_now_is() {
+    let (mut app, dir) = gltf_app("reload", &[("oak.glb", &tree().to_bytes())]);
+    let server = app.world().resource::<AssetServer>().clone();
+    let density = LayerDensity::Constant(0.05);
+    let mut l = layer(density.clone());
+    l.classes = vec![ScatterClass::asset(
+        density,
+        AssetLook::new(server.load("oak.glb")),
+    )];
+    app.world_mut().spawn(l);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    // Parts per chunk entity's chunk, once every chunk draws `parts`.
+    let drawn_with = |parts: usize| {
+        move |app: &App| {
+            let mut per_chunk: HashMap<_, usize> = HashMap::new();
+            for e in app.world().iter_entities() {
+                if let Some(c) = e.get::<InstancedChunk>() {
+                    *per_chunk.entry(c.chunk).or_default() += 1;
+                }
+            }
+            !per_chunk.is_empty() && per_chunk.values().all(|n| *n == parts)
+        }
+    };
+    assert!(
+        run_until(&mut app, 2_000, drawn_with(3)),
+        "two levels: 2 + 1 parts"
+    );
+    // The file becomes a rock of one primitive, read again as the file watcher would.
+    let mut rock = Glb::default();
+    let grey = rock.add_material(GlbMaterial::colored([0.5, 0.5, 0.5, 1.0]));
+    let boulder = GlbPrimitive::from_mesh(&Sphere::new(1.0).mesh().build(), grey).unwrap();
+    let mesh = rock.add_mesh(vec![boulder]);
+    let node = rock.add_node(GlbNode::named("rock").with_mesh(mesh));
+    rock.add_root(node);
+    std::fs::write(dir.join("oak.glb"), rock.to_bytes()).unwrap();
+    server.reload("oak.glb");
+    assert!(
+        run_until(&mut app, 2_000, drawn_with(1)),
+        "the rock's one part"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
