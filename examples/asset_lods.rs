@@ -3,7 +3,7 @@
 //!
 //! The example writes a two-level asset (`assets/generated/asset_lods.glb`: a fine sphere
 //! at `ball_LOD0`, a coarse one at `ball_LOD1`) and scatters it in a patch ahead of the
-//! camera, the second level taking over at [`SWITCH`] m. The camera steps back three times
+//! camera, the second level taking over at 40 m. The camera steps back three times
 //! (the patch all nearer than the switch, across it, all beyond it); at each step the
 //! culling pass's indirect arguments are read back ([`CullingCheck`]; the camera occludes, so
 //! that every chunk is culled per instance). It prints
