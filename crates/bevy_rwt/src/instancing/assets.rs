@@ -12,17 +12,20 @@ use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use std::sync::Arc;
 
-/// Every asset look of the layers, resolved (or why it cannot be drawn).
+/// A look resolved, or why it cannot be drawn.
+type Resolved = Result<Arc<ResolvedAsset>, AssetLookError>;
+
+/// Every asset look of the layers, resolved (or why it cannot be drawn), by file and root.
 #[derive(Resource, Default)]
 pub struct ResolvedAssets {
-    looks: HashMap<(AssetId<Gltf>, AssetRoot), Result<Arc<ResolvedAsset>, AssetLookError>>,
+    looks: HashMap<AssetId<Gltf>, HashMap<AssetRoot, Resolved>>,
     generation: u64,
 }
 
 impl ResolvedAssets {
     /// `look` resolved: `None` while its file loads.
-    pub fn get(&self, look: &AssetLook) -> Option<&Result<Arc<ResolvedAsset>, AssetLookError>> {
-        self.looks.get(&(look.gltf.id(), look.root.clone()))
+    pub fn get(&self, look: &AssetLook) -> Option<&Resolved> {
+        self.looks.get(&look.gltf.id())?.get(&look.root)
     }
 
     /// `look` ready to draw, if it is.
@@ -49,7 +52,7 @@ pub(super) struct AssetSources<'w> {
 
 impl AssetSources<'_> {
     /// `look` resolved, or `None` while its file (or something it names) is loading.
-    fn resolve(&mut self, look: &AssetLook) -> Option<Result<Arc<ResolvedAsset>, AssetLookError>> {
+    fn resolve(&mut self, look: &AssetLook) -> Option<Resolved> {
         let id = look.gltf.id();
         if let Some(LoadState::Failed(e)) = self.server.get_load_state(id) {
             return Some(Err(AssetLookError::Load(e.to_string())));
@@ -80,12 +83,10 @@ pub(super) fn resolve_asset_looks(
     let Some(mut sources) = sources else { return };
     if let Some(events) = events {
         for event in cursor.read(&events) {
-            if let AssetEvent::Modified { id } | AssetEvent::Removed { id } = event {
-                let before = resolved.looks.len();
-                resolved.looks.retain(|(file, _), _| file != id);
-                if resolved.looks.len() != before {
-                    resolved.generation += 1;
-                }
+            if let AssetEvent::Modified { id } | AssetEvent::Removed { id } = event
+                && resolved.looks.remove(id).is_some()
+            {
+                resolved.generation += 1;
             }
         }
     }
@@ -97,12 +98,12 @@ pub(super) fn resolve_asset_looks(
             _ => None,
         });
     for look in looks {
-        let key = (look.gltf.id(), look.root.clone());
-        if resolved.looks.contains_key(&key) {
+        if resolved.get(look).is_some() {
             continue;
         }
         if let Some(result) = sources.resolve(look) {
-            resolved.looks.insert(key, result);
+            let file = resolved.looks.entry(look.gltf.id()).or_default();
+            file.insert(look.root.clone(), result);
             resolved.generation += 1;
         }
     }

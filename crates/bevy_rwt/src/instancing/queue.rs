@@ -251,7 +251,7 @@ impl<'a> Upload<'a> {
                 let Some(c) = layer.classes.get(*class as usize) else {
                     continue;
                 };
-                let asset = c.look.is_instanced() && !matches!(c.look, ClassLook::Instanced(_));
+                let asset = c.look.is_asset();
                 if asset && assets_changed {
                     // Promoted instances show the asset as it was: promoted again as it is.
                     for (_, e) in buffer.promoted.drain() {

@@ -71,6 +71,15 @@ impl ClassLook {
             ClassLook::Mesh { .. } | ClassLook::Custom(_) => false,
         }
     }
+
+    /// Whether this look is a glTF asset's ([`ClassLook::Asset`]).
+    pub fn is_asset(&self) -> bool {
+        match self {
+            #[cfg(feature = "gltf")]
+            ClassLook::Asset(_) => true,
+            _ => false,
+        }
+    }
 }
 
 impl std::fmt::Debug for ClassLook {

@@ -341,3 +341,53 @@ fn a_changed_file_is_drawn_again_as_it_now_is() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_part_every_level_shares_is_moved_into_the_assets_frame_once() {
+    let mut file = Glb::default();
+    let grey = file.add_material(GlbMaterial::colored([0.5, 0.5, 0.5, 1.0]));
+    let mut mesh =
+        |shape: Mesh| file.add_mesh(vec![GlbPrimitive::from_mesh(&shape, grey).unwrap()]);
+    let (near, far, base) = (
+        mesh(Sphere::new(1.0).mesh().build()),
+        mesh(Cuboid::new(1.0, 1.0, 1.0).mesh().build()),
+        mesh(Cylinder::new(0.5, 0.2).mesh().build()),
+    );
+    let lod0 = file.add_node(GlbNode::named("rock_LOD0").with_mesh(near));
+    let lod1 = file.add_node(GlbNode::named("rock_LOD1").with_mesh(far));
+    let lifted = Transform::from_xyz(0.0, 0.1, 0.0);
+    let plinth = file.add_node(
+        GlbNode::named("plinth")
+            .with_mesh(base)
+            .with_transform(lifted),
+    );
+    let root = file.add_node(GlbNode::named("rock").with_children([lod0, lod1, plinth]));
+    file.add_root(root);
+    let (mut app, dir) = gltf_app("shared", &[("rock.glb", &file.to_bytes())]);
+    let handle: Handle<Gltf> = app.world().resource::<AssetServer>().load("rock.glb");
+    let loaded = run_until(&mut app, 2_000, |app| {
+        let server = app.world().resource::<AssetServer>();
+        server.is_loaded_with_dependencies(&handle)
+    });
+    assert!(loaded, "rock.glb did not load");
+    let world = app.world_mut();
+    let before = world.resource::<Assets<Mesh>>().len();
+    let resolved = world.resource_scope(|world, mut meshes: Mut<Assets<Mesh>>| {
+        let from = GltfAssets {
+            nodes: world.resource(),
+            meshes: world.resource(),
+            materials: world.resource(),
+        };
+        let gltf = world.resource::<Assets<Gltf>>().get(&handle).unwrap();
+        resolve_asset(gltf, &AssetRoot::File, from, &mut meshes).unwrap()
+    });
+    let plinths: Vec<_> = resolved
+        .levels
+        .iter()
+        .map(|l| l.last().unwrap().mesh.id())
+        .collect();
+    assert_eq!(plinths.len(), 2);
+    assert_eq!(plinths[0], plinths[1], "one moved plinth for both levels");
+    assert_eq!(world.resource::<Assets<Mesh>>().len(), before + 1);
+    std::fs::remove_dir_all(&dir).ok();
+}

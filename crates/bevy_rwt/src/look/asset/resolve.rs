@@ -8,6 +8,7 @@ use super::parts::{AssetParts, Placed};
 use super::surface::{InstancedSurface, SurfaceError};
 use crate::look::{InstancedClassError, InstancedShading, InstancedShadows, check_instanced_mesh};
 use bevy::gltf::{Gltf, GltfMaterial, GltfMesh, GltfNode};
+use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 
 /// The look of a class drawn from a game's own glTF asset: every primitive under
@@ -221,7 +222,8 @@ pub struct GltfAssets<'a> {
 }
 
 /// `root` of the loaded file `gltf` made ready to draw: its primitives' meshes moved into
-/// the asset's frame (added to `meshes`, shared where a node does not move its mesh).
+/// the asset's frame (added to `meshes` once per mesh and transform, shared where a node
+/// does not move its mesh).
 pub fn resolve_asset(
     gltf: &Gltf,
     root: &AssetRoot,
@@ -230,13 +232,17 @@ pub fn resolve_asset(
 ) -> Result<ResolvedAsset, AssetLookError> {
     let tree = asset_tree(gltf, root, from.nodes, from.meshes)?;
     let parts = AssetParts::split(&tree);
+    let mut baker = Baker {
+        meshes,
+        baked: HashMap::new(),
+    };
     let mut bounds = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     let mut levels = Vec::with_capacity(parts.levels.len());
     for level in &parts.levels {
         let mut drawn = Vec::with_capacity(level.len());
         for placed in level {
             let surface = surface_of(&placed.primitive, from.materials)?;
-            let (mesh, (lo, hi)) = placed_mesh(placed, meshes)?;
+            let (mesh, (lo, hi)) = baker.place(placed)?;
             bounds = (bounds.0.min(lo), bounds.1.max(hi));
             drawn.push(AssetPart { mesh, surface });
         }
@@ -248,9 +254,9 @@ pub fn resolve_asset(
     let colliders = parts
         .colliders
         .iter()
-        .map(|placed| placed_mesh(placed, meshes).map(|(mesh, _)| mesh))
+        .map(|placed| baker.place(placed).map(|(mesh, _)| mesh))
         .collect::<Result<_, _>>()?;
-    let hull = vertices(&levels[0], meshes);
+    let hull = vertices(&levels[0], baker.meshes);
     Ok(ResolvedAsset {
         levels,
         colliders,
@@ -288,16 +294,47 @@ fn surface_of(
     Ok(InstancedSurface::try_from(material)?)
 }
 
+/// A mesh in the asset's frame, and its bounds there.
+type Baked = (Handle<Mesh>, (Vec3, Vec3));
+
+/// Primitives' meshes moved into the asset's frame, each mesh and transform once: a part
+/// every level shares is baked one time, not once per level.
+struct Baker<'a> {
+    meshes: &'a mut Assets<Mesh>,
+    /// By mesh and the bits of the transform (translation, rotation, scale).
+    baked: HashMap<(AssetId<Mesh>, [u32; 10]), Baked>,
+}
+
+impl Baker<'_> {
+    fn place(&mut self, placed: &Placed<AssetPrimitive>) -> Result<Baked, AssetLookError> {
+        let Transform {
+            translation: t,
+            rotation: r,
+            scale: s,
+        } = placed.transform;
+        let values = [t.x, t.y, t.z, r.x, r.y, r.z, r.w, s.x, s.y, s.z];
+        let key = (placed.primitive.mesh.id(), values.map(f32::to_bits));
+        if let Some(done) = self.baked.get(&key) {
+            return Ok(done.clone());
+        }
+        let done = placed_mesh(placed, self.meshes)?;
+        self.baked.insert(key, done.clone());
+        Ok(done)
+    }
+}
+
 /// The primitive's mesh in the asset's frame, and its bounds there.
 fn placed_mesh(
     placed: &Placed<AssetPrimitive>,
     meshes: &mut Assets<Mesh>,
-) -> Result<(Handle<Mesh>, (Vec3, Vec3)), AssetLookError> {
+) -> Result<Baked, AssetLookError> {
     let handle = &placed.primitive.mesh;
     let mesh = meshes
         .get(handle)
         .ok_or_else(|| AssetTreeError::NotLoaded(format!("{handle:?}")))?;
-    if mesh.try_attribute(Mesh::ATTRIBUTE_POSITION).is_err() && mesh.try_attributes().is_err() {
+    // A render-world-only mesh keeps no attributes here (its bounds alone would pass the
+    // check, its vertices could not be moved).
+    if mesh.try_attributes().is_err() {
         return Err(AssetLookError::MeshNotInMainWorld);
     }
     if placed.transform == Transform::IDENTITY {
