@@ -10,8 +10,7 @@
 //!
 //! Exit status 0 when accepted, 2 when refused (the reason on standard error).
 
-use bevy::prelude::Handle;
-use bevy_rwt::layers::file::{LayerDescription, MAX_LAYER_FILE_BYTES, NamedAssets};
+use bevy_rwt::layers::file::{LayerDescription, MAX_LAYER_FILE_BYTES, NamedAssets, Placeholders};
 use bevy_rwt::rwt_core::Lattice;
 use bevy_rwt::rwt_core::density::decode_image;
 use bevy_rwt::rwt_core::edits::{EditSet, EditStamp, EditsError, MAX_EDITS_FILE_BYTES};
@@ -55,12 +54,7 @@ fn layer(path: &Path) -> Result<String, String> {
     let text = std::str::from_utf8(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
     let description = LayerDescription::from_ron(text).map_err(|e| e.to_string())?;
     let layer = description
-        .to_layer(
-            &NamedAssets::default(),
-            |_| Handle::default(),
-            |_| Handle::default(),
-            |_| Handle::default(),
-        )
+        .to_layer(&NamedAssets::default(), &mut Placeholders)
         .map_err(|e| e.to_string())?;
     Ok(format!("layer: {} classes", layer.classes.len()))
 }

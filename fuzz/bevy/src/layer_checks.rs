@@ -1,9 +1,8 @@
 //! Fuzz check of `bevy_rwt`'s layer file loader: any text is rejected with an error or
 //! becomes a layer whose densities, streaming and queries behave.
 
-use bevy::prelude::Handle;
 use bevy_rwt::LayerDensity;
-use bevy_rwt::layers::file::{LayerDescription, NamedAssets};
+use bevy_rwt::layers::file::{LayerDescription, NamedAssets, Placeholders};
 use bevy_rwt::rwt_core::density::{Density, sanitize};
 use bevy_rwt::rwt_core::query::{Rect, Sampler};
 use bevy_rwt::rwt_core::streaming::{ChunkSet, Viewer};
@@ -28,12 +27,7 @@ pub fn layer_file(data: &[u8]) -> bool {
         return false;
     };
     // With no names registered, a file naming a mesh, material or ground is rejected.
-    let Ok(layer) = description.to_layer(
-        &NamedAssets::default(),
-        |_| Handle::default(),
-        |_| Handle::default(),
-        |_| Handle::default(),
-    ) else {
+    let Ok(layer) = description.to_layer(&NamedAssets::default(), &mut Placeholders) else {
         return false;
     };
     // Streaming around a viewer at the origin stays bounded and terminates.

@@ -1,5 +1,5 @@
-//! Baking an impostor atlas on the CPU: the class's mesh, coloured by its material (base
-//! colour, vertex colours, base-colour texture, alpha cut-out), rasterized orthographically
+//! Baking an impostor atlas on the CPU: the class's mesh (or an asset's primitives), coloured
+//! by its material (base colour, vertex colours, base-colour texture, alpha cut-out), rasterized orthographically
 //! from every view into one sRGB image: albedo and coverage on the left half, normals in
 //! the mesh's frame on the right half, with a mip chain whose cut-out coverage stays that of
 //! the full-size views. Deterministic: the same mesh and material bake the same bytes.
@@ -105,8 +105,21 @@ struct BakeVertex {
 
 /// Bakes `source` with the views of `settings`.
 pub fn bake(source: &BakeSource, settings: &Impostor) -> Result<BakedImpostor, BakeError> {
-    let (vertices, triangles) = read_mesh(source.mesh)?;
-    let (lo, hi) = vertices.iter().fold(
+    bake_parts(std::slice::from_ref(source), settings)
+}
+
+/// Bakes the parts of one look together (an asset's primitives, each with its material):
+/// every view shows them all, the nearer hiding the farther, framed by their joint bounds.
+pub fn bake_parts(parts: &[BakeSource], settings: &Impostor) -> Result<BakedImpostor, BakeError> {
+    let meshes = parts
+        .iter()
+        .map(|p| read_mesh(p.mesh))
+        .collect::<Result<Vec<_>, _>>()?;
+    if meshes.is_empty() {
+        return Err(BakeError::Empty);
+    }
+    let every = || meshes.iter().flat_map(|(vertices, _)| vertices);
+    let (lo, hi) = every().fold(
         (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
         |(lo, hi), v| (lo.min(v.position), hi.max(v.position)),
     );
@@ -119,7 +132,7 @@ pub fn bake(source: &BakeSource, settings: &Impostor) -> Result<BakedImpostor, B
         center,
         half: Vec2::ZERO,
     };
-    frames.half = half_extents(&frames, &vertices);
+    frames.half = half_extents(&frames, every());
     if frames.half.min_element() <= 0.0 {
         return Err(BakeError::Empty);
     }
@@ -127,19 +140,30 @@ pub fn bake(source: &BakeSource, settings: &Impostor) -> Result<BakedImpostor, B
     let mut level = Level::new(size);
     for j in 0..rows {
         for i in 0..views {
-            let raster = Raster::view(&frames, (i, j, hi.y), source, (&vertices, &triangles));
+            let mut raster = Raster::new(frames.texels * SUPERSAMPLE);
+            for (part, (vertices, triangles)) in parts.iter().zip(&meshes) {
+                raster.draw(&frames, (i, j, hi.y), part, (vertices, triangles));
+            }
             raster.store(&mut level, (i * texels, j * texels), (views * texels, 0));
         }
     }
     level.dilate(4);
-    let image = atlas_image(&frames, level, source.alpha_cutoff.unwrap_or(0.5));
+    // The mips keep the coverage of the strictest cut-out.
+    let cutoff = parts
+        .iter()
+        .filter_map(|p| p.alpha_cutoff)
+        .fold(None, |m: Option<f32>, c| Some(m.map_or(c, |m| m.max(c))));
+    let image = atlas_image(&frames, level, cutoff.unwrap_or(0.5));
     Ok(BakedImpostor { image, frames })
 }
 
 /// The half width and height every view must cover: the mesh's farthest reach across the
 /// vertical axis through the centre, and the largest half height over the rows.
-fn half_extents(frames: &ImpostorFrames, vertices: &[BakeVertex]) -> Vec2 {
-    let (across, up) = vertices.iter().fold((0.0f32, 0.0f32), |(a, u), v| {
+fn half_extents<'a>(
+    frames: &ImpostorFrames,
+    vertices: impl Iterator<Item = &'a BakeVertex>,
+) -> Vec2 {
+    let (across, up) = vertices.fold((0.0f32, 0.0f32), |(a, u), v| {
         let d = v.position - frames.center;
         (a.max(d.xz().length()), u.max(d.y.abs()))
     });
@@ -222,19 +246,25 @@ struct Raster {
 }
 
 impl Raster {
-    /// View `i` of row `j`: the mesh's triangles, nearest first by depth.
-    fn view(
+    /// An empty view `side` texels wide.
+    fn new(side: u32) -> Self {
+        Self {
+            side,
+            depth: vec![f32::MIN; (side * side) as usize],
+            texels: vec![Texel::default(); (side * side) as usize],
+        }
+    }
+
+    /// Draws a mesh seen in view `i` of row `j`, nearer than what is there (`top`: the
+    /// look's top, where a gradient reaches its tip colour).
+    fn draw(
+        &mut self,
         frames: &ImpostorFrames,
         (i, j, top): (u32, u32, f32),
         source: &BakeSource,
         (vertices, triangles): (&[BakeVertex], &[[usize; 3]]),
-    ) -> Self {
-        let side = frames.texels * SUPERSAMPLE;
-        let mut raster = Self {
-            side,
-            depth: vec![f32::MIN; (side * side) as usize],
-            texels: vec![Texel::default(); (side * side) as usize],
-        };
+    ) {
+        let side = self.side;
         let direction = frames.direction(i, j);
         let (right, up) = card_axes(direction);
         let project = |p: Vec3| {
@@ -251,9 +281,8 @@ impl Raster {
         for t in triangles {
             let corners = t.map(|k| projected[k]);
             let attributes = t.map(|k| vertices[k]);
-            raster.triangle(corners, attributes, source, (direction, top));
+            self.triangle(corners, attributes, source, (direction, top));
         }
-        raster
     }
 
     /// Fills the texels a triangle covers where it is nearer than what is there.
@@ -551,6 +580,44 @@ mod tests {
             "level 0 {base}, level 2 {mip2}"
         );
         assert_eq!(baked.image.texture_descriptor.mip_level_count, 5);
+    }
+
+    #[test]
+    fn parts_bake_together_each_in_its_colour_the_nearer_hiding_the_farther() {
+        let tower = |x: f32| {
+            Cuboid::new(1.0, 4.0, 1.0)
+                .mesh()
+                .build()
+                .translated_by(Vec3::new(x, 2.0, 0.0))
+        };
+        let (left, right) = (tower(-1.0), tower(1.0));
+        let mut red = source(&left);
+        red.color = BakeColor::Plain(LinearRgba::RED);
+        let mut blue = source(&right);
+        blue.color = BakeColor::Plain(LinearRgba::BLUE);
+        let baked = bake_parts(&[red, blue], &settings(4, 1, 64)).unwrap();
+        let f = baked.frames;
+        // Framed by both: centred between them, wide enough for both.
+        assert!((f.center - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-5);
+        assert!(f.half.x > 1.5, "{:?}", f.half);
+        let column = |x: f32| ((x / f.half.x * 0.5 + 0.5) * 64.0) as u32;
+        let is = |t: [u8; 4], red: bool| match red {
+            true => t[0] > 200 && t[2] < 60,
+            false => t[2] > 200 && t[0] < 60,
+        };
+        let (l, r) = (
+            texel(&baked, (0, 0), (column(-1.0), 32), false),
+            texel(&baked, (0, 0), (column(1.0), 32), false),
+        );
+        assert!(is(l, true) && is(r, false), "{l:?} {r:?}");
+        // Seen along their row, the nearer tower hides the other.
+        let blue_nearer = f.direction(1, 0).x > 0.0;
+        let middle = texel(&baked, (1, 0), (32, 32), false);
+        assert!(is(middle, !blue_nearer), "{middle:?}");
+        assert_eq!(
+            bake_parts(&[], &settings(4, 1, 64)).err(),
+            Some(BakeError::Empty)
+        );
     }
 
     #[test]

@@ -10,6 +10,8 @@
 //! culled per instance like any instanced class), and entity instances are only spawned
 //! near enough to crossfade with them.
 
+#[cfg(feature = "gltf")]
+mod asset;
 mod atlas;
 pub mod bake;
 mod frames;
@@ -42,6 +44,12 @@ enum LookKey {
         tip_from: u32,
         alpha_cutoff: u32,
         texture: Option<AssetId<Image>>,
+    },
+    /// An asset class's look: its file and (hashed) root.
+    #[cfg(feature = "gltf")]
+    Asset {
+        gltf: AssetId<bevy::gltf::Gltf>,
+        root: u64,
     },
 }
 
@@ -217,15 +225,29 @@ pub(crate) fn bake_impostors(
     atlases.generation += ready;
 }
 
-/// What a bake task takes with it: the mesh, its look, the texture.
+/// What a bake task takes with it: the parts (one, or an asset's primitives), the
+/// roughness the cards are lit with.
 struct OwnedSource {
+    parts: Vec<OwnedPart>,
+    roughness: f32,
+}
+
+/// A mesh and its look, owned by a bake task.
+struct OwnedPart {
     mesh: Mesh,
     color: bake::BakeColor,
     vertex_colors: bool,
     lean: f32,
     texture: Option<Image>,
     alpha_cutoff: Option<f32>,
-    roughness: f32,
+}
+
+/// A texture's image: `Some(None)` without one, `None` while it loads.
+fn loaded_texture(handle: Option<&Handle<Image>>, images: &Assets<Image>) -> Option<Option<Image>> {
+    match handle {
+        Some(h) => images.get(h).map(|i| Some(i.clone())),
+        None => Some(None),
+    }
 }
 
 impl OwnedSource {
@@ -236,39 +258,41 @@ impl OwnedSource {
         materials: &Assets<StandardMaterial>,
         images: &Assets<Image>,
     ) -> Option<Self> {
-        let texture = |handle: Option<&Handle<Image>>| match handle {
-            Some(h) => images.get(h).map(|i| Some(i.clone())),
-            None => Some(None),
-        };
-        Some(match look {
+        let (part, roughness) = match look {
             BakedLook::Material(handle) => {
                 let material = materials.get(*handle)?;
-                Self {
+                let part = OwnedPart {
                     mesh: mesh.clone(),
                     color: bake::BakeColor::Plain(material.base_color.to_linear()),
                     vertex_colors: true,
                     lean: 0.0,
-                    texture: texture(material.base_color_texture.as_ref())?,
+                    texture: loaded_texture(material.base_color_texture.as_ref(), images)?,
                     alpha_cutoff: match material.alpha_mode {
                         AlphaMode::Mask(cutoff) => Some(cutoff),
                         _ => None,
                     },
-                    roughness: material.perceptual_roughness,
-                }
+                };
+                (part, material.perceptual_roughness)
             }
-            BakedLook::Shading(shading) => Self {
-                mesh: mesh.clone(),
-                color: bake::BakeColor::Gradient {
-                    base: shading.base_color.to_linear(),
-                    tip: shading.tip_color.to_linear(),
-                    tip_from: shading.tip_from,
-                },
-                vertex_colors: false,
-                lean: INSTANCED_LEAN,
-                texture: texture(shading.texture.as_ref())?,
-                alpha_cutoff: shading.texture.as_ref().map(|_| shading.alpha_cutoff),
-                roughness: shading.roughness,
-            },
+            BakedLook::Shading(shading) => {
+                let part = OwnedPart {
+                    mesh: mesh.clone(),
+                    color: bake::BakeColor::Gradient {
+                        base: shading.base_color.to_linear(),
+                        tip: shading.tip_color.to_linear(),
+                        tip_from: shading.tip_from,
+                    },
+                    vertex_colors: false,
+                    lean: INSTANCED_LEAN,
+                    texture: loaded_texture(shading.texture.as_ref(), images)?,
+                    alpha_cutoff: shading.texture.as_ref().map(|_| shading.alpha_cutoff),
+                };
+                (part, shading.roughness)
+            }
+        };
+        Some(Self {
+            parts: vec![part],
+            roughness,
         })
     }
 }
@@ -279,15 +303,19 @@ const INSTANCED_LEAN: f32 = 0.45;
 /// A bake of `source` on the async compute pool.
 fn start_bake(source: OwnedSource, impostor: Impostor) -> Task<Result<BakedImpostor, BakeError>> {
     AsyncComputeTaskPool::get().spawn(async move {
-        let s = bake::BakeSource {
-            mesh: &source.mesh,
-            color: source.color,
-            vertex_colors: source.vertex_colors,
-            lean: source.lean,
-            texture: source.texture.as_ref(),
-            alpha_cutoff: source.alpha_cutoff,
-        };
-        bake::bake(&s, &impostor)
+        let parts: Vec<bake::BakeSource> = source
+            .parts
+            .iter()
+            .map(|p| bake::BakeSource {
+                mesh: &p.mesh,
+                color: p.color,
+                vertex_colors: p.vertex_colors,
+                lean: p.lean,
+                texture: p.texture.as_ref(),
+                alpha_cutoff: p.alpha_cutoff,
+            })
+            .collect();
+        bake::bake_parts(&parts, &impostor)
     })
 }
 

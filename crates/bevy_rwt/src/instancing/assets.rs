@@ -1,7 +1,9 @@
 //! Asset classes' side of the instanced path: each [`AssetLook`] of a layer is resolved once
 //! its file has loaded with everything it names, again when the file changes (hot reload),
-//! and its chunks drawn again then ([`ResolvedAssets::generation`]).
+//! and its chunks drawn again then ([`ResolvedAssets::generation`]); its impostor is baked
+//! from its last level once resolved, and again when the file changes.
 
+use crate::impostor::ImpostorAtlases;
 use crate::layers::ScatterLayer;
 use crate::look::ClassLook;
 use crate::look::asset::{AssetLook, AssetLookError, AssetRoot, GltfAssets, ResolvedAsset};
@@ -79,6 +81,7 @@ pub(super) fn resolve_asset_looks(
     mut cursor: Local<MessageCursor<AssetEvent<Gltf>>>,
     sources: Option<AssetSources>,
     mut resolved: ResMut<ResolvedAssets>,
+    mut atlases: Option<ResMut<ImpostorAtlases>>,
 ) {
     let Some(mut sources) = sources else { return };
     if let Some(events) = events {
@@ -87,6 +90,9 @@ pub(super) fn resolve_asset_looks(
                 && resolved.looks.remove(id).is_some()
             {
                 resolved.generation += 1;
+                if let Some(atlases) = atlases.as_mut() {
+                    atlases.forget_file(*id);
+                }
             }
         }
     }
@@ -105,6 +111,27 @@ pub(super) fn resolve_asset_looks(
             let file = resolved.looks.entry(look.gltf.id()).or_default();
             file.insert(look.root.clone(), result);
             resolved.generation += 1;
+        }
+    }
+}
+
+/// Starts baking the impostors of asset classes that have one, once their look is resolved.
+pub(super) fn bake_asset_impostors(
+    layers: Query<&ScatterLayer>,
+    resolved: Res<ResolvedAssets>,
+    atlases: Option<ResMut<ImpostorAtlases>>,
+    meshes: Option<Res<Assets<Mesh>>>,
+    images: Option<Res<Assets<Image>>>,
+) {
+    let (Some(mut atlases), Some(meshes), Some(images)) = (atlases, meshes, images) else {
+        return;
+    };
+    for class in layers.iter().flat_map(|l| &l.classes) {
+        let (ClassLook::Asset(look), Some(impostor)) = (&class.look, &class.impostor) else {
+            continue;
+        };
+        if let Some(asset) = resolved.ready(look) {
+            atlases.bake_asset((look, asset), impostor, &meshes, &images);
         }
     }
 }

@@ -75,7 +75,11 @@ impl Plugin for RwtInstancingPlugin {
             .add_systems(
                 self.schedule,
                 // It adds meshes: before the bake and planning read them.
-                super::assets::resolve_asset_looks
+                (
+                    super::assets::resolve_asset_looks,
+                    super::assets::bake_asset_impostors,
+                )
+                    .chain()
                     .after(RwtSystems::Viewers)
                     .before(crate::impostor::bake_impostors)
                     .before(RwtSystems::Plan),

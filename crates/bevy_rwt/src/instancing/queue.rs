@@ -383,10 +383,22 @@ impl<'a> Upload<'a> {
         buffer: Arc<InstanceBuffer>,
     ) -> Option<(InstancedChunk, Aabb)> {
         let c = target.layer.classes.get(class as usize)?;
-        let atlas = self.impostors?.of(c)?;
+        let atlas = self.atlas(c)?;
         let component = impostor_chunk(target, class, c, atlas, buffer);
         let aabb = component.aabb(self.checked.bounds(&atlas.card, self.meshes));
         Some((component, aabb))
+    }
+
+    /// The impostor atlas of a class, once baked (an asset class's once resolved).
+    fn atlas(&self, c: &ScatterClass) -> Option<&'a ImpostorAtlas> {
+        let atlases = self.impostors?;
+        match &c.look {
+            #[cfg(feature = "gltf")]
+            ClassLook::Asset(look) => {
+                atlases.of_asset(look, self.assets?.ready(look)?, c.impostor.as_ref()?)
+            }
+            _ => atlases.of(c),
+        }
     }
 
     /// The components drawing `buffer` of a class of the target's layer, with their bounds:
@@ -405,7 +417,11 @@ impl<'a> Upload<'a> {
             ClassLook::Instanced(look) => vec![self.instanced(target, class, look, buffer)],
             #[cfg(feature = "gltf")]
             ClassLook::Asset(look) => match self.assets.and_then(|a| a.ready(look)) {
-                Some(asset) => asset_parts(target, class, (look, asset), buffer),
+                Some(asset) => {
+                    // Where its impostors are drawn, the last level fades out into them.
+                    let impostor = c.impostor.filter(|_| self.atlas(c).is_some());
+                    asset_parts(target, class, (look, asset, impostor), buffer)
+                }
                 None => Vec::new(),
             },
             _ => Vec::new(),
@@ -439,8 +455,10 @@ impl<'a> Upload<'a> {
         let layer = target.layer;
         let c = &layer.classes[class as usize];
         // Where its impostors are drawn, the meshes fade out as they fade in.
-        let impostors = self.impostors.and_then(|a| a.of(c)).is_some();
-        let fade_out = c.impostor.filter(|_| impostors).map(|i| i.band());
+        let fade_out = c
+            .impostor
+            .filter(|_| self.atlas(c).is_some())
+            .map(|i| i.band());
         let mesh_bounds = self.checked.bounds(&look.mesh, self.meshes);
         let meshes = (look.mesh.clone(), look.far.clone());
         let far_per_instance = self.checked.far_as_tall(&meshes, self.meshes);
@@ -467,21 +485,28 @@ impl<'a> Upload<'a> {
 }
 
 /// The components drawing `buffer` of an asset class: one per primitive of each level,
-/// each level fading in where the one before hands over and out where the next takes over,
-/// each part bounded by the whole asset (its top is the wind's and the fade's height).
+/// each level fading in where the one before hands over and out where the next takes over
+/// (the last where its `impostor` takes over, if it has one drawn), each part bounded by
+/// the whole asset (its top is the wind's and the fade's height).
 #[cfg(feature = "gltf")]
 fn asset_parts(
     target: Target,
     class: u16,
-    (look, asset): (
+    (look, asset, impostor): (
         &crate::look::asset::AssetLook,
         &crate::look::asset::ResolvedAsset,
+        Option<crate::look::Impostor>,
     ),
     buffer: Arc<InstanceBuffer>,
 ) -> Vec<(InstancedChunk, Aabb)> {
     let c = &target.layer.classes[class as usize];
     let switches = look.lods.switches(asset.levels.len(), asset.bounds);
-    let band = |level: usize| switches.get(level).map(|d| look.lods.band(*d));
+    let last = asset.levels.len() - 1;
+    let band = |level: usize| match switches.get(level) {
+        Some(d) => Some(look.lods.band(*d)),
+        None if level == last => impostor.map(|i| i.band()),
+        None => None,
+    };
     let parts = asset.levels.iter().enumerate().flat_map(|(level, parts)| {
         let fades = (level.checked_sub(1).and_then(band), band(level));
         parts.iter().map(move |part| (part, fades))
@@ -530,6 +555,8 @@ fn impostor_chunk(
     let frames = atlas.frames;
     let color_variation = match &c.look {
         ClassLook::Instanced(look) => look.material.color_variation,
+        #[cfg(feature = "gltf")]
+        ClassLook::Asset(look) => look.color_variation,
         _ => 0.0,
     };
     let material = InstancedShading {

@@ -1,6 +1,7 @@
 //! glTF assets: a file written by `testing::glb`, loaded by Bevy's glTF loader headless,
 //! read back as a node tree, split into levels of detail and colliders, resolved for the
-//! instanced path, and streamed as an asset class beside a class whose file is broken.
+//! instanced path, and streamed as an asset class beside a class whose file is broken, in
+//! code and from a layer file.
 
 use crate::common::{app_reading_with, layer, run_until, spawn_viewer};
 use bevy::camera::primitives::MeshAabb;
@@ -8,6 +9,7 @@ use bevy::gltf::{Gltf, GltfMesh, GltfNode, GltfPlugin};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy_rwt::instancing::{InstancedChunk, PromotedInstance};
+use bevy_rwt::layers::file::LayerDescription;
 use bevy_rwt::look::InstancedClassError;
 use bevy_rwt::look::asset::{
     AssetCollider, AssetLook, AssetLookError, AssetParts, AssetPrimitive, AssetRoot,
@@ -389,5 +391,156 @@ fn a_part_every_level_shares_is_moved_into_the_assets_frame_once() {
     assert_eq!(plinths.len(), 2);
     assert_eq!(plinths[0], plinths[1], "one moved plinth for both levels");
     assert_eq!(world.resource::<Assets<Mesh>>().len(), before + 1);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_layer_file_names_assets_and_describes_them_back() {
+    let bytes = tree().to_bytes();
+    let layer_file = r#"(format: 2, tile_size: 8.0, chunk_size: 16.0, load_distance: 48.0, unload_distance: 64.0,
+        classes: [
+            (density: Constant(0.05), asset: (path: "oak.glb#oak", lods: [12.0], collider: false, wind_response: 0.1)),
+            (density: Constant(0.05), asset: "broken.glb"),
+            (density: Constant(0.05), asset: "garbled.glb#Scene0"),
+            (density: Constant(0.05), asset: "missing.glb"),
+        ])"#;
+    let garbled: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
+        .collect();
+    let (mut app, dir) = gltf_app(
+        "asset_layer_file",
+        &[
+            ("oak.glb", &bytes),
+            ("broken.glb", &bytes[..bytes.len() / 2]),
+            ("garbled.glb", &garbled),
+            ("forest.layer.ron", layer_file.as_bytes()),
+        ],
+    );
+    let handle: Handle<ScatterLayerAsset> = app
+        .world()
+        .resource::<AssetServer>()
+        .load("forest.layer.ron");
+    let entity = app.world_mut().spawn(ScatterLayerSource(handle)).id();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let settled = run_until(&mut app, 3_000, |app| {
+        let drawn = app
+            .world()
+            .iter_entities()
+            .any(|e| e.contains::<InstancedChunk>());
+        let status = app.world().get::<ScatterLayerStatus>(entity).unwrap();
+        drawn && status.class_errors.len() == 3 && status.pending_tasks == 0
+    });
+    let status = app.world().get::<ScatterLayerStatus>(entity).unwrap();
+    assert!(settled, "{status:?}");
+    // Each bad file is its own class's error; the good one streams.
+    let failed: Vec<u16> = status.class_errors.iter().map(|(c, _)| *c).collect();
+    assert_eq!(failed, [1, 2, 3]);
+    for (class, error) in &status.class_errors {
+        let InstancedClassError::Asset(e) = error else {
+            panic!("class {class}: {error}");
+        };
+        assert!(matches!(**e, AssetLookError::Load(_)), "class {class}: {e}");
+    }
+    let mut chunks = app.world_mut().query::<&InstancedChunk>();
+    let near_out: Vec<_> = chunks
+        .iter(app.world())
+        .inspect(|c| assert_eq!(c.class, 0))
+        .filter(|c| c.fade_in.is_none())
+        .map(|c| c.fade_out)
+        .collect();
+    assert!(!near_out.is_empty());
+    // The file's switch distance, with its crossfade (a tenth of it) centred on it.
+    assert!(
+        near_out.iter().all(|b| *b == Some((11.4, 12.6))),
+        "{near_out:?}"
+    );
+    // Back to a file: the same classes, through RON and back.
+    let layer = app.world().get::<ScatterLayer>(entity).unwrap();
+    let names = NamedAssets::default();
+    let described = LayerDescription::describe(layer, &names, |_| None).unwrap();
+    let read = LayerDescription::from_ron(layer_file).unwrap();
+    assert_eq!(described.classes, read.classes);
+    let text = described.to_ron().unwrap();
+    assert_eq!(
+        LayerDescription::from_ron(&text).unwrap(),
+        described,
+        "{text}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn an_asset_fades_its_last_level_into_an_impostor_of_all_its_parts() {
+    let (mut app, dir) = gltf_app("asset_impostor", &[("oak.glb", &tree().to_bytes())]);
+    let server = app.world().resource::<AssetServer>().clone();
+    let oak = AssetLook::new(server.load("oak.glb"));
+    // The near level alone: bark and leaves, both in the impostor.
+    let near = oak.clone().with_root(AssetRoot::Node("oak_LOD0".into()));
+    let impostor = Impostor {
+        texels: 32,
+        views: 4,
+        rows: 1,
+        ..Impostor::at(30.0)
+    };
+    let density = LayerDensity::Constant(0.02);
+    let mut l = layer(density.clone());
+    l.streaming.load_distance = 64.0;
+    l.streaming.unload_distance = 80.0;
+    l.classes = [oak, near]
+        .map(|look| ScatterClass::asset(density.clone(), look).with_impostor(impostor))
+        .into();
+    let layer_entity = app.world_mut().spawn(l).id();
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let impostors = |app: &App| {
+        let mut classes: Vec<u16> = app
+            .world()
+            .iter_entities()
+            .filter_map(|e| e.get::<InstancedChunk>())
+            .filter(|c| c.impostor.is_some())
+            .map(|c| c.class)
+            .collect();
+        classes.sort();
+        classes.dedup();
+        classes
+    };
+    assert!(
+        run_until(&mut app, 4_000, |app| impostors(app) == [0, 1]),
+        "no impostors drawn: {:?}",
+        impostors(&app)
+    );
+    // The last level of each class fades out over the band the impostor fades in over.
+    let band = Some(impostor.band());
+    let mut q = app.world_mut().query::<&InstancedChunk>();
+    for c in q.iter(app.world()) {
+        let last = c.class == 1 || c.fade_in.is_some();
+        match (&c.impostor, last) {
+            (Some(draw), _) => assert_eq!(Some(draw.band), band),
+            (None, true) => assert_eq!(c.fade_out, band, "class {}", c.class),
+            (None, false) => assert_ne!(c.fade_out, band),
+        }
+    }
+    // The near level's atlas shows the bark and the leaves, each in its colour.
+    let world = app.world();
+    let layer = world.get::<ScatterLayer>(layer_entity).unwrap();
+    let ClassLook::Asset(look) = &layer.classes[1].look else {
+        unreachable!()
+    };
+    let resolved = world.resource::<bevy_rwt::instancing::ResolvedAssets>();
+    let atlases = world.resource::<bevy_rwt::impostor::ImpostorAtlases>();
+    let atlas = atlases
+        .of_asset(look, resolved.ready(look).unwrap(), &impostor)
+        .unwrap();
+    let image = world.resource::<Assets<Image>>().get(&atlas.image).unwrap();
+    let data = image.data.as_ref().unwrap();
+    let level0 = (atlas.frames.size().x * atlas.frames.size().y * 4) as usize;
+    let shows = |linear: [f32; 3]| {
+        let srgb = Srgba::from(LinearRgba::rgb(linear[0], linear[1], linear[2])).to_u8_array();
+        data[..level0]
+            .chunks_exact(4)
+            .filter(|t| t[3] == 255 && (0..3).all(|k| t[k].abs_diff(srgb[k]) <= 4))
+            .count()
+    };
+    let (bark, leaves) = (shows([0.3, 0.2, 0.1]), shows([0.2, 0.6, 0.1]));
+    assert!(bark > 20 && leaves > 200, "bark {bark}, leaves {leaves}");
     std::fs::remove_dir_all(&dir).ok();
 }

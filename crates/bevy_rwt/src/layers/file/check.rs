@@ -65,6 +65,13 @@ impl LayerDescription {
                 Clumps::new(*params).map_err(InvalidLayer::Clumps)?;
             }
         }
+        for (i, c) in d.classes.iter().enumerate() {
+            let drawn = c.mesh.is_some() && c.material.is_some();
+            let asset_only = c.mesh.is_none() && c.material.is_none() && c.lod.is_none();
+            if c.asset.as_ref().map_or(!drawn, |_| !asset_only) {
+                return Err(InvalidLayer::ClassLook { class: i });
+            }
+        }
         for (i, c, lod) in d
             .classes
             .iter()
@@ -77,7 +84,7 @@ impl LayerDescription {
                     distance: lod.distance,
                 });
             }
-            let instanced = matches!(c.material, MaterialDescription::Instanced(_));
+            let instanced = matches!(c.material, Some(MaterialDescription::Instanced(_)));
             if instanced != matches!(lod.material, MaterialDescription::Instanced(_)) {
                 return Err(InvalidLayer::FarMaterial { class: i });
             }

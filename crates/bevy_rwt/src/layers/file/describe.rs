@@ -1,14 +1,22 @@
 //! Layers back to layer files: [`LayerDescription::describe`].
 
 use super::{
-    ClassDescription, DensityDescription, HeightDescription, InstancedShadingDescription,
-    KeepOutDescription, LAYER_FORMAT, LayerDescription, LayerFileError, LayerPart, LodDescription,
-    MapDescription, MaterialDescription, MeshDescription, NamedAssets, PromotionDescription,
-    Undescribable,
+    AssetDescription, ClassDescription, DensityDescription, HeightDescription,
+    InstancedShadingDescription, KeepOutDescription, LAYER_FORMAT, LayerDescription,
+    LayerFileError, LayerPart, LodDescription, MapDescription, MaterialDescription,
+    MeshDescription, NamedAssets, PromotionDescription, Undescribable,
 };
 use crate::layers::{HeightSource, LayerDensity, LayerRef, ScatterClass, ScatterLayer};
 use crate::look::{ClassLook, MeshLod};
 use bevy::prelude::*;
+
+/// The fields of a class description that say how it looks.
+struct LookFields {
+    mesh: Option<MeshDescription>,
+    material: Option<MaterialDescription>,
+    lod: Option<LodDescription>,
+    asset: Option<AssetDescription>,
+}
 
 /// How [`LayerDescription::describe`] names assets.
 struct Namer<'a, I> {
@@ -119,7 +127,12 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             stance,
             impostor,
         } = c;
-        let (mesh, material, lod) = self.look(look, lod.as_ref())?;
+        let LookFields {
+            mesh,
+            material,
+            lod,
+            asset,
+        } = self.look(look, lod.as_ref())?;
         let promotion = match promotion {
             Some(p) => Some(PromotionDescription {
                 distance: p.distance,
@@ -134,6 +147,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             density: self.density(density)?,
             mesh,
             material,
+            asset,
             scale: *scale,
             scale_variation: *scale_variation,
             lod,
@@ -149,7 +163,7 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
         &mut self,
         look: &ClassLook,
         lod: Option<&MeshLod>,
-    ) -> Result<(MeshDescription, MaterialDescription, Option<LodDescription>), Undescribable> {
+    ) -> Result<LookFields, Undescribable> {
         let (mesh, material) = match look {
             ClassLook::Mesh { mesh, material } => (self.mesh(mesh)?, self.material(material)?),
             ClassLook::Instanced(look) => {
@@ -164,7 +178,15 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             }
             ClassLook::Custom(_) => return Err(Undescribable::CustomLook),
             #[cfg(feature = "gltf")]
-            ClassLook::Asset(_) => return Err(Undescribable::AssetLook),
+            ClassLook::Asset(look) => {
+                let file = asset_path(&look.gltf).ok_or(Undescribable::AssetLook)?;
+                return Ok(LookFields {
+                    mesh: None,
+                    material: None,
+                    lod: None,
+                    asset: Some(AssetDescription::of(look, &file)),
+                });
+            }
         };
         let far = match look {
             ClassLook::Instanced(look) => look.far.as_ref(),
@@ -185,7 +207,12 @@ impl<I: FnMut(&Handle<Image>) -> Option<String>> Namer<'_, I> {
             }),
             (None, None) => None,
         };
-        Ok((mesh, material, lod))
+        Ok(LookFields {
+            mesh: Some(mesh),
+            material: Some(material),
+            lod,
+            asset: None,
+        })
     }
 
     fn mesh(&self, mesh: &Handle<Mesh>) -> Result<MeshDescription, Undescribable> {

@@ -38,6 +38,12 @@ pub enum LayerFileError {
         /// The name.
         name: String,
     },
+    /// The file names a glTF asset, and this build has no glTF loader (the `gltf` feature).
+    #[error("class {class} names a glTF asset: build bevy_rwt with its `gltf` feature")]
+    NoGltf {
+        /// The class's index.
+        class: usize,
+    },
     /// The file is larger than [`MAX_LAYER_FILE_BYTES`](super::MAX_LAYER_FILE_BYTES): not a
     /// layer description.
     #[error("layer file is larger than {limit} bytes")]
@@ -117,6 +123,15 @@ pub enum InvalidLayer {
         /// The limit ([`MAX_CLASSES`](super::MAX_CLASSES)).
         limit: usize,
     },
+    /// A class has neither a mesh and a material nor an asset, or an asset beside a mesh, a
+    /// material or a far `lod` (an asset's levels are in its file).
+    #[error(
+        "class {class}: a class has a mesh and a material, or an asset (without mesh, material or lod)"
+    )]
+    ClassLook {
+        /// The class's index.
+        class: usize,
+    },
     /// A far material is not `Instanced()` exactly when its class is instanced.
     #[error("class {class}: a far material is Instanced() exactly when the class is instanced")]
     FarMaterial {
@@ -152,8 +167,8 @@ pub enum Undescribable {
     /// A look made in code.
     #[error("a custom look (code) has no file form")]
     CustomLook,
-    /// A glTF asset's look (layer files do not name assets yet).
-    #[error("an asset class's look has no file form yet")]
+    /// An asset class whose glTF file was not loaded from a path.
+    #[error("an asset class's glTF file has no asset path")]
     AssetLook,
     /// A density made in code.
     #[error("a custom density (code) has no file form")]

@@ -1,12 +1,11 @@
 //! The asset loader of layer files.
 
 use super::{
-    LayerDescription, LayerFileError, MAX_LAYER_FILE_BYTES, MaterialDescription, NamedAssets,
-    ScatterLayerAsset,
+    LayerDescription, LayerFileError, LayerHandles, MAX_LAYER_FILE_BYTES, MaterialDescription,
+    MeshDescription, NamedAssets, ScatterLayerAsset,
 };
 use bevy::asset::{AssetLoader, AssetPath, AsyncReadExt, LoadContext, io::Reader};
 use bevy::prelude::*;
-use std::cell::RefCell;
 
 /// Loads `.layer.ron` files, looking names up in the [`NamedAssets`] it was made with.
 #[derive(Default, TypePath)]
@@ -37,45 +36,12 @@ impl AssetLoader for ScatterLayerLoader {
         }
         let text = std::str::from_utf8(&bytes)?;
         let description = LayerDescription::from_ron(text)?;
-        // Primitive meshes and plain colours become labelled sub-assets of the layer file.
-        let ctx = RefCell::new(ctx);
-        let (mut meshes, mut materials) = (0, 0);
         let layer = description.to_layer(
             &self.names,
-            |m| {
-                let mut ctx = ctx.borrow_mut();
-                let label = format!("mesh{meshes}");
-                meshes += 1;
-                match m.primitive() {
-                    Ok(mesh) => ctx.add_labeled_asset(label, mesh),
-                    Err(path) => {
-                        let path = relative_to(ctx.path(), path);
-                        ctx.load(path)
-                    }
-                }
-            },
-            |m| {
-                let mut ctx = ctx.borrow_mut();
-                let label = format!("material{materials}");
-                materials += 1;
-                match m {
-                    MaterialDescription::Color(r, g, b) => ctx.add_labeled_asset(
-                        label,
-                        StandardMaterial::from(Color::linear_rgb(*r, *g, *b)),
-                    ),
-                    MaterialDescription::Path(path) => {
-                        let path = relative_to(ctx.path(), path);
-                        ctx.load(path)
-                    }
-                    MaterialDescription::Named(_) | MaterialDescription::Instanced(_) => {
-                        Handle::default()
-                    }
-                }
-            },
-            |path| {
-                let mut ctx = ctx.borrow_mut();
-                let path = relative_to(ctx.path(), path);
-                ctx.load(path)
+            &mut Loads {
+                ctx,
+                meshes: 0,
+                materials: 0,
             },
         )?;
         Ok(ScatterLayerAsset(layer))
@@ -83,6 +49,53 @@ impl AssetLoader for ScatterLayerLoader {
 
     fn extensions(&self) -> &[&str] {
         &["layer.ron"]
+    }
+}
+
+/// A layer file's handles: loads (its dependencies, so that it reloads with them), and its
+/// primitive meshes and plain colours as labelled sub-assets.
+struct Loads<'a, 'c> {
+    ctx: &'a mut LoadContext<'c>,
+    meshes: usize,
+    materials: usize,
+}
+
+impl Loads<'_, '_> {
+    fn load<A: Asset>(&mut self, path: &str) -> Handle<A> {
+        let path = relative_to(self.ctx.path(), path);
+        self.ctx.load(path)
+    }
+}
+
+impl LayerHandles for Loads<'_, '_> {
+    fn mesh(&mut self, mesh: &MeshDescription) -> Handle<Mesh> {
+        let label = format!("mesh{}", self.meshes);
+        self.meshes += 1;
+        match mesh.primitive() {
+            Ok(mesh) => self.ctx.add_labeled_asset(label, mesh),
+            Err(path) => self.load(path),
+        }
+    }
+
+    fn material(&mut self, material: &MaterialDescription) -> Handle<StandardMaterial> {
+        let label = format!("material{}", self.materials);
+        self.materials += 1;
+        match material {
+            MaterialDescription::Color(r, g, b) => self
+                .ctx
+                .add_labeled_asset(label, StandardMaterial::from(Color::linear_rgb(*r, *g, *b))),
+            MaterialDescription::Path(path) => self.load(path),
+            MaterialDescription::Named(_) | MaterialDescription::Instanced(_) => Handle::default(),
+        }
+    }
+
+    fn image(&mut self, path: &str) -> Handle<Image> {
+        self.load(path)
+    }
+
+    #[cfg(feature = "gltf")]
+    fn gltf(&mut self, path: &str) -> Handle<bevy::gltf::Gltf> {
+        self.load(path)
     }
 }
 

@@ -17,6 +17,9 @@
 //!          mesh: Cone(radius: 0.6, height: 2.5), material: Color(0.15, 0.4, 0.15)),
 //!         (density: Image(path: "maps/flowers.png", min: (-128.0, -128.0), size: (256.0, 256.0), scale: 2.0),
 //!          mesh: Path("models/flower.glb#Mesh0/Primitive0"), material: Path("models/flower.glb#Material0")),
+//!         // A glTF asset with all its parts, levels and collider, drawn instanced.
+//!         (density: Constant(0.01), asset: (path: "trees/oak.glb#Scene0", lods: [30.0, 90.0], wind_response: 0.05)),
+//!         (density: Constant(0.02), asset: "rocks/boulder.glb"),
 //!         // Instanced: one draw per chunk, no entity per blade.
 //!         (density: Constant(40.0), mesh: Blade(width: 0.08, height: 0.6, bend: 0.1),
 //!          material: Instanced(tip: (0.3, 0.5, 0.1), wind_response: 0.3), scale_variation: 0.3),
@@ -47,13 +50,18 @@
 //! seeds turned the tiling, and its layer keeps its places on [`Lattice::Aligned`]
 //! (`lattice: Aligned` does the same in format 2).
 //!
+//! An `asset` class (see [`AssetDescription`]) has no `mesh`, `material` or `lod`: its
+//! parts, materials, levels of detail and collider are the file's. The layer reloads with
+//! the `.glb`, and a file that does not load leaves that class empty while the others
+//! stream.
+//!
 //! In code, a file is parsed and checked by [`LayerDescription::from_ron`], becomes a
 //! layer with [`LayerDescription::to_layer`], and a layer becomes a file again with
 //! [`LayerDescription::describe`] and [`LayerDescription::to_ron`]:
 //!
 //! ```
 //! use bevy::prelude::*;
-//! use bevy_rwt::layers::file::{LayerDescription, MeshDescription, NamedAssets};
+//! use bevy_rwt::layers::file::{LayerDescription, MeshDescription, NamedAssets, Placeholders};
 //! use bevy_rwt::prelude::*;
 //!
 //! let names = NamedAssets::default();
@@ -62,7 +70,7 @@
 //! let text = r#"(classes: [(density: Constant(0.05), mesh: Named("pine"), material: Color(0.1, 0.3, 0.1))],
 //!                tile_size: 32.0, falloff: (100.0, 400.0), falloff_floor: 0.2)"#;
 //! let file = LayerDescription::from_ron(text).unwrap();
-//! let layer = file.to_layer(&names, |_| Handle::default(), |_| Handle::default(), |_| Handle::default()).unwrap();
+//! let layer = file.to_layer(&names, &mut Placeholders).unwrap();
 //! assert_eq!(layer.tile_size, 32.0);
 //! assert_eq!(layer.falloff.unwrap().floor, 0.2);
 //! // Back to a file: the mesh by its name.
@@ -72,7 +80,7 @@
 //! let mut layer = layer;
 //! layer.classes[0].look = look;
 //! let again = LayerDescription::describe(&layer, &names, |_| None).unwrap();
-//! assert_eq!(again.classes[0].mesh, MeshDescription::Named("pine".into()));
+//! assert_eq!(again.classes[0].mesh, Some(MeshDescription::Named("pine".into())));
 //! assert!(again.to_ron().unwrap().contains("Named(\"needles\")"));
 //! ```
 //!
@@ -82,6 +90,7 @@
 //! Named("terrain")`) through [`NamedAssets`], and [`LayerDescription::describe`] turns a
 //! layer built in code back into a file.
 
+mod asset;
 mod check;
 mod describe;
 mod error;
@@ -91,6 +100,7 @@ mod numbers;
 #[cfg(test)]
 mod tests;
 
+pub use asset::{AssetDescription, AssetLabel};
 pub use error::{InvalidLayer, LayerFileError, LayerPart, NamedKind, Undescribable};
 pub use loader::ScatterLayerLoader;
 pub use names::NamedAssets;
@@ -347,10 +357,20 @@ fn variation() -> f32 {
 pub struct ClassDescription {
     /// Where and how densely the class grows.
     pub density: DensityDescription,
-    /// Its mesh.
-    pub mesh: MeshDescription,
+    /// Its mesh (a class has a mesh and a material, or an asset).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<MeshDescription>,
     /// Its material.
-    pub material: MaterialDescription,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<MaterialDescription>,
+    /// The glTF asset it draws, instanced, with every part and material
+    /// (`asset: "trees/oak.glb#Scene0"`; see [`AssetDescription`]).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "asset::either_form"
+    )]
+    pub asset: Option<AssetDescription>,
     /// Base scale.
     #[serde(default = "one")]
     pub scale: f32,
@@ -567,27 +587,19 @@ impl LayerDescription {
         })
     }
 
-    /// The layer, with named assets from `names` and other handles made by the given
-    /// functions (asset loads in a loader): `mesh` for paths and primitives, `material` for
-    /// paths and colours of classes that are not instanced, `image` for density maps and
-    /// heightmaps.
+    /// The layer, with named assets from `names` and the other handles from `handles` (asset
+    /// loads in a loader; [`Placeholders`] to check a file).
     pub fn to_layer(
         &self,
         names: &NamedAssets,
-        mesh: impl FnMut(&MeshDescription) -> Handle<Mesh>,
-        material: impl FnMut(&MaterialDescription) -> Handle<StandardMaterial>,
-        image: impl FnMut(&str) -> Handle<Image>,
+        handles: &mut impl LayerHandles,
     ) -> Result<ScatterLayer, LayerFileError> {
-        let mut handles = Handles {
-            names,
-            mesh,
-            material,
-            image,
-        };
+        let mut handles = Handles { names, handles };
         let classes = self
             .classes
             .iter()
-            .map(|c| c.to_class(&mut handles))
+            .enumerate()
+            .map(|(i, c)| c.to_class(i, &mut handles))
             .collect::<Result<_, _>>()?;
         let defaults = StreamingConfig::default();
         let mut layer = ScatterLayer::new(classes)
@@ -606,7 +618,7 @@ impl LayerDescription {
             .falloff
             .map(|(near, far)| Falloff::new(near, far).with_floor(self.falloff_floor));
         layer.exclusion = match &self.exclusion {
-            Some(e) => Some(e.to_density(&mut handles.image)?),
+            Some(e) => Some(e.to_density(&mut |p| handles.handles.image(p))?),
             None => None,
         };
         layer.height_range = self.height_range;
@@ -624,13 +636,10 @@ impl LayerDescription {
         Ok(layer)
     }
 
-    fn height_source<M, T, I>(
+    fn height_source<H: LayerHandles>(
         &self,
-        handles: &mut Handles<M, T, I>,
-    ) -> Result<HeightSource, LayerFileError>
-    where
-        I: FnMut(&str) -> Handle<Image>,
-    {
+        handles: &mut Handles<H>,
+    ) -> Result<HeightSource, LayerFileError> {
         Ok(match &self.ground {
             None => HeightSource::Constant(self.height),
             Some(HeightDescription::Named(name)) => handles
@@ -638,7 +647,7 @@ impl LayerDescription {
                 .height(name)
                 .ok_or_else(|| unknown(NamedKind::Height, name))?,
             Some(HeightDescription::Image(map)) => {
-                HeightSource::Image(map.to_map(&mut handles.image))
+                HeightSource::Image(map.to_map(|p| handles.handles.image(p)))
             }
             Some(HeightDescription::Surfaces) => HeightSource::Surfaces,
         })
@@ -653,26 +662,57 @@ fn unknown(kind: NamedKind, name: &str) -> LayerFileError {
     }
 }
 
-/// Where [`LayerDescription::to_layer`] gets its handles.
-struct Handles<'a, M, T, I> {
-    names: &'a NamedAssets,
-    mesh: M,
-    material: T,
-    image: I,
+/// Where [`LayerDescription::to_layer`] gets the handles of what a file names by path or
+/// describes: in an asset loader, loads and labelled sub-assets of the layer file.
+pub trait LayerHandles {
+    /// A mesh's handle: a loaded path, or a primitive made.
+    fn mesh(&mut self, mesh: &MeshDescription) -> Handle<Mesh>;
+    /// The material of a class that is not instanced: a loaded path, or a colour made.
+    fn material(&mut self, material: &MaterialDescription) -> Handle<StandardMaterial>;
+    /// An image (density map, heightmap, texture) loaded from its path.
+    fn image(&mut self, path: &str) -> Handle<Image>;
+    /// A glTF file loaded from its path (without a label), for an asset class.
+    #[cfg(feature = "gltf")]
+    fn gltf(&mut self, path: &str) -> Handle<bevy::gltf::Gltf>;
 }
 
-impl<M, T, I> Handles<'_, M, T, I>
-where
-    M: FnMut(&MeshDescription) -> Handle<Mesh>,
-    T: FnMut(&MaterialDescription) -> Handle<StandardMaterial>,
-{
+/// Default handles for everything a file names: a layer to check or inspect, not to draw.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Placeholders;
+
+impl LayerHandles for Placeholders {
+    fn mesh(&mut self, _: &MeshDescription) -> Handle<Mesh> {
+        Handle::default()
+    }
+
+    fn material(&mut self, _: &MaterialDescription) -> Handle<StandardMaterial> {
+        Handle::default()
+    }
+
+    fn image(&mut self, _: &str) -> Handle<Image> {
+        Handle::default()
+    }
+
+    #[cfg(feature = "gltf")]
+    fn gltf(&mut self, _: &str) -> Handle<bevy::gltf::Gltf> {
+        Handle::default()
+    }
+}
+
+/// Named assets and the handles of the rest.
+struct Handles<'a, H> {
+    names: &'a NamedAssets,
+    handles: &'a mut H,
+}
+
+impl<H: LayerHandles> Handles<'_, H> {
     fn mesh(&mut self, d: &MeshDescription) -> Result<Handle<Mesh>, LayerFileError> {
         match d {
             MeshDescription::Named(name) => self
                 .names
                 .mesh(name)
                 .ok_or_else(|| unknown(NamedKind::Mesh, name)),
-            other => Ok((self.mesh)(other)),
+            other => Ok(self.handles.mesh(other)),
         }
     }
 
@@ -685,7 +725,7 @@ where
                 .names
                 .material(name)
                 .ok_or_else(|| unknown(NamedKind::Material, name)),
-            other => Ok((self.material)(other)),
+            other => Ok(self.handles.material(other)),
         }
     }
 }
@@ -704,54 +744,76 @@ impl ClassDescription {
         }))
     }
 
-    fn to_class<M, T, I>(
+    fn to_class<H: LayerHandles>(
         &self,
-        handles: &mut Handles<M, T, I>,
-    ) -> Result<ScatterClass, LayerFileError>
-    where
-        M: FnMut(&MeshDescription) -> Handle<Mesh>,
-        T: FnMut(&MaterialDescription) -> Handle<StandardMaterial>,
-        I: FnMut(&str) -> Handle<Image>,
-    {
-        let density = self.density.to_density(&mut handles.image)?;
-        let mesh = handles.mesh(&self.mesh)?;
-        let class = match &self.material {
-            MaterialDescription::Instanced(m) => {
-                ScatterClass::instanced(density, mesh, m.to_material(&mut handles.image))
-            }
-            other => ScatterClass::new(density, mesh, handles.material(other)?),
-        };
-        let instanced = matches!(self.material, MaterialDescription::Instanced(_));
-        let lod = match &self.lod {
-            Some(lod) if instanced => {
-                let far = handles.mesh(&lod.mesh)?;
-                return Ok(ScatterClass {
-                    scale: self.scale,
-                    scale_variation: self.scale_variation,
-                    stance: self.stance,
-                    pick_bounds: self.pick_bounds,
-                    promotion: self.promotion(handles.names)?,
-                    impostor: self.impostor,
-                    ..class.with_instanced_far(far, lod.distance)
-                });
-            }
-            Some(lod) => Some(MeshLod {
-                mesh: handles.mesh(&lod.mesh)?,
-                material: handles.material(&lod.material)?,
-                distance: lod.distance,
-                crossfade: lod.crossfade.unwrap_or(0.1 * lod.distance),
-            }),
-            None => None,
-        };
-        Ok(ScatterClass {
+        index: usize,
+        handles: &mut Handles<H>,
+    ) -> Result<ScatterClass, LayerFileError> {
+        let density = self.density.to_density(&mut |p| handles.handles.image(p))?;
+        let class = ScatterClass {
             scale: self.scale,
             scale_variation: self.scale_variation,
-            lod,
             stance: self.stance,
             pick_bounds: self.pick_bounds,
             promotion: self.promotion(handles.names)?,
             impostor: self.impostor,
-            ..class
+            ..self.look(index, density, handles)?
+        };
+        Ok(class)
+    }
+
+    /// The class's look and far level, its other fields at their defaults.
+    fn look<H: LayerHandles>(
+        &self,
+        index: usize,
+        density: LayerDensity,
+        handles: &mut Handles<H>,
+    ) -> Result<ScatterClass, LayerFileError> {
+        let (Some(mesh), Some(material)) = (&self.mesh, &self.material) else {
+            return self.asset_class(index, density, handles);
+        };
+        let mesh = handles.mesh(mesh)?;
+        let class = match material {
+            MaterialDescription::Instanced(m) => {
+                let shading = m.to_material(|p| handles.handles.image(p));
+                ScatterClass::instanced(density, mesh, shading)
+            }
+            other => ScatterClass::new(density, mesh, handles.material(other)?),
+        };
+        Ok(match (&self.lod, material) {
+            (Some(lod), MaterialDescription::Instanced(_)) => {
+                class.with_instanced_far(handles.mesh(&lod.mesh)?, lod.distance)
+            }
+            (Some(lod), _) => ScatterClass {
+                lod: Some(MeshLod {
+                    mesh: handles.mesh(&lod.mesh)?,
+                    material: handles.material(&lod.material)?,
+                    distance: lod.distance,
+                    crossfade: lod.crossfade.unwrap_or(0.1 * lod.distance),
+                }),
+                ..class
+            },
+            (None, _) => class,
         })
+    }
+
+    /// The class of an asset (checked to have one when it has no mesh and material).
+    #[cfg_attr(not(feature = "gltf"), allow(unused_variables))]
+    fn asset_class<H: LayerHandles>(
+        &self,
+        index: usize,
+        density: LayerDensity,
+        handles: &mut Handles<H>,
+    ) -> Result<ScatterClass, LayerFileError> {
+        let Some(asset) = &self.asset else {
+            return Err(InvalidLayer::ClassLook { class: index }.into());
+        };
+        #[cfg(feature = "gltf")]
+        {
+            let gltf = handles.handles.gltf(asset.file());
+            Ok(ScatterClass::asset(density, asset.to_look(gltf)))
+        }
+        #[cfg(not(feature = "gltf"))]
+        Err(LayerFileError::NoGltf { class: index })
     }
 }

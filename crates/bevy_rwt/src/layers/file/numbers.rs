@@ -4,8 +4,8 @@
 //! field, instead of loading as a silent blank or a default.
 
 use super::{
-    ClassDescription, DensityDescription, InstancedShadingDescription, InvalidLayer,
-    LayerDescription, MapDescription, MaterialDescription, MeshDescription,
+    AssetDescription, ClassDescription, DensityDescription, InstancedShadingDescription,
+    InvalidLayer, LayerDescription, MapDescription, MaterialDescription, MeshDescription,
 };
 
 /// Tile sizes a layer may have: within them every subdivision level of a tile has a finite,
@@ -151,8 +151,15 @@ pub(super) fn check(d: &LayerDescription) -> Result<(), InvalidLayer> {
 
 fn class(n: &mut Numbers, at: &str, c: &ClassDescription) {
     density(n, at, &c.density);
-    mesh(n, at, &c.mesh);
-    material(n, at, &c.material);
+    if let Some(m) = &c.mesh {
+        mesh(n, at, m);
+    }
+    if let Some(m) = &c.material {
+        material(n, at, m);
+    }
+    if let Some(a) = &c.asset {
+        asset(n, at, a);
+    }
     n.add(
         format!("{at}: scale"),
         c.scale,
@@ -289,6 +296,28 @@ fn shading(n: &mut Numbers, at: &str, s: &InstancedShadingDescription) {
     }
     if let crate::look::InstancedShadows::Within(d) = s.shadows {
         n.add(format!("{at}: shadows within"), d, Rule::NonNegative);
+    }
+}
+
+fn asset(n: &mut Numbers, at: &str, a: &AssetDescription) {
+    for (i, d) in a.lods.iter().enumerate() {
+        n.add(format!("{at}: asset lod {i}"), *d, Rule::Positive(f64::MAX));
+    }
+    n.add(
+        format!("{at}: asset crossfade"),
+        a.crossfade,
+        Rule::Between(0.0, 1.0),
+    );
+    for (name, v) in [
+        ("color_variation", a.color_variation),
+        ("wind_response", a.wind_response),
+        ("bend_response", a.bend_response),
+        ("fade_band", a.fade_band),
+    ] {
+        n.add(format!("{at}: asset {name}"), v, Rule::Finite);
+    }
+    if let crate::look::InstancedShadows::Within(d) = a.shadows {
+        n.add(format!("{at}: asset shadows within"), d, Rule::NonNegative);
     }
 }
 

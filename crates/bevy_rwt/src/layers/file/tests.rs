@@ -5,13 +5,51 @@ use crate::look::{ClassLook, InstancedShadows};
 
 /// The layer of `d` with default handles and no names.
 fn plain(d: &LayerDescription) -> ScatterLayer {
-    d.to_layer(
-        &NamedAssets::default(),
-        |_| Handle::default(),
-        |_| Handle::default(),
-        |_| Handle::default(),
-    )
-    .unwrap()
+    d.to_layer(&NamedAssets::default(), &mut Placeholders)
+        .unwrap()
+}
+
+/// Handles that record what a file asks for; every image is `image`.
+#[derive(Default)]
+struct Recorder {
+    meshes: Vec<MeshDescription>,
+    materials: Vec<MaterialDescription>,
+    images: Vec<String>,
+    gltfs: Vec<String>,
+    image: Handle<Image>,
+}
+
+impl Recorder {
+    /// Whether nothing was asked for.
+    fn nothing(&self) -> bool {
+        self.meshes.is_empty()
+            && self.materials.is_empty()
+            && self.images.is_empty()
+            && self.gltfs.is_empty()
+    }
+}
+
+impl LayerHandles for Recorder {
+    fn mesh(&mut self, mesh: &MeshDescription) -> Handle<Mesh> {
+        self.meshes.push(mesh.clone());
+        Handle::default()
+    }
+
+    fn material(&mut self, material: &MaterialDescription) -> Handle<StandardMaterial> {
+        self.materials.push(material.clone());
+        Handle::default()
+    }
+
+    fn image(&mut self, path: &str) -> Handle<Image> {
+        self.images.push(path.to_string());
+        self.image.clone()
+    }
+
+    #[cfg(feature = "gltf")]
+    fn gltf(&mut self, path: &str) -> Handle<bevy::gltf::Gltf> {
+        self.gltfs.push(path.to_string());
+        Handle::default()
+    }
 }
 
 const MEADOW: &str = r#"(
@@ -44,7 +82,7 @@ fn a_layer_file_writes_and_reads_back_the_same() {
     );
     let d = LayerDescription::from_ron(&with_all).unwrap();
     assert_eq!(d.classes.len(), 4);
-    let MaterialDescription::Instanced(m) = &d.classes[0].material else {
+    let Some(MaterialDescription::Instanced(m)) = &d.classes[0].material else {
         panic!("the first class is instanced");
     };
     let mut loaded = Vec::new();
@@ -83,21 +121,13 @@ fn parses_a_layer_file() {
         "falloff: (20.0, 60.0),",
         "falloff: (20.0, 60.0), exclusion: Image(path: \"roads.png\", min: (0.0, 0.0), size: (8.0, 8.0), scale: 1.0),",
     );
-    let mut loads = Vec::new();
+    let mut loads = Recorder::default();
     let layer = LayerDescription::from_ron(&excluded)
         .unwrap()
-        .to_layer(
-            &NamedAssets::default(),
-            |_| Handle::default(),
-            |_| Handle::default(),
-            |path| {
-                loads.push(path.to_string());
-                Handle::default()
-            },
-        )
+        .to_layer(&NamedAssets::default(), &mut loads)
         .unwrap();
     assert!(matches!(layer.exclusion, Some(LayerDensity::Image(_))));
-    assert_eq!(loads, ["roads.png"]);
+    assert_eq!(loads.images, ["roads.png"]);
 }
 
 #[test]
@@ -109,19 +139,9 @@ fn instanced_classes_in_a_layer_file() {
          (density: Constant(5.0), mesh: Cuboid(size: (0.1, 0.1, 0.1)), material: Instanced()),",
     );
     let d = LayerDescription::from_ron(&text).unwrap();
-    let mut materials = 0;
-    let layer = d
-        .to_layer(
-            &NamedAssets::default(),
-            |_| Handle::default(),
-            |_| {
-                materials += 1;
-                Handle::default()
-            },
-            |_| Handle::default(),
-        )
-        .unwrap();
-    assert_eq!(materials, 2, "entity classes only");
+    let mut loads = Recorder::default();
+    let layer = d.to_layer(&NamedAssets::default(), &mut loads).unwrap();
+    assert_eq!(loads.materials.len(), 2, "entity classes only");
     let ClassLook::Instanced(look) = &layer.classes[0].look else {
         panic!("{:?}", layer.classes[0].look);
     };
@@ -136,7 +156,7 @@ fn instanced_classes_in_a_layer_file() {
     let base = defaults.base_color.to_linear();
     let read = plain.material.base_color.to_linear();
     assert!((base.green - read.green).abs() < 1e-6, "{base:?} {read:?}");
-    let blade = d.classes[0].mesh.primitive().unwrap();
+    let blade = d.classes[0].mesh.as_ref().unwrap().primitive().unwrap();
     let (_, hi) = crate::look::check_instanced_mesh(&blade).unwrap().unwrap();
     assert!((hi.y - 0.6).abs() < 1e-6);
 }
@@ -321,24 +341,24 @@ fn a_layer_built_in_code_describes_itself_and_reads_back_the_same() {
     let layer = code_layer(&names, &map);
     let saved = |h: &Handle<Image>| (h.id() == map.id()).then(|| "./flowers.png".to_string());
     let d = LayerDescription::describe(&layer, &names, saved).unwrap();
-    assert_eq!(d.classes[1].mesh, MeshDescription::Named("bush".into()));
+    assert_eq!(
+        d.classes[1].mesh,
+        Some(MeshDescription::Named("bush".into()))
+    );
     assert_eq!(d.ground, Some(HeightDescription::Named("terrain".into())));
     let text = d.to_ron().unwrap();
     let read = LayerDescription::from_ron(&text).unwrap();
     assert_eq!(read, d, "{text}");
-    let mut images = Vec::new();
-    let back = read
-        .to_layer(
-            &names,
-            |m| panic!("only named meshes: {m:?}"),
-            |m| panic!("only named materials: {m:?}"),
-            |path| {
-                images.push(path.to_string());
-                map.clone()
-            },
-        )
-        .unwrap();
-    assert_eq!(images, ["./flowers.png"]);
+    let mut loads = Recorder {
+        image: map.clone(),
+        ..Recorder::default()
+    };
+    let back = read.to_layer(&names, &mut loads).unwrap();
+    assert_eq!(loads.images, ["./flowers.png"]);
+    assert!(
+        loads.meshes.is_empty() && loads.materials.is_empty(),
+        "only named ones"
+    );
     let ClassLook::Mesh { material, .. } = &back.classes[1].look else {
         panic!("{:?}", back.classes[1].look);
     };
@@ -407,12 +427,7 @@ fn what_a_file_cannot_name_is_a_typed_error() {
     let text = MEADOW.replace("mesh: Sphere(radius: 0.3)", "mesh: Named(\"oak\")");
     let err = LayerDescription::from_ron(&text)
         .unwrap()
-        .to_layer(
-            &names,
-            |_| Handle::default(),
-            |_| Handle::default(),
-            |_| Handle::default(),
-        )
+        .to_layer(&names, &mut Placeholders)
         .unwrap_err();
     assert!(
         matches!(&err, LayerFileError::UnknownName { kind: NamedKind::Mesh, name } if name == "oak"),
@@ -465,14 +480,9 @@ fn ground_stances_and_clumps_read_back_the_same() {
     }
     let read = LayerDescription::from_ron(&text).unwrap();
     assert_eq!(read, d);
-    let back = read
-        .to_layer(
-            &names,
-            |_| unreachable!(),
-            |_| unreachable!(),
-            |_| unreachable!(),
-        )
-        .unwrap();
+    let mut loads = Recorder::default();
+    let back = read.to_layer(&names, &mut loads).unwrap();
+    assert!(loads.nothing(), "everything by name");
     assert!(matches!(back.height, HeightSource::Surfaces));
     assert_eq!(
         (back.surfaces, back.per_area),
@@ -569,4 +579,107 @@ fn formats_place_the_lattice_and_unknown_ones_are_refused() {
         );
         assert!(e.to_string().contains(&format!("format {format}")), "{e}");
     }
+}
+
+const FOREST: &str = r#"(classes: [
+    (density: Constant(0.01), asset: (path: "trees/oak.glb#Scene0", lods: [30.0, 90.0], wind_response: 0.05)),
+    (density: Constant(0.02), asset: "rocks/boulder.glb", scale: 2.0),
+])"#;
+
+#[cfg(feature = "gltf")]
+#[test]
+fn asset_classes_in_a_layer_file() {
+    use crate::look::asset::AssetRoot;
+    let d = LayerDescription::from_ron(FOREST).unwrap();
+    let mut loads = Recorder::default();
+    let layer = d.to_layer(&NamedAssets::default(), &mut loads).unwrap();
+    // The files load without their labels; the labels pick the part.
+    assert_eq!(loads.gltfs, ["trees/oak.glb", "rocks/boulder.glb"]);
+    assert!(loads.meshes.is_empty() && loads.materials.is_empty());
+    let looks: Vec<_> = layer
+        .classes
+        .iter()
+        .map(|c| match &c.look {
+            ClassLook::Asset(look) => look.clone(),
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(looks[0].root, AssetRoot::Scene(0));
+    assert_eq!(looks[0].lods.distances, [30.0, 90.0]);
+    assert_eq!(looks[0].wind_response, 0.05);
+    assert!(looks[0].collider);
+    // The path alone: every other field at the look's default.
+    let plain = crate::look::asset::AssetLook::new(Handle::default());
+    assert_eq!(looks[1].root, AssetRoot::File);
+    assert_eq!(
+        (&looks[1].lods, looks[1].fade_band, looks[1].shadows),
+        (&plain.lods, plain.fade_band, plain.shadows)
+    );
+    assert_eq!(layer.classes[1].scale, 2.0);
+    // Written back in full, read back the same.
+    let text = d.to_ron().unwrap();
+    assert!(text.contains("path: \"rocks/boulder.glb\""), "{text}");
+    assert_eq!(LayerDescription::from_ron(&text).unwrap(), d);
+}
+
+#[test]
+fn an_asset_class_has_nothing_else_to_look_like() {
+    let with = |class: &str| format!("(classes: [(density: Constant(1.0), {class})])");
+    for class in [
+        "asset: \"a.glb\", mesh: Sphere(radius: 1.0)",
+        "asset: \"a.glb\", material: Color(1.0, 1.0, 1.0)",
+        "asset: \"a.glb\", lod: (mesh: Sphere(radius: 1.0), material: Color(1.0, 1.0, 1.0), distance: 9.0)",
+        "mesh: Sphere(radius: 1.0)",
+        "material: Color(1.0, 1.0, 1.0)",
+        "scale: 2.0",
+    ] {
+        let err = LayerDescription::from_ron(&with(class)).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                LayerFileError::Invalid(InvalidLayer::ClassLook { class: 0 })
+            ),
+            "{class}: {err}"
+        );
+    }
+    for (class, field) in [
+        (
+            "asset: (path: \"a.glb\", lods: [10.0, -1.0])",
+            "asset lod 1",
+        ),
+        (
+            "asset: (path: \"a.glb\", crossfade: 2.0)",
+            "asset crossfade",
+        ),
+        (
+            "asset: (path: \"a.glb\", wind_response: inf)",
+            "asset wind_response",
+        ),
+        (
+            "asset: (path: \"a.glb\", shadows: Within(-3.0))",
+            "asset shadows within",
+        ),
+    ] {
+        let err = LayerDescription::from_ron(&with(class)).unwrap_err();
+        let LayerFileError::Invalid(InvalidLayer::Number { field: named, .. }) = &err else {
+            panic!("{class}: {err}");
+        };
+        assert_eq!(named, &format!("class 0: {field}"));
+    }
+    // Unknown fields of an asset are refused, in either form's place.
+    let err =
+        LayerDescription::from_ron(&with("asset: (path: \"a.glb\", lod: [1.0])")).unwrap_err();
+    assert!(matches!(err, LayerFileError::Parse(_)), "{err}");
+    let err = LayerDescription::from_ron(&with("asset: 3")).unwrap_err();
+    assert!(matches!(err, LayerFileError::Parse(_)), "{err}");
+}
+
+#[cfg(not(feature = "gltf"))]
+#[test]
+fn without_the_gltf_feature_an_asset_class_is_a_typed_error() {
+    let d = LayerDescription::from_ron(FOREST).unwrap();
+    let err = d
+        .to_layer(&NamedAssets::default(), &mut Placeholders)
+        .unwrap_err();
+    assert!(matches!(err, LayerFileError::NoGltf { class: 0 }), "{err}");
 }
