@@ -23,7 +23,7 @@ use bevy_rwt::prelude::*;
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
 use rwt_examples::frame_check::{
     CHECK_SKY as SKY, COMPARED_MSAA, Captures, Disc, HIGH_SUN, off_sky, out_of_patience,
-    output_dir, passed, spawn_shadow_sun,
+    output_dir, passed, scene_per_instance, spawn_shadow_sun,
 };
 use std::sync::Arc;
 
@@ -69,7 +69,7 @@ fn main() -> AppExit {
 fn asset() -> Glb {
     let mut file = Glb::default();
     let trunk = file.add_material(GlbMaterial::colored([0.8, 0.08, 0.05, 1.0]));
-    let image = file.add_image(leaf_png());
+    let image = file.add_image(rwt_examples::generated::leaf_mask_png());
     let leaves = file.add_material(GlbMaterial {
         base_color_texture: Some(image),
         alpha: GlbAlpha::Mask(0.5),
@@ -101,26 +101,6 @@ fn asset() -> Glb {
     );
     file.add_root(node);
     file
-}
-
-/// A leaf texture: white, opaque inside five overlapping discs, clear elsewhere.
-fn leaf_png() -> Vec<u8> {
-    let size = 64;
-    let discs = [(32.0, 32.0, 18.0), (16.0, 20.0, 12.0), (48.0, 20.0, 12.0)];
-    let more = [(18.0, 46.0, 11.0), (46.0, 46.0, 11.0)];
-    let image = image::RgbaImage::from_fn(size, size, |x, y| {
-        let (x, y) = (x as f32 + 0.5, y as f32 + 0.5);
-        let inside = discs
-            .iter()
-            .chain(&more)
-            .any(|(cx, cy, r)| (x - cx).hypot(y - cy) <= *r);
-        image::Rgba([255, 255, 255, if inside { 255 } else { 0 }])
-    });
-    let mut png = Vec::new();
-    image
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .expect("a PNG encodes in memory");
-    png
 }
 
 fn setup(mut commands: Commands, server: Res<AssetServer>) {
@@ -187,7 +167,8 @@ fn run_check(
     match (captures.get("asset"), captures.get("scene")) {
         (None, _) => captures.capture(&mut commands, "asset", dir),
         (Some(_), None) if check.instances == 0 => {
-            check.instances = spawn_scenes(&mut commands, &chunks, &server);
+            let scene = server.load(format!("{FILE}#Scene0"));
+            check.instances = scene_per_instance(&mut commands, &chunks, &scene);
             for layer in &layers {
                 commands.entity(layer).despawn();
             }
@@ -203,33 +184,6 @@ fn run_check(
             });
         }
     }
-}
-
-/// Spawns the file's scene at every instance the chunks draw (one chunk entity per
-/// primitive: the first primitive's are every instance); returns how many.
-fn spawn_scenes(
-    commands: &mut Commands,
-    chunks: &Query<(&InstancedChunk, &Transform)>,
-    server: &AssetServer,
-) -> usize {
-    let scene = server.load(format!("{FILE}#Scene0"));
-    let mut seen = std::collections::HashSet::new();
-    let mut count = 0;
-    for (chunk, corner) in chunks {
-        if !seen.insert(chunk.chunk) {
-            continue;
-        }
-        for g in &chunk.buffer.instances {
-            let transform = Transform {
-                translation: corner.translation + Vec3::from_array(g.offset),
-                rotation: g.rotation(),
-                scale: Vec3::splat(g.scale),
-            };
-            commands.spawn((WorldAssetRoot(scene.clone()), transform));
-            count += 1;
-        }
-    }
-    count
 }
 
 /// Which primitive's colour a pixel shows: 0 red, 1 green, 2 blue; `None` for the sky.

@@ -18,6 +18,8 @@
 # cover (silhouette IoU >= 0.8), coloured alike, culled per instance as the CPU does, and
 # asset_match, which fails unless a glTF asset drawn instanced covers the pixels Bevy's own
 # scene entities of it cover (silhouette IoU >= 0.98, each primitive's colour in its place),
+# asset_shadows, which fails unless an asset's cut-out leaves cast their shadows where Bevy's
+# own scene entities of it cast theirs (shadow IoU >= 0.85) and its moss receives them,
 # and asset_lods, which fails unless an asset's levels of detail, chosen per instance on the
 # GPU, draw fewer vertices as the camera moves away, each instance the level its distance
 # calls for.
@@ -32,10 +34,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_lods)
+examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_shadows asset_lods)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_lods)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_shadows asset_lods)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -114,6 +116,11 @@ for run in "${runs[@]}"; do
     if [ "$ex" = asset_match ]; then
         # Assets: rwt's instanced draw of a glTF asset against Bevy's scene entities.
         self_checked RWT_ASSET_DIR=$out/asset rwt-asset 'instances'
+        continue
+    fi
+    if [ "$ex" = asset_shadows ]; then
+        # Shadows of an asset: rwt's cut-out card casts where Bevy's own scene casts.
+        self_checked RWT_ASSET_SHADOWS_DIR=$out/asset_shadows rwt-asset-shadows 'instances'
         continue
     fi
     if [ "$ex" = asset_lods ]; then

@@ -186,3 +186,30 @@ pub fn off_sky(p: &image::Rgb<u8>, by: u8) -> bool {
     let sky = CHECK_SKY.to_srgba().to_u8_array();
     p.0.iter().zip(sky).any(|(c, s)| c.abs_diff(s) > by)
 }
+
+/// Spawns `scene` at every instance the chunks draw, at its transform as the chunk holds it
+/// (an asset class has one chunk entity per primitive: the first one's are every
+/// instance); returns how many.
+pub fn scene_per_instance(
+    commands: &mut Commands,
+    chunks: &Query<(&bevy_rwt::instancing::InstancedChunk, &Transform)>,
+    scene: &Handle<bevy::world_serialization::WorldAsset>,
+) -> usize {
+    let mut seen = std::collections::HashSet::new();
+    let mut count = 0;
+    for (chunk, corner) in chunks {
+        if !seen.insert(chunk.chunk) {
+            continue;
+        }
+        for g in &chunk.buffer.instances {
+            let transform = Transform {
+                translation: corner.translation + Vec3::from_array(g.offset),
+                rotation: g.rotation(),
+                scale: Vec3::splat(g.scale),
+            };
+            commands.spawn((WorldAssetRoot(scene.clone()), transform));
+            count += 1;
+        }
+    }
+    count
+}

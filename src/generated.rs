@@ -16,3 +16,24 @@ pub fn write_asset(relative: &str, bytes: &[u8]) -> PathBuf {
     }
     path
 }
+
+/// A leaf-card texture, 64 texels square: white, opaque inside five overlapping discs,
+/// clear elsewhere (as a PNG).
+pub fn leaf_mask_png() -> Vec<u8> {
+    let size = 64;
+    let discs = [(32.0, 32.0, 18.0), (16.0, 20.0, 12.0), (48.0, 20.0, 12.0)];
+    let more = [(18.0, 46.0, 11.0), (46.0, 46.0, 11.0)];
+    let image = image::RgbaImage::from_fn(size, size, |x, y| {
+        let (x, y) = (x as f32 + 0.5, y as f32 + 0.5);
+        let inside = discs
+            .iter()
+            .chain(&more)
+            .any(|(cx, cy, r)| (x - cx).hypot(y - cy) <= *r);
+        image::Rgba([255, 255, 255, if inside { 255 } else { 0 }])
+    });
+    let mut png = Vec::new();
+    image
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .expect("a PNG encodes in memory");
+    png
+}
