@@ -70,7 +70,8 @@ export VK_ICD_FILENAMES=$icd VK_DRIVER_FILES=$icd WGPU_BACKEND=vulkan
 export BEVY_ASSET_ROOT=$PWD RUST_LOG=${RUST_LOG:-warn} RWT_PAINT_DIR=$PWD/$out/painted
 # CI's runs check behaviour on a 640 x 360 window (a quarter of the pixels lavapipe shades on
 # the CPU); the screenshots for the docs are 1280 x 720.
-if [ $docs = 0 ]; then export RWT_WINDOW=${RWT_WINDOW:-640x360}; fi
+# The docs' screenshots show the game, not the debug overlay.
+if [ $docs = 0 ]; then export RWT_WINDOW=${RWT_WINDOW:-640x360}; else export RWT_HUD=${RWT_HUD:-off}; fi
 
 failed=0
 # Runs example $ex (log $name) that checks itself: $1 (VAR=folder) names where it saves its

@@ -1,9 +1,10 @@
 //! open_world's forests: three tree species from fractal noise, and their stump, in one
-//! layer that streams to 2.6 km. Shared by open_world and the cost benchmark, which times
+//! layer that streams to 2.6 km: the asset pack's glTF trees, or the meshes made in code. Shared by open_world and the cost benchmark, which times
 //! far trees drawn both ways ([`FarTrees`]).
 
 use crate::foliage;
 use bevy::prelude::*;
+use bevy_rwt::look::asset::{AssetLods, AssetLook};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::density::{Density, NoiseDensity, NoiseParams};
 use glam::DVec2;
@@ -104,16 +105,29 @@ pub fn tree_layer(
             class
         })
         .collect();
-    // Nowhere until a tree is chopped (an edit gives its point this class); the same scale
-    // rule as the trees, so a stump is as thick as its tree was.
+    classes.push(stump(meshes, material));
+    let layer = forest_layer(classes, ground);
+    match far {
+        FarTrees::Thinned => layer.with_falloff_floor(350.0, 1400.0, 0.2),
+        FarTrees::Impostors => layer,
+    }
+}
+
+/// The stump: nowhere until a tree is chopped (an edit gives its point this class); the
+/// same scale rule as the trees, so a stump is as thick as its tree was.
+fn stump(meshes: &mut Assets<Mesh>, material: &Handle<StandardMaterial>) -> ScatterClass {
     let mut stump = ScatterClass::new(
         LayerDensity::Constant(0.0),
         meshes.add(foliage::stump()),
         material.clone(),
     );
     stump.scale_variation = 0.3;
-    classes.push(stump);
-    let layer = ScatterLayer::new(classes)
+    stump
+}
+
+/// The forests' layer of `classes` on `ground`, streamed to 2.6 km.
+fn forest_layer(classes: Vec<ScatterClass>, ground: &HeightSource) -> ScatterLayer {
+    ScatterLayer::new(classes)
         .with_seed(1)
         .with_tile_size(128.0)
         .with_streaming(StreamingConfig {
@@ -122,9 +136,44 @@ pub fn tree_layer(
             unload_distance: 2800.0,
             near_distance: 200.0,
         })
-        .with_height(ground.clone());
-    match far {
-        FarTrees::Thinned => layer.with_falloff_floor(350.0, 1400.0, 0.2),
-        FarTrees::Impostors => layer,
-    }
+        .with_height(ground.clone())
+}
+
+/// Where the pack's trees switch from their near level to their far one (metres).
+pub const ASSET_LOD_DISTANCE: f32 = 70.0;
+
+/// The forests of the asset pack's trees on `ground` ([`crate::pack`]: spruce, oak and
+/// birch files, `looks` made from them), drawn instanced with their own levels of detail,
+/// impostors from [`IMPOSTOR_DISTANCE`] and promoted within `promotion` metres of a viewer
+/// (where the file's trunk hull becomes their collider).
+pub fn asset_tree_layer(
+    ground: &HeightSource,
+    looks: [AssetLook; 3],
+    meshes: &mut Assets<Mesh>,
+    material: &Handle<StandardMaterial>,
+    promotion: f32,
+) -> ScatterLayer {
+    let densities = FORESTS.map(|(seed, base)| LayerDensity::Noise(forest(seed, base)));
+    let mut classes: Vec<ScatterClass> = looks
+        .into_iter()
+        .zip(densities)
+        .map(|(look, density)| {
+            let look = AssetLook {
+                wind_response: 0.015,
+                color_variation: 0.12,
+                lods: AssetLods {
+                    distances: vec![ASSET_LOD_DISTANCE],
+                    ..default()
+                },
+                ..look
+            };
+            let mut class = ScatterClass::asset(density, look)
+                .with_impostor(Impostor::at(IMPOSTOR_DISTANCE))
+                .with_promotion(promotion, |_| {});
+            class.scale_variation = 0.3;
+            class
+        })
+        .collect();
+    classes.push(stump(meshes, material));
+    forest_layer(classes, ground)
 }

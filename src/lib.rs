@@ -18,6 +18,7 @@ pub mod frame_clock;
 pub mod generated;
 pub mod grass_field;
 pub mod hud;
+pub mod pack;
 pub mod smoke;
 pub mod terrain;
 pub mod tuft;

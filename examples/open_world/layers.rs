@@ -1,15 +1,19 @@
 //! The vegetation: every plant and rock is placed by a `bevy_rwt` layer (none by hand).
+//! Trees, bushes, ferns and rocks are the asset pack's glTF files ([`rwt_examples::pack`]),
+//! drawn instanced as asset classes; grass and flowers are rwt's own instanced looks.
 
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::layers::file::NamedAssets;
+use bevy_rwt::look::asset::AssetLook;
 use bevy_rwt::look::{blade_mesh, far_blade_mesh};
 use bevy_rwt::prelude::*;
 use glam::DVec2;
 use noise::{NoiseFn, Perlin};
 use rwt_core::density::{Density, NoiseDensity, NoiseParams};
 use rwt_examples::foliage;
-use rwt_examples::forest::{FarTrees, ForestCover, tree_layer};
+use rwt_examples::forest::{ForestCover, asset_tree_layer};
+use rwt_examples::pack::Pack;
 use rwt_examples::terrain::{Terrain, WATER};
 use std::sync::Arc;
 
@@ -31,10 +35,17 @@ const FLOWERS: [(&str, Color); 3] = [
     ("blue flowers", Color::srgb(0.3, 0.35, 0.9)),
 ];
 
+/// Within this distance of a viewer (the camera, the walker) trees and rocks are entities
+/// with the file's collider (metres).
+const PROMOTION: f32 = 14.0;
+
 /// Spawns the layers and aims the brush at the flower and bush maps.
+#[allow(clippy::too_many_arguments)]
 pub fn setup_layers(
     mut commands: Commands,
     terrain: Res<Terrain>,
+    pack: Res<PackFiles>,
+    server: Res<AssetServer>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut images: ResMut<Assets<Image>>,
@@ -50,14 +61,21 @@ pub fn setup_layers(
     let ground = terrain.source();
     names.insert_height("terrain", &ground);
     names.insert_material("white", white.clone());
-    let trees = tree_layer(&ground, &mut meshes, &white, FarTrees::Impostors)
-        .with_height_range(WATER + 1.5, 112.0)
-        .with_max_slope(0.6);
+    let look = |path: &str| AssetLook::new(server.load(path.to_string()));
+    let trees = asset_tree_layer(
+        &ground,
+        pack.0.trees.map(look),
+        &mut meshes,
+        &white,
+        PROMOTION,
+    )
+    .with_height_range(WATER + 1.5, 112.0)
+    .with_max_slope(0.6);
     commands.spawn((Name::new("trees"), trees));
-    let rocks = rocks(&ground, &mut meshes, &white);
+    let rocks = rocks(&ground, look(pack.0.rock));
     commands.spawn((Name::new("rocks"), rocks));
     commands.spawn((Name::new("grass"), grass(&ground, &mut meshes)));
-    let ferns = ferns(&ground, &mut meshes, &mut images);
+    let ferns = ferns(&ground, look(pack.0.fern));
     commands.spawn((Name::new("ferns"), ferns));
     let (flowers, flower_targets) = flowers(&ground, &mut meshes, &names, &mut images);
     let flowers = commands.spawn((Name::new("flowers"), flowers)).id();
@@ -65,7 +83,7 @@ pub fn setup_layers(
     let bushes = commands
         .spawn((
             Name::new("bushes"),
-            bushes(&ground, bush_density, &mut meshes, &names, &white),
+            bushes(&ground, bush_density, look(pack.0.bush)),
         ))
         .id();
     brush.targets = flower_targets
@@ -76,6 +94,10 @@ pub fn setup_layers(
         .collect();
     brush.save_dir = std::env::var_os("RWT_PAINT_DIR").map_or("painted".into(), Into::into);
 }
+
+/// The asset pack's files (written before the app starts).
+#[derive(Resource)]
+pub struct PackFiles(pub &'static Pack);
 
 /// A map over the world's painted square, filled with soft patches of noise (`seed`,
 /// patches about `feature` metres across) so that the world starts with meadows; the density
@@ -124,12 +146,9 @@ impl Density for FernDensity {
     }
 }
 
-/// Boulders, more of them on slopes' noise-chosen patches.
-fn rocks(
-    ground: &HeightSource,
-    meshes: &mut Assets<Mesh>,
-    material: &Handle<StandardMaterial>,
-) -> ScatterLayer {
+/// Boulders, more of them on slopes' noise-chosen patches; promoted near a viewer, where
+/// the rock's hull becomes its collider.
+fn rocks(ground: &HeightSource, rock: AssetLook) -> ScatterLayer {
     let density = LayerDensity::Noise(NoiseDensity::new(NoiseParams {
         seed: 21,
         frequency: 1.0 / 300.0,
@@ -138,7 +157,11 @@ fn rocks(
         amplitude: 1.5,
         scale: 0.004,
     }));
-    let mut class = ScatterClass::new(density, meshes.add(foliage::rock()), material.clone());
+    let look = AssetLook {
+        color_variation: 0.15,
+        ..rock
+    };
+    let mut class = ScatterClass::asset(density, look).with_promotion(PROMOTION, |_| {});
     class.scale = 1.1;
     class.scale_variation = 0.6;
     ScatterLayer::new(vec![class])
@@ -156,16 +179,13 @@ fn rocks(
 }
 
 /// Bushes from a painted map (up to 0.05 per square metre).
-fn bushes(
-    ground: &HeightSource,
-    density: LayerDensity,
-    meshes: &mut Assets<Mesh>,
-    names: &NamedAssets,
-    material: &Handle<StandardMaterial>,
-) -> ScatterLayer {
-    let mesh = meshes.add(foliage::bush());
-    names.insert_mesh("bush", mesh.clone());
-    let mut class = ScatterClass::new(density, mesh, material.clone());
+fn bushes(ground: &HeightSource, density: LayerDensity, bush: AssetLook) -> ScatterLayer {
+    let look = AssetLook {
+        wind_response: 0.05,
+        color_variation: 0.15,
+        ..bush
+    };
+    let mut class = ScatterClass::asset(density, look);
     class.scale_variation = 0.4;
     ScatterLayer::new(vec![class])
         .with_seed(2)
@@ -225,24 +245,18 @@ fn grass(ground: &HeightSource, meshes: &mut Assets<Mesh>) -> ScatterLayer {
         .with_height_range(WATER + 0.3, 105.0)
 }
 
-/// Ferns on the forest floor: textured fronds, cut out by the texture's alpha, instanced.
-fn ferns(
-    ground: &HeightSource,
-    meshes: &mut Assets<Mesh>,
-    images: &mut Assets<Image>,
-) -> ScatterLayer {
-    let mut class = ScatterClass::instanced(
+/// Ferns on the forest floor: the pack's fern, its fronds cut out by their texture's
+/// alpha, instanced.
+fn ferns(ground: &HeightSource, fern: AssetLook) -> ScatterLayer {
+    let look = AssetLook {
+        wind_response: 0.35,
+        color_variation: 0.15,
+        shadows: InstancedShadows::Within(GRASS_SHADOWS),
+        ..fern
+    };
+    let mut class = ScatterClass::asset(
         LayerDensity::Custom(Arc::new(FernDensity(ForestCover::new()))),
-        meshes.add(foliage::fern(7, 1.6)),
-        InstancedShading {
-            base_color: Color::srgb(0.07, 0.17, 0.04),
-            tip_color: Color::srgb(0.3, 0.5, 0.12),
-            tip_from: 0.2,
-            wind_response: 0.35,
-            texture: Some(images.add(foliage::fern_texture())),
-            shadows: InstancedShadows::Within(GRASS_SHADOWS),
-            ..default()
-        },
+        look,
     );
     class.scale_variation = 0.3;
     ScatterLayer::new(vec![class])

@@ -1,9 +1,10 @@
 //! A game scene streamed by `bevy_rwt`: an unbounded hilly world (walk 10 km in any
 //! direction: nothing is precomputed) with dense wind-blown grass and painted flower
 //! meadows drawn from per-chunk instance buffers, ferns with textured fronds on the forest
-//! floor, bushes, rocks and three tree species as entities (near and far meshes
-//! crossfading), forests at full density to the horizon (impostors from 350 m), and a
-//! density brush that paints the flower and bush maps live.
+//! floor, bushes, rocks and three tree species from glTF files the example writes (bark and
+//! leaf-card trees with two levels of detail, normal-mapped rocks), drawn instanced,
+//! forests at full density to the horizon (impostors from 350 m), and a density brush that
+//! paints the flower and bush maps live.
 //!
 //! `cargo run --release --example open_world`
 //! - WASD / arrows fly, Q / E down and up, Shift boosts, hold the right mouse button to
@@ -15,7 +16,8 @@
 //!   temporal anti-aliasing with ambient occlusion (on; off gives 4x MSAA instead);
 //! - with the brush off, a left click chops the tree under the cursor (a stump stays), H
 //!   places a cabin that clears the ground under it; F5 saves these edits with the maps;
-//! - K walks on foot (a capsule that trunks, stumps and rocks stop; avian3d), K again flies.
+//! - K walks on foot (a capsule that trunks, stumps and rocks stop; avian3d), K again flies;
+//! - F1 hides the overlay (`RWT_HUD=off` starts without it).
 //!
 //! The camera culls what hills, trees and bushes hide (`OcclusionCulling`; `RWT_OCCLUSION=0`
 //! draws it all); `RWT_COST=1` times the scripted view's frame culled so, drawn whole, and
@@ -48,7 +50,9 @@ fn main() {
         // The render world's time is its own only when the worlds run one after the other.
         window = window.disable::<PipelinedRenderingPlugin>();
     }
+    let pack = rwt_examples::pack::write_pack();
     App::new()
+        .insert_resource(layers::PackFiles(pack))
         .insert_resource(ClearColor(SKY))
         .insert_resource(Terrain::new(2006))
         .add_plugins((

@@ -8,7 +8,7 @@
 //! `rwt-smoke: walked into a trunk: closest D m from its axis, collision at R m`.
 
 use crate::gameplay::{Cabins, spawn_cabin, tree_layer, trees_only};
-use crate::walk::{RADIUS as WALKER_RADIUS, TRUNK_RADIUS, Walker, spawn_walker};
+use crate::walk::{RADIUS as WALKER_RADIUS, Walker, spawn_walker};
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
@@ -254,7 +254,8 @@ fn start_walk(world: &Stage, commands: &mut Commands) -> Option<Walk> {
         intent: (axis - from).normalize() * 4.0,
         scripted: true,
     });
-    let contact = TRUNK_RADIUS * tree.transform.scale.x + WALKER_RADIUS;
+    let hull = rwt_examples::pack::trees::hull_radius(tree.class as usize);
+    let contact = hull * tree.transform.scale.x + WALKER_RADIUS;
     Some(Walk {
         walker,
         axis,

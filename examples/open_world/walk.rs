@@ -1,20 +1,20 @@
 //! Walking on foot (K toggles): a capsule on the terrain that avian's move-and-slide keeps
 //! out of tree trunks, stumps and rocks, and that grass parts around (a `Bender`); the camera rides at eye height and looks with the
-//! mouse as the fly camera does. Trunks and rocks get static colliders as `bevy_rwt`
-//! spawns them (an observer on `ScatterEntity`): the plugin knows nothing of physics.
+//! mouse as the fly camera does. Trees and rocks near a viewer (the camera, the walker) are
+//! promoted to entities with their file's `AssetCollider`, which an observer turns into
+//! avian's static collider; stumps get theirs by class: the plugin knows nothing of physics.
 
 use avian3d::prelude::*;
 use bevy::prelude::*;
 use bevy::transform::TransformSystems;
+use bevy_rwt::look::asset::AssetCollider;
 use bevy_rwt::prelude::*;
-use rwt_examples::forest::{STUMP, TREE_SPECIES};
+use rwt_examples::forest::STUMP;
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::{Terrain, WATER};
 
 /// Capsule radius and the length of its straight part.
 pub const RADIUS: f32 = 0.35;
-/// Radius of a trunk's collider at scale 1.
-pub const TRUNK_RADIUS: f32 = 0.32;
 const LENGTH: f32 = 1.0;
 /// Eye height above the ground.
 const EYE: f32 = 1.65;
@@ -26,6 +26,7 @@ impl Plugin for WalkPlugin {
     fn build(&self, app: &mut App) {
         app.add_plugins(PhysicsPlugins::default())
             .add_observer(add_colliders)
+            .add_observer(add_asset_colliders)
             .add_systems(Update, toggle_walk)
             .add_systems(
                 PostUpdate,
@@ -43,13 +44,47 @@ pub struct Walker {
     pub scripted: bool,
 }
 
-/// The collider of a trunk, stump or rock at scale 1 (`None` for what one walks through).
+/// The collider of a stump at scale 1 (`None` for what one walks through: trees and rocks
+/// get theirs from their files, [`add_asset_colliders`]).
 fn collider_of(layer: &str, class: u16) -> Option<Collider> {
-    match layer {
-        "trees" if TREE_SPECIES.contains(&class) => Some(Collider::cylinder(TRUNK_RADIUS, 10.0)),
-        "trees" if class == STUMP => Some(Collider::cylinder(0.36, 1.4)),
-        "rocks" => Some(Collider::sphere(0.9)),
-        _ => None,
+    (layer == "trees" && class == STUMP).then(|| Collider::cylinder(0.36, 1.4))
+}
+
+/// A promoted tree or rock's collider from its file: the convex hull of each `UCX_` mesh
+/// (a tree's trunk), or of the asset's vertices (a rock).
+fn add_asset_colliders(
+    add: On<Add, AssetCollider>,
+    shapes: Query<&AssetCollider>,
+    meshes: Res<Assets<Mesh>>,
+    mut commands: Commands,
+) {
+    let Ok(shape) = shapes.get(add.entity) else {
+        return;
+    };
+    let points = |mesh: &Handle<Mesh>| {
+        let positions = meshes.get(mesh)?.attribute(Mesh::ATTRIBUTE_POSITION)?;
+        let positions = positions.as_float3()?;
+        Some(
+            positions
+                .iter()
+                .map(|p| Vec3::from_array(*p))
+                .collect::<Vec<_>>(),
+        )
+    };
+    let collider = match shape {
+        AssetCollider::Hull(points) => Collider::convex_hull(points.clone()),
+        AssetCollider::Meshes(pieces) => Some(Collider::compound(
+            pieces
+                .iter()
+                .filter_map(|piece| Collider::convex_hull(points(piece)?))
+                .map(|hull| (Vec3::ZERO, Quat::IDENTITY, hull))
+                .collect(),
+        )),
+    };
+    if let Some(collider) = collider {
+        commands
+            .entity(add.entity)
+            .insert((RigidBody::Static, collider));
     }
 }
 
@@ -112,6 +147,8 @@ pub fn spawn_walker(
             Transform::from_translation(centre),
             RigidBody::Kinematic,
             Collider::capsule(RADIUS, LENGTH),
+            // Trees and rocks near it are promoted, with their colliders.
+            RwtViewer::all_around(),
             // Grass and flowers part around the walker and stand up behind it.
             Bender {
                 radius: 0.8,
