@@ -23,7 +23,7 @@ use bevy_rwt::prelude::*;
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
 use rwt_examples::frame_check::{
     CHECK_SKY as SKY, COMPARED_MSAA, Captures, Disc, HIGH_SUN, off_sky, out_of_patience,
-    output_dir, passed, scene_per_instance, spawn_shadow_sun,
+    output_dir, passed, scene_per_instance, spawn_shadow_sun, still_check_app,
 };
 use std::sync::Arc;
 
@@ -50,15 +50,8 @@ const FILE: &str = "generated/asset_match.glb";
 
 fn main() -> AppExit {
     rwt_examples::generated::write_asset(FILE, &asset().to_bytes());
-    let mut app = App::new();
-    app.add_plugins(rwt_examples::example_plugins("rwt asset_match"))
-        .add_plugins(RwtPlugins::default())
-        .insert_resource(ClearColor(SKY))
-        .insert_resource(RwtWind {
-            strength: 0.0,
-            ..default()
-        })
-        .init_resource::<Captures>()
+    let mut app = still_check_app("rwt asset_match");
+    app.insert_resource(ClearColor(SKY))
         .init_resource::<Check>()
         .add_systems(Startup, setup)
         .add_systems(Update, run_check);

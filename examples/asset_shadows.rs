@@ -28,7 +28,7 @@ use bevy_rwt::prelude::*;
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
 use rwt_examples::frame_check::{
     CHECK_SKY as SKY, COMPARED_MSAA, Captures, Disc, out_of_patience, output_dir, passed,
-    scene_per_instance, spawn_shadow_sun,
+    scene_per_instance, spawn_shadow_sun, still_check_app,
 };
 use std::sync::Arc;
 
@@ -58,15 +58,8 @@ const GROUND: Color = Color::srgb(0.55, 0.55, 0.5);
 
 fn main() -> AppExit {
     rwt_examples::generated::write_asset(FILE, &asset().to_bytes());
-    let mut app = App::new();
-    app.add_plugins(rwt_examples::example_plugins("rwt asset_shadows"))
-        .add_plugins(RwtPlugins::default())
-        .insert_resource(ClearColor(SKY))
-        .insert_resource(RwtWind {
-            strength: 0.0,
-            ..default()
-        })
-        .init_resource::<Captures>()
+    let mut app = still_check_app("rwt asset_shadows");
+    app.insert_resource(ClearColor(SKY))
         .init_resource::<Check>()
         .add_systems(Startup, setup)
         .add_systems(Update, run_check);

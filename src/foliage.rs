@@ -308,6 +308,16 @@ pub fn fern(fronds: u32, length: f32) -> Mesh {
             indices.extend([a, a + 1, a + 3, a, a + 3, a + 2]);
         }
     }
+    uv_mesh(positions, normals, uvs, indices)
+}
+
+/// A triangle list of these positions, normals, texture coordinates and indices.
+pub fn uv_mesh(
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    uvs: Vec<[f32; 2]>,
+    indices: Vec<u32>,
+) -> Mesh {
     Mesh::new(
         PrimitiveTopology::TriangleList,
         RenderAssetUsages::default(),

@@ -83,10 +83,9 @@ pub fn pixels_differing(a: &image::RgbImage, b: &image::RgbImage, by: u8) -> usi
         .count()
 }
 
-/// The app of an example that checks culling against the frame drawn whole: Bevy's and
-/// rwt's plugins, no wind (so that two frames can match), chunks drawn whole to begin with,
-/// a [`CullingCheck`] and the [`Captures`].
-pub fn culling_check_app(title: &str) -> App {
+/// The app of an example that compares frames: Bevy's and rwt's plugins, no wind (so that
+/// two frames can match), the [`Captures`].
+pub fn still_check_app(title: &str) -> App {
     let mut app = App::new();
     app.add_plugins(crate::example_plugins(title))
         .add_plugins(RwtPlugins::default())
@@ -94,9 +93,16 @@ pub fn culling_check_app(title: &str) -> App {
             strength: 0.0,
             ..default()
         })
-        .insert_resource(InstanceCulling::PerChunk)
-        .init_resource::<CullingCheck>()
         .init_resource::<Captures>();
+    app
+}
+
+/// The app of an example that checks culling against the frame drawn whole: a
+/// [`still_check_app`] whose chunks are drawn whole to begin with, and a [`CullingCheck`].
+pub fn culling_check_app(title: &str) -> App {
+    let mut app = still_check_app(title);
+    app.insert_resource(InstanceCulling::PerChunk)
+        .init_resource::<CullingCheck>();
     app
 }
 

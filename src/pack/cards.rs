@@ -1,9 +1,7 @@
 //! Leaf cards: quads mapped to a whole cut-out texture, lit by normals that face out of
-//! the plant (so that a crown of cards shades as one volume), and the mesh helpers the
-//! pack shares.
+//! the plant (so that a crown of cards shades as one volume), both faces of each drawn.
 
-use bevy::asset::RenderAssetUsages;
-use bevy::mesh::{Indices, PrimitiveTopology};
+use crate::foliage::uv_mesh;
 use bevy::prelude::*;
 
 /// One card: its centre, its half-size axes (the texture's top along `up`), and the normal
@@ -37,23 +35,6 @@ impl Hash {
     }
 }
 
-/// A triangle list of these attributes.
-pub fn mesh(
-    positions: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-    uvs: Vec<[f32; 2]>,
-    indices: Vec<u32>,
-) -> Mesh {
-    Mesh::new(
-        PrimitiveTopology::TriangleList,
-        RenderAssetUsages::default(),
-    )
-    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
-    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, normals)
-    .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, uvs)
-    .with_inserted_indices(Indices::U32(indices))
-}
-
 /// The cards as one mesh.
 pub fn cards_mesh(cards: &[Card]) -> Mesh {
     let (mut positions, mut normals, mut uvs, mut indices) = (vec![], vec![], vec![], vec![]);
@@ -65,7 +46,10 @@ pub fn cards_mesh(cards: &[Card]) -> Mesh {
             normals.push(card.normal.to_array());
             uvs.push([u, v]);
         }
+        // Both faces, each lit by the outward normal: a double-sided material would turn
+        // the back's normal round, into the crown, and shade it as if in the dark.
         indices.extend([first, first + 3, first + 2, first, first + 2, first + 1]);
+        indices.extend([first, first + 2, first + 3, first, first + 1, first + 2]);
     }
-    mesh(positions, normals, uvs, indices)
+    uv_mesh(positions, normals, uvs, indices)
 }

@@ -45,3 +45,83 @@ pub fn write_pack() -> &'static Pack {
     write_asset(PACK.rock, &plants::rock().to_bytes());
     &PACK
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bevy_rwt::testing::glb::{Glb, GlbAlpha};
+
+    /// The vertices of the mesh of the node named `name`.
+    fn vertices(file: &Glb, name: &str) -> usize {
+        let node = file.nodes.iter().find(|n| n.name == name).expect(name);
+        let mesh = node.mesh.expect("a mesh");
+        file.meshes[mesh].iter().map(|p| p.positions.len()).sum()
+    }
+
+    #[test]
+    fn trees_have_two_levels_that_thin_and_a_hull_round_the_trunk() {
+        for (i, spec) in [trees::spruce(), trees::oak(), trees::birch()]
+            .iter()
+            .enumerate()
+        {
+            let file = trees::tree(spec);
+            let name = spec.name;
+            let (near, far) = (
+                vertices(&file, &format!("{name}_LOD0")),
+                vertices(&file, &format!("{name}_LOD1")),
+            );
+            assert!(far * 3 < near, "{name}: {near} then {far} vertices");
+            let hull = file
+                .nodes
+                .iter()
+                .find(|n| n.name == format!("UCX_{name}"))
+                .and_then(|n| n.mesh)
+                .expect("a hull");
+            let widest = file.meshes[hull][0]
+                .positions
+                .iter()
+                .map(|p| glam::Vec2::new(p[0], p[2]).length())
+                .fold(0.0f32, f32::max);
+            assert!(
+                (widest - trees::hull_radius(i)).abs() < 1e-4,
+                "{name}: {widest}"
+            );
+            // Bark with a normal map, leaves cut out.
+            assert!(file.materials[0].normal_texture.is_some());
+            assert_eq!(file.materials[1].alpha, GlbAlpha::Mask(0.5));
+        }
+    }
+
+    #[test]
+    fn normal_maps_hold_unit_normals_facing_out_of_the_surface() {
+        for maps in [textures::bark(1, [0.5; 3], [0.1; 3]), textures::rock(2)] {
+            let image = image::load_from_memory(&maps.normal).unwrap().to_rgb8();
+            for p in image.pixels().step_by(97) {
+                let n = glam::Vec3::from_array(p.0.map(|c| c as f32 / 255.0 * 2.0 - 1.0));
+                assert!((n.length() - 1.0).abs() < 0.02 && n.z > 0.2, "{n}");
+            }
+            let albedo = image::load_from_memory(&maps.albedo).unwrap().to_rgb8();
+            assert_eq!(albedo.dimensions(), image.dimensions());
+        }
+    }
+
+    #[test]
+    fn leaf_clusters_are_cut_out_cards() {
+        let png = textures::leaf_cluster(textures::Leaves {
+            count: 12,
+            size: (0.3, 0.12),
+            colours: ([0.3, 0.5, 0.1], [0.2, 0.3, 0.1]),
+            seed: 1,
+        });
+        let image = image::load_from_memory(&png).unwrap().to_rgba8();
+        let opaque = image.pixels().filter(|p| p.0[3] == 255).count();
+        let clear = image.pixels().filter(|p| p.0[3] == 0).count();
+        let total = image.pixels().count();
+        // Only fully opaque or fully clear texels: a mask, with room between the leaves.
+        assert_eq!(opaque + clear, total);
+        assert!(
+            opaque > total / 5 && clear > total / 4,
+            "{opaque} of {total}"
+        );
+    }
+}

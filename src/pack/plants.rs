@@ -7,13 +7,12 @@ use bevy::prelude::*;
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
 use noise::{NoiseFn, Perlin};
 
-/// A cut-out, double-sided leaf material of `texture`.
+/// A cut-out leaf material of `texture` (cards carry both faces).
 fn leaf_material(file: &mut Glb, texture: Vec<u8>) -> usize {
     let image = file.add_image(texture);
     file.add_material(GlbMaterial {
         base_color_texture: Some(image),
         alpha: GlbAlpha::Mask(0.5),
-        double_sided: true,
         roughness: 0.8,
         ..GlbMaterial::colored([1.0, 1.0, 1.0, 1.0])
     })
@@ -27,7 +26,7 @@ fn levels(file: &mut Glb, name: &str, meshes: Vec<(Mesh, usize)>) {
         .map(|(i, (mesh, material))| {
             let primitive = GlbPrimitive::from_mesh(&mesh, material).unwrap();
             let mesh = file.add_mesh(vec![primitive]);
-            file.add_node(GlbNode::named(&format!("{name}_LOD{i}")).with_mesh(mesh))
+            file.add_node(GlbNode::named(format!("{name}_LOD{i}")).with_mesh(mesh))
         })
         .collect();
     let root = file.add_node(GlbNode::named(name).with_children(nodes));
@@ -42,7 +41,7 @@ pub fn bush() -> Glb {
         leaf_cluster(Leaves {
             count: 12,
             size: (0.3, 0.12),
-            colours: ([0.24, 0.4, 0.1], [0.13, 0.26, 0.06]),
+            colours: ([0.34, 0.52, 0.15], [0.22, 0.38, 0.1]),
             seed: 21,
         }),
     );

@@ -188,7 +188,7 @@ pub fn trunk(radius: f32, height: f32, sides: u32) -> Mesh {
             indices.extend([a, b, a + 1, a + 1, b, b + 1]);
         }
     }
-    super::cards::mesh(positions, normals, uvs, indices)
+    crate::foliage::uv_mesh(positions, normals, uvs, indices)
 }
 
 /// The glTF file of `tree`.
@@ -206,7 +206,6 @@ pub fn tree(tree: &TreeSpec) -> Glb {
     let leaves = file.add_material(GlbMaterial {
         base_color_texture: Some(leaf_image),
         alpha: GlbAlpha::Mask(0.5),
-        double_sided: true,
         roughness: 0.8,
         ..GlbMaterial::colored(tree.leaf_tint)
     });
@@ -236,9 +235,9 @@ pub fn tree(tree: &TreeSpec) -> Glb {
         .build()
         .translated_by(Vec3::Y * top * 0.4);
     let hull = file.add_mesh(vec![primitive(hull, bark)]);
-    let lod0 = file.add_node(GlbNode::named(&format!("{}_LOD0", tree.name)).with_mesh(near));
-    let lod1 = file.add_node(GlbNode::named(&format!("{}_LOD1", tree.name)).with_mesh(far));
-    let ucx = file.add_node(GlbNode::named(&format!("UCX_{}", tree.name)).with_mesh(hull));
+    let lod0 = file.add_node(GlbNode::named(format!("{}_LOD0", tree.name)).with_mesh(near));
+    let lod1 = file.add_node(GlbNode::named(format!("{}_LOD1", tree.name)).with_mesh(far));
+    let ucx = file.add_node(GlbNode::named(format!("UCX_{}", tree.name)).with_mesh(hull));
     let root = file.add_node(GlbNode::named(tree.name).with_children([lod0, lod1, ucx]));
     file.add_root(root);
     file
