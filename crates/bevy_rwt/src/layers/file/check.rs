@@ -65,13 +65,7 @@ impl LayerDescription {
                 Clumps::new(*params).map_err(InvalidLayer::Clumps)?;
             }
         }
-        for (i, c) in d.classes.iter().enumerate() {
-            let drawn = c.mesh.is_some() && c.material.is_some();
-            let asset_only = c.mesh.is_none() && c.material.is_none() && c.lod.is_none();
-            if c.asset.as_ref().map_or(!drawn, |_| !asset_only) {
-                return Err(InvalidLayer::ClassLook { class: i });
-            }
-        }
+        d.check_looks()?;
         for (i, c, lod) in d
             .classes
             .iter()
@@ -90,5 +84,17 @@ impl LayerDescription {
             }
         }
         numbers::check(d)
+    }
+
+    /// Whether each class has a mesh and a material, or an asset alone.
+    fn check_looks(&self) -> Result<(), InvalidLayer> {
+        for (i, c) in self.classes.iter().enumerate() {
+            let drawn = c.mesh.is_some() && c.material.is_some();
+            let asset_only = c.mesh.is_none() && c.material.is_none() && c.lod.is_none();
+            if c.asset.as_ref().map_or(!drawn, |_| !asset_only) {
+                return Err(InvalidLayer::ClassLook { class: i });
+            }
+        }
+        Ok(())
     }
 }
