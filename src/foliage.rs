@@ -1,5 +1,6 @@
-//! The showcase's own meshes, generated in code: three tree species (each with a cheap far
-//! mesh), bushes, rocks and a flower for instanced classes. Low-poly and faceted (flat
+//! Meshes generated in code: three tree species (each with a cheap far mesh) for the
+//! benchmarks and checks that draw trees as entities, a stump, a cabin, and a flower for
+//! instanced classes. Low-poly and faceted (flat
 //! normals), coloured per vertex, so that one white material per species is enough. The
 //! fern is a ring of textured fronds instead: cards whose texture's alpha cuts out the
 //! leaflets.
@@ -126,32 +127,6 @@ pub fn birch() -> TreeMeshes {
     }
 }
 
-/// A bush: a few leafy lumps huddled on the ground.
-pub fn bush() -> Mesh {
-    let leaves = Color::srgb(0.13, 0.26, 0.07);
-    let lumps = [
-        (Vec3::new(0.0, 0.55, 0.0), 0.75),
-        (Vec3::new(0.55, 0.4, 0.25), 0.55),
-        (Vec3::new(-0.5, 0.38, -0.2), 0.6),
-        (Vec3::new(0.1, 0.35, -0.55), 0.5),
-        (Vec3::new(-0.2, 0.85, 0.25), 0.45),
-    ];
-    let parts = lumps
-        .into_iter()
-        .enumerate()
-        .map(|(i, (at, r))| {
-            let lump = Sphere::new(r).mesh().ico(1).expect("small ico sphere");
-            shaded(
-                lumpy(lump, 90 + i as u32, 0.3, 1.6).translated_by(at),
-                leaves,
-                0.35,
-                95 + i as u32,
-            )
-        })
-        .collect();
-    faceted(merged(parts))
-}
-
 /// What a chopped tree leaves: a short stump with a pale cut face.
 pub fn stump() -> Mesh {
     let bark = Color::srgb(0.24, 0.17, 0.1);
@@ -219,15 +194,6 @@ fn prism(size: Vec3) -> Mesh {
     .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0, 1.0, 0.0]; 6])
     .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, vec![[0.0, 0.0]; 6])
     .with_inserted_indices(Indices::U32(indices))
-}
-
-/// A boulder, half sunk into the ground.
-pub fn rock() -> Mesh {
-    let stone = Sphere::new(1.0).mesh().ico(2).expect("small ico sphere");
-    let stone = lumpy(stone, 120, 0.35, 0.8)
-        .scaled_by(Vec3::new(1.3, 0.75, 1.0))
-        .translated_by(Vec3::Y * 0.15);
-    faceted(shaded(stone, Color::srgb(0.36, 0.34, 0.31), 0.3, 121))
 }
 
 /// A flower for an instanced class: a thin stem under a flat star of six petals. With
@@ -491,12 +457,7 @@ mod tests {
     #[test]
     fn the_meshes_stand_on_their_origin_and_have_what_the_renderer_needs() {
         let trees = [conifer(), broadleaf(), birch()];
-        let mut all: Vec<(Mesh, f32)> = vec![
-            (bush(), 0.8),
-            (rock(), 0.0),
-            (flower(0.4), 0.4),
-            (fern(7, 1.6), 0.8),
-        ];
+        let mut all: Vec<(Mesh, f32)> = vec![(flower(0.4), 0.4), (fern(7, 1.6), 0.8)];
         for t in trees {
             let (far, near) = (t.far.count_vertices(), t.near.count_vertices());
             assert!(far * 2 < near, "a cheaper far mesh: {far} vs {near}");

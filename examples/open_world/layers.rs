@@ -13,7 +13,7 @@ use noise::{NoiseFn, Perlin};
 use rwt_core::density::{Density, NoiseDensity, NoiseParams};
 use rwt_examples::foliage;
 use rwt_examples::forest::{ForestCover, asset_tree_layer};
-use rwt_examples::pack::Pack;
+use rwt_examples::pack::PACK;
 use rwt_examples::terrain::{Terrain, WATER};
 use std::sync::Arc;
 
@@ -44,7 +44,6 @@ const PROMOTION: f32 = 14.0;
 pub fn setup_layers(
     mut commands: Commands,
     terrain: Res<Terrain>,
-    pack: Res<PackFiles>,
     server: Res<AssetServer>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
@@ -64,7 +63,7 @@ pub fn setup_layers(
     let look = |path: &str| AssetLook::new(server.load(path.to_string()));
     let trees = asset_tree_layer(
         &ground,
-        pack.0.trees.map(look),
+        PACK.trees.map(look),
         &mut meshes,
         &white,
         PROMOTION,
@@ -72,10 +71,10 @@ pub fn setup_layers(
     .with_height_range(WATER + 1.5, 112.0)
     .with_max_slope(0.6);
     commands.spawn((Name::new("trees"), trees));
-    let rocks = rocks(&ground, look(pack.0.rock));
+    let rocks = rocks(&ground, look(PACK.rock));
     commands.spawn((Name::new("rocks"), rocks));
     commands.spawn((Name::new("grass"), grass(&ground, &mut meshes)));
-    let ferns = ferns(&ground, look(pack.0.fern));
+    let ferns = ferns(&ground, look(PACK.fern));
     commands.spawn((Name::new("ferns"), ferns));
     let (flowers, flower_targets) = flowers(&ground, &mut meshes, &names, &mut images);
     let flowers = commands.spawn((Name::new("flowers"), flowers)).id();
@@ -83,7 +82,7 @@ pub fn setup_layers(
     let bushes = commands
         .spawn((
             Name::new("bushes"),
-            bushes(&ground, bush_density, look(pack.0.bush)),
+            bushes(&ground, bush_density, look(PACK.bush)),
         ))
         .id();
     brush.targets = flower_targets
@@ -94,10 +93,6 @@ pub fn setup_layers(
         .collect();
     brush.save_dir = std::env::var_os("RWT_PAINT_DIR").map_or("painted".into(), Into::into);
 }
-
-/// The asset pack's files (written before the app starts).
-#[derive(Resource)]
-pub struct PackFiles(pub &'static Pack);
 
 /// A map over the world's painted square, filled with soft patches of noise (`seed`,
 /// patches about `feature` metres across) so that the world starts with meadows; the density

@@ -50,9 +50,8 @@ fn main() {
         // The render world's time is its own only when the worlds run one after the other.
         window = window.disable::<PipelinedRenderingPlugin>();
     }
-    let pack = rwt_examples::pack::write_pack();
+    rwt_examples::pack::write_pack();
     App::new()
-        .insert_resource(layers::PackFiles(pack))
         .insert_resource(ClearColor(SKY))
         .insert_resource(Terrain::new(2006))
         .add_plugins((

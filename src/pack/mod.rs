@@ -34,8 +34,9 @@ pub const PACK: Pack = Pack {
     rock: "generated/pack/rock.glb",
 };
 
-/// Writes the pack where the asset server reads it (each file only when it changed).
-pub fn write_pack() -> &'static Pack {
+/// Writes the pack where the asset server reads it, at [`PACK`]'s paths (each file only
+/// when it changed).
+pub fn write_pack() {
     let species = [trees::spruce(), trees::oak(), trees::birch()];
     for (tree, path) in species.iter().zip(PACK.trees) {
         write_asset(path, &trees::tree(tree).to_bytes());
@@ -43,7 +44,6 @@ pub fn write_pack() -> &'static Pack {
     write_asset(PACK.bush, &plants::bush().to_bytes());
     write_asset(PACK.fern, &plants::fern().to_bytes());
     write_asset(PACK.rock, &plants::rock().to_bytes());
-    &PACK
 }
 
 #[cfg(test)]

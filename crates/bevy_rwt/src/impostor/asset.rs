@@ -2,8 +2,8 @@
 //! together, each with its own material, into one atlas.
 
 use super::{
-    Baking, ImpostorAtlas, ImpostorAtlases, ImpostorKey, LookKey, OwnedPart, OwnedSource,
-    bake::BakeColor, loaded_texture, start_bake,
+    ImpostorAtlas, ImpostorAtlases, ImpostorKey, LookKey, OwnedPart, OwnedSource, bake::BakeColor,
+    loaded_texture,
 };
 use crate::look::Impostor;
 use crate::look::asset::{AssetLook, AssetPart, ResolvedAsset, SurfaceAlpha};
@@ -19,10 +19,7 @@ impl ImpostorAtlases {
         asset: &ResolvedAsset,
         impostor: &Impostor,
     ) -> Option<&ImpostorAtlas> {
-        match self.atlases.get(&asset_key(look, asset, impostor)?)? {
-            Baking::Ready(atlas) => Some(atlas),
-            _ => None,
-        }
+        self.ready(&asset_key(look, asset, impostor)?)
     }
 
     /// Starts baking the impostor of an asset class drawn from `asset`, unless it is baked
@@ -46,9 +43,7 @@ impl ImpostorAtlases {
         let Some(source) = source_of(last, meshes, images) else {
             return;
         };
-        let roughness = source.roughness;
-        let task = start_bake(source, *impostor);
-        self.atlases.insert(key, Baking::Running(task, roughness));
+        self.start(key, source, *impostor);
     }
 
     /// Forgets the atlases of the assets of a file (it changed: they are baked again).

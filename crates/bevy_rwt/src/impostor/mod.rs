@@ -117,10 +117,22 @@ pub struct ImpostorAtlases {
 impl ImpostorAtlases {
     /// The atlas of `class`, once baked.
     pub fn of(&self, class: &ScatterClass) -> Option<&ImpostorAtlas> {
-        match self.atlases.get(&key_of(class)?)? {
+        self.ready(&key_of(class)?)
+    }
+
+    /// The atlas baked from `key`, once ready.
+    fn ready(&self, key: &ImpostorKey) -> Option<&ImpostorAtlas> {
+        match self.atlases.get(key)? {
             Baking::Ready(atlas) => Some(atlas),
             _ => None,
         }
+    }
+
+    /// Starts baking `source` with `impostor`'s views as the atlas of `key`.
+    fn start(&mut self, key: ImpostorKey, source: OwnedSource, impostor: Impostor) {
+        let roughness = source.roughness;
+        let task = start_bake(source, impostor);
+        self.atlases.insert(key, Baking::Running(task, roughness));
     }
 
     /// How many atlases became ready so far.
@@ -192,11 +204,7 @@ pub(crate) fn bake_impostors(
         let Some(source) = OwnedSource::of(mesh, &look, &materials, &images) else {
             continue;
         };
-        let roughness = source.roughness;
-        let task = start_bake(source, *impostor);
-        atlases
-            .atlases
-            .insert(key, Baking::Running(task, roughness));
+        atlases.start(key, source, *impostor);
     }
     let mut ready = 0;
     for (key, baking) in atlases.atlases.iter_mut() {
