@@ -5,8 +5,9 @@ use super::{
 };
 use bevy::prelude::*;
 
-/// Where [`LayerDescription::to_layer`] gets the handles of what a file names by path or
-/// describes: in an asset loader, loads and labelled sub-assets of the layer file.
+/// Where [`LayerDescription::to_layer`](super::LayerDescription::to_layer) gets the handles
+/// of what a file names by path or describes: in an asset loader, loads and labelled
+/// sub-assets of the layer file.
 pub trait LayerHandles {
     /// A mesh's handle: a loaded path, or a primitive made.
     fn mesh(&mut self, mesh: &MeshDescription) -> Handle<Mesh>;
