@@ -160,10 +160,13 @@ pub fn report(
     }
     let mut n = 0usize;
     for (chunk, at) in &chunks {
+        // Sunk instances stand upright here (the trees): their foot is above their root.
+        let layer = layers.get(chunk.layer).ok();
+        let sink = layer.map_or(0.0, |l| l.classes[chunk.class as usize].stance.sink);
         for i in &chunk.buffer.instances {
             n += 1;
             if n.is_multiple_of(100) {
-                let foot = at.translation() + Vec3::from_array(i.offset);
+                let foot = at.translation() + Vec3::from_array(i.offset) + Vec3::Y * sink;
                 tally.judge(&triangles, foot, limit(chunk.layer));
             }
         }

@@ -1,8 +1,9 @@
 //! Scatter onto a glTF level: an island with a cliff, a bridge, rocks and a house, loaded
 //! from a `.glb` that this example writes itself (`assets/levels/island.glb`). Grass grows
 //! on the ground and on the bridge and under it, but never inside the rocks or the house,
-//! nor on the cliff; trees clear the grass around their trunks; flowers grow in clumps;
-//! moss grows on the rock tops, along their slope.
+//! nor on the cliff; spruces (the asset pack's glTF tree) clear the grass around their
+//! trunks; the pack's flowers grow in clumps; moss grows on the rock tops, along their
+//! slope.
 //!
 //! `cargo run --release --example mesh_ground`
 
@@ -11,13 +12,14 @@ mod level;
 
 use bevy::prelude::*;
 use bevy_rwt::ground::{ScatterSurface, SurfacePolicy};
+use bevy_rwt::look::asset::{AssetLook, AssetRoot};
 use bevy_rwt::look::blade_mesh;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::clumps::{ClumpKernel, ClumpParams, Clumps};
 use bevy_rwt::rwt_core::streaming::StreamingConfig;
 use bevy_rwt::{ScatterClass, ScatterLayer};
 use check::{Checked, LevelPart};
-use rwt_examples::foliage;
+use rwt_examples::pack::PACK;
 use rwt_examples::prelude::*;
 
 fn main() {
@@ -31,9 +33,11 @@ fn main() {
         .run();
 }
 
-/// Writes the level's `.glb` where the asset server reads it (only when it changed).
+/// Writes the level's `.glb` and the asset pack where the asset server reads them (each
+/// file only when it changed).
 fn write_level() {
     rwt_examples::generated::write_asset("levels/island.glb", &level::glb(&level::parts()));
+    rwt_examples::pack::write_pack();
 }
 
 /// The moss layer, whose ground the rocks are.
@@ -77,9 +81,9 @@ fn setup(
         Mesh3d(meshes.add(Plane3d::default().mesh().size(600.0, 600.0))),
         MeshMaterial3d(materials.add(Color::srgb(0.1, 0.25, 0.35))),
     ));
-    let trees = commands.spawn(trees(&mut meshes, &mut materials)).id();
+    let trees = commands.spawn(trees(&assets)).id();
     let grass = commands.spawn(grass(&mut meshes, trees)).id();
-    let flowers = commands.spawn(flowers(&mut meshes)).id();
+    let flowers = commands.spawn(flowers(&assets)).id();
     let moss = commands.spawn(moss(&mut meshes)).id();
     commands.insert_resource(Moss(moss));
     // Every mesh of the level is ground for the trees, grass and flowers, unless a part
@@ -101,13 +105,14 @@ fn streaming() -> StreamingConfig {
 }
 
 /// Spruces on gentle ground above the shore, sunk 0.3 m.
-fn trees(meshes: &mut Assets<Mesh>, materials: &mut Assets<StandardMaterial>) -> ScatterLayer {
-    let tree = ScatterClass::new(
-        LayerDensity::Constant(0.004),
-        meshes.add(foliage::conifer().near),
-        materials.add(StandardMaterial::default()),
-    )
-    .with_stance(0.0, 0.3);
+fn trees(assets: &AssetServer) -> ScatterLayer {
+    let spruce = AssetLook {
+        color_variation: 0.1,
+        wind_response: 0.03,
+        ..AssetLook::new(assets.load(PACK.trees[0]))
+    };
+    let mut tree = ScatterClass::asset(LayerDensity::Constant(0.004), spruce).with_stance(0.0, 0.3);
+    tree.scale_variation = 0.3;
     ScatterLayer::new(vec![tree])
         .with_seed(21)
         .with_tile_size(40.0)
@@ -139,28 +144,30 @@ fn grass(meshes: &mut Assets<Mesh>, trees: Entity) -> ScatterLayer {
         .with_keep_out(trees, [1.5])
 }
 
-/// Flowers in clumps of about 30, 4.4 m across.
-fn flowers(meshes: &mut Assets<Mesh>) -> ScatterLayer {
-    let clumps = Clumps::new(ClumpParams {
-        seed: 4,
-        clumps: 0.008,
-        per_clump: 30.0,
-        radius: 2.2,
-        kernel: ClumpKernel::Thomas,
-    })
-    .expect("valid clumps");
-    let flower = ScatterClass::instanced(
-        LayerDensity::Clumps(clumps),
-        meshes.add(foliage::flower(0.4)),
-        InstancedShading {
-            base_color: Color::srgb(0.1, 0.22, 0.05),
-            tip_color: Color::srgb(0.85, 0.2, 0.45),
-            tip_from: 0.86,
+/// The pack's red and yellow flowers, each in clumps of about 30, 4.4 m across.
+fn flowers(assets: &AssetServer) -> ScatterLayer {
+    let file = assets.load(PACK.flowers);
+    let classes = [(4, "red"), (5, "yellow")].map(|(seed, colour)| {
+        let clumps = Clumps::new(ClumpParams {
+            seed,
+            clumps: 0.004,
+            per_clump: 30.0,
+            radius: 2.2,
+            kernel: ClumpKernel::Thomas,
+        })
+        .expect("valid clumps");
+        let look = AssetLook {
+            wind_response: 0.2,
+            color_variation: 0.15,
             shadows: InstancedShadows::Off,
-            ..default()
-        },
-    );
-    ScatterLayer::new(vec![flower])
+            collider: false,
+            ..AssetLook::new(file.clone()).with_root(AssetRoot::Node(colour.into()))
+        };
+        let mut flower = ScatterClass::asset(LayerDensity::Clumps(clumps), look);
+        flower.scale = 0.65;
+        flower
+    });
+    ScatterLayer::new(classes.into())
         .with_seed(23)
         .with_tile_size(8.0)
         .with_streaming(streaming())

@@ -1,19 +1,18 @@
 //! The vegetation: every plant and rock is placed by a `bevy_rwt` layer (none by hand).
-//! Trees, bushes, ferns and rocks are the asset pack's glTF files ([`rwt_examples::pack`]),
-//! drawn instanced as asset classes; grass and flowers are rwt's own instanced looks.
+//! Trees, bushes, ferns, rocks and flowers are the asset pack's glTF files
+//! ([`rwt_examples::pack`]), drawn instanced as asset classes; grass is rwt's own look.
 
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::layers::file::NamedAssets;
-use bevy_rwt::look::asset::AssetLook;
+use bevy_rwt::look::asset::{AssetLods, AssetLook, AssetRoot};
 use bevy_rwt::look::{blade_mesh, far_blade_mesh};
 use bevy_rwt::prelude::*;
 use glam::DVec2;
 use noise::{NoiseFn, Perlin};
 use rwt_core::density::{Density, NoiseDensity, NoiseParams};
-use rwt_examples::foliage;
 use rwt_examples::forest::{ForestCover, asset_tree_layer};
-use rwt_examples::pack::PACK;
+use rwt_examples::pack::{PACK, flowers};
 use rwt_examples::terrain::{Terrain, WATER};
 use std::sync::Arc;
 
@@ -28,12 +27,8 @@ const GRASS_THINNING: f32 = 25.0;
 const GRASS_FAR_BLADE: f32 = 30.0;
 const MAP_SIZE: f32 = 4096.0;
 
-/// Flower colours (petals), one painted map and instanced class each.
-const FLOWERS: [(&str, Color); 3] = [
-    ("red flowers", Color::srgb(0.75, 0.08, 0.06)),
-    ("yellow flowers", Color::srgb(0.95, 0.75, 0.12)),
-    ("blue flowers", Color::srgb(0.3, 0.35, 0.9)),
-];
+/// Flowers draw their lighter level from this far from the camera (metres).
+const FLOWER_LOD: f32 = 15.0;
 
 /// Within this distance of a viewer (the camera, the walker) trees and rocks are entities
 /// with the file's collider (metres).
@@ -76,7 +71,7 @@ pub fn setup_layers(
     commands.spawn((Name::new("grass"), grass(&ground, &mut meshes)));
     let ferns = ferns(&ground, look(PACK.fern));
     commands.spawn((Name::new("ferns"), ferns));
-    let (flowers, flower_targets) = flowers(&ground, &mut meshes, &names, &mut images);
+    let (flowers, flower_targets) = flowers(&ground, server.load(PACK.flowers), &mut images);
     let flowers = commands.spawn((Name::new("flowers"), flowers)).id();
     let bush_density = painted_map(&mut images, 9, 0.05, 120.0);
     let bushes = commands
@@ -269,34 +264,31 @@ fn ferns(ground: &HeightSource, fern: AssetLook) -> ScatterLayer {
         .with_max_slope(0.7)
 }
 
-/// Flowers in three colours, each from its own painted map (up to 5 per square metre),
-/// instanced; returns the layer and its maps' names (one per class).
+/// Flowers in three colours, the pack's flower file's root nodes, each from its own
+/// painted map (up to 5 per square metre); returns the layer and its maps' names (one per
+/// class).
 fn flowers(
     ground: &HeightSource,
-    meshes: &mut Assets<Mesh>,
-    names: &NamedAssets,
+    file: Handle<Gltf>,
     images: &mut Assets<Image>,
 ) -> (ScatterLayer, Vec<String>) {
-    let mesh = meshes.add(foliage::flower(0.62));
-    names.insert_mesh("flower", mesh.clone());
-    let classes = FLOWERS
+    let classes = flowers::FLOWERS
         .iter()
         .enumerate()
-        .map(|(i, (_, petals))| {
+        .map(|(i, (name, _, _))| {
             let density = painted_map(images, 30 + i as u32, 5.0, 45.0);
-            let mut class = ScatterClass::instanced(
-                density,
-                mesh.clone(),
-                InstancedShading {
-                    base_color: Color::srgb(0.1, 0.22, 0.05),
-                    tip_color: *petals,
-                    color_variation: 0.15,
-                    wind_response: 0.2,
-                    tip_from: 0.86,
-                    shadows: InstancedShadows::Within(GRASS_SHADOWS),
+            let look = AssetLook {
+                color_variation: 0.15,
+                wind_response: 0.2,
+                shadows: InstancedShadows::Within(GRASS_SHADOWS),
+                lods: AssetLods {
+                    distances: vec![FLOWER_LOD],
                     ..default()
                 },
-            );
+                collider: false,
+                ..AssetLook::new(file.clone()).with_root(AssetRoot::Node(name.to_string()))
+            };
+            let mut class = ScatterClass::asset(density, look);
             class.scale_variation = 0.3;
             class
         })
@@ -313,5 +305,8 @@ fn flowers(
         .with_falloff(30.0, 95.0)
         .with_height(ground.clone())
         .with_height_range(WATER + 0.5, 100.0);
-    (layer, FLOWERS.iter().map(|(n, _)| n.to_string()).collect())
+    let maps = flowers::FLOWERS
+        .iter()
+        .map(|(n, _, _)| format!("{n} flowers"));
+    (layer, maps.collect())
 }

@@ -1,9 +1,11 @@
 //! The showcase's asset pack: glTF files the examples write themselves (nothing is
 //! downloaded), as a game's artist would ship them, for rwt to scatter as asset classes.
 //! Three trees (bark with a normal map, alpha-masked leaf cards, two levels of detail, a
-//! `UCX_` hull), a bush, a fern and a rock (normal-mapped, two levels).
+//! `UCX_` hull), a bush, a fern, a rock (normal-mapped, two levels) and meadow flowers
+//! (three colours in one file, a root node each).
 
 mod cards;
+pub mod flowers;
 pub mod plants;
 pub mod textures;
 pub mod trees;
@@ -20,6 +22,8 @@ pub struct Pack {
     pub fern: &'static str,
     /// A boulder.
     pub rock: &'static str,
+    /// Flowers, a root node per colour (see [`flowers::FLOWERS`]).
+    pub flowers: &'static str,
 }
 
 /// Where the pack is written.
@@ -32,6 +36,7 @@ pub const PACK: Pack = Pack {
     bush: "generated/pack/bush.glb",
     fern: "generated/pack/fern.glb",
     rock: "generated/pack/rock.glb",
+    flowers: "generated/pack/flowers.glb",
 };
 
 /// Writes the pack where the asset server reads it, at [`PACK`]'s paths (each file only
@@ -44,6 +49,7 @@ pub fn write_pack() {
     write_asset(PACK.bush, &plants::bush().to_bytes());
     write_asset(PACK.fern, &plants::fern().to_bytes());
     write_asset(PACK.rock, &plants::rock().to_bytes());
+    write_asset(PACK.flowers, &flowers::flowers().to_bytes());
 }
 
 #[cfg(test)]
@@ -102,6 +108,36 @@ mod tests {
             }
             let albedo = image::load_from_memory(&maps.albedo).unwrap().to_rgb8();
             assert_eq!(albedo.dimensions(), image.dimensions());
+        }
+    }
+
+    #[test]
+    fn flowers_are_a_root_each_with_a_lighter_far_level_in_their_own_colours() {
+        let file = flowers::flowers();
+        let image = image::load_from_memory(&file.images[0]).unwrap().to_rgb8();
+        let roots: Vec<&str> = file
+            .roots
+            .iter()
+            .map(|r| file.nodes[*r].name.as_str())
+            .collect();
+        assert_eq!(roots, ["red", "yellow", "blue"]);
+        for (name, petal, _) in flowers::FLOWERS {
+            let near = vertices(&file, &format!("{name}_LOD0"));
+            let far = vertices(&file, &format!("{name}_LOD1"));
+            assert!(far * 3 < near * 2, "{name}: {near} then {far} vertices");
+            // The petals' texture coordinates land on the flower's own petal colour.
+            let node = file.nodes.iter().find(|n| n.name == format!("{name}_LOD0"));
+            let primitive = &file.meshes[node.unwrap().mesh.unwrap()][0];
+            let top = (0..primitive.positions.len())
+                .max_by(|a, b| primitive.positions[*a][1].total_cmp(&primitive.positions[*b][1]))
+                .unwrap();
+            let petal_uv = primitive.uvs.as_ref().unwrap()[top + 1];
+            let (w, h) = image.dimensions();
+            let texel = image.get_pixel(
+                (petal_uv[0] * w as f32) as u32,
+                (petal_uv[1] * h as f32) as u32,
+            );
+            assert_eq!(texel.0, petal, "{name}");
         }
     }
 

@@ -19,7 +19,7 @@ fn leaf_material(file: &mut Glb, texture: Vec<u8>) -> usize {
 }
 
 /// Levels of one primitive each under a root named `name` (`<name>_LOD0`, …).
-fn levels(file: &mut Glb, name: &str, meshes: Vec<(Mesh, usize)>) {
+pub(super) fn levels(file: &mut Glb, name: &str, meshes: Vec<(Mesh, usize)>) {
     let nodes: Vec<usize> = meshes
         .into_iter()
         .enumerate()

@@ -6,7 +6,9 @@
 use crate::impostor::ImpostorAtlases;
 use crate::layers::ScatterLayer;
 use crate::look::ClassLook;
-use crate::look::asset::{AssetLook, AssetLookError, AssetRoot, GltfAssets, ResolvedAsset};
+use crate::look::asset::{
+    AssetLook, AssetLookError, AssetRoot, GltfAssets, MsftLodTable, ResolvedAsset,
+};
 use bevy::asset::LoadState;
 use bevy::ecs::message::MessageCursor;
 use bevy::gltf::{Gltf, GltfMaterial, GltfMesh, GltfNode};
@@ -49,6 +51,7 @@ pub(super) struct AssetSources<'w> {
     nodes: Res<'w, Assets<GltfNode>>,
     gltf_meshes: Res<'w, Assets<GltfMesh>>,
     materials: Res<'w, Assets<GltfMaterial>>,
+    lods: Option<Res<'w, MsftLodTable>>,
     meshes: ResMut<'w, Assets<Mesh>>,
 }
 
@@ -61,10 +64,14 @@ impl AssetSources<'_> {
         }
         let loaded = self.server.is_loaded_with_dependencies(id);
         let gltf = self.files.get(id).filter(|_| loaded)?;
+        // What the loader's handler read of the file (nothing: a file added in code).
+        let path = self.server.get_path(id);
+        let lods = path.zip(self.lods.as_ref()).and_then(|(p, t)| t.get(&p));
         let from = GltfAssets {
             nodes: &self.nodes,
             meshes: &self.gltf_meshes,
             materials: &self.materials,
+            lods: lods.as_deref(),
         };
         let resolved = crate::look::asset::resolve_asset(gltf, &look.root, from, &mut self.meshes);
         if let Err(e) = &resolved {

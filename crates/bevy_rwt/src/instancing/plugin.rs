@@ -70,6 +70,8 @@ impl Plugin for RwtInstancingPlugin {
                 ),
             );
         #[cfg(feature = "gltf")]
+        crate::look::asset::register_msft_lod(app);
+        #[cfg(feature = "gltf")]
         app.init_resource::<super::ResolvedAssets>()
             .register_type::<crate::look::asset::AssetCollider>()
             .add_systems(

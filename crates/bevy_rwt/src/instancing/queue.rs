@@ -500,7 +500,9 @@ fn asset_parts(
     buffer: Arc<InstanceBuffer>,
 ) -> Vec<(InstancedChunk, Aabb)> {
     let c = &target.layer.classes[class as usize];
-    let switches = look.lods.switches(asset.levels.len(), asset.bounds);
+    let switches = look
+        .lods
+        .switches(asset.levels.len(), asset.bounds, &asset.coverage);
     let last = asset.levels.len() - 1;
     let band = |level: usize| match switches.get(level) {
         Some(d) => Some(look.lods.band(*d)),

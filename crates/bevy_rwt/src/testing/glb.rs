@@ -179,6 +179,10 @@ pub struct GlbNode {
     pub mesh: Option<usize>,
     /// Its children.
     pub children: Vec<usize>,
+    /// `MSFT_lod`: the nodes of its lower levels (none: no extension).
+    pub lods: Vec<usize>,
+    /// `MSFT_screencoverage` in its extras (none when empty).
+    pub coverage: Vec<f32>,
 }
 
 impl GlbNode {
@@ -205,6 +209,14 @@ impl GlbNode {
     /// This node, with `children`.
     pub fn with_children(mut self, children: impl IntoIterator<Item = usize>) -> Self {
         self.children.extend(children);
+        self
+    }
+
+    /// This node, naming its lower levels with `MSFT_lod` and hinting their screen
+    /// coverage (`MSFT_screencoverage`, none when empty).
+    pub fn with_msft_lod(mut self, levels: Vec<usize>, coverage: Vec<f32>) -> Self {
+        self.lods = levels;
+        self.coverage = coverage;
         self
     }
 }
@@ -291,6 +303,9 @@ impl Glb {
             // Linear filtering, mipmaps, repeat.
             root["samplers"] = json!([{ "magFilter": 9729, "minFilter": 9987 }]);
         }
+        if self.nodes.iter().any(|n| !n.lods.is_empty()) {
+            root["extensionsUsed"] = json!(["MSFT_lod"]);
+        }
         // glTF's arrays are present only when not empty.
         if let Value::Object(fields) = &mut root {
             fields.retain(|_, v| v.as_array().is_none_or(|a| !a.is_empty()));
@@ -313,6 +328,12 @@ fn node_json(node: &GlbNode) -> Value {
     }
     if !node.children.is_empty() {
         out["children"] = json!(node.children);
+    }
+    if !node.lods.is_empty() {
+        out["extensions"] = json!({ "MSFT_lod": { "ids": node.lods } });
+    }
+    if !node.coverage.is_empty() {
+        out["extras"] = json!({ "MSFT_screencoverage": node.coverage });
     }
     out
 }

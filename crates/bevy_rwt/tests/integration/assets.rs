@@ -13,7 +13,7 @@ use bevy_rwt::layers::file::LayerDescription;
 use bevy_rwt::look::InstancedClassError;
 use bevy_rwt::look::asset::{
     AssetCollider, AssetLook, AssetLookError, AssetParts, AssetPrimitive, AssetRoot,
-    AssetTreeError, GltfAssets, SurfaceAlpha, asset_tree, resolve_asset,
+    AssetTreeError, GltfAssets, MsftLodTable, SurfaceAlpha, asset_tree, resolve_asset,
 };
 use bevy_rwt::prelude::*;
 use bevy_rwt::testing::glb::{Glb, GlbAlpha, GlbMaterial, GlbNode, GlbPrimitive};
@@ -68,11 +68,13 @@ fn a_written_asset_loads_and_splits_into_levels_and_a_collider() {
     check_resolved(&mut app, &handle);
     let world = app.world();
     let gltf = world.resource::<Assets<Gltf>>().get(&handle).unwrap();
-    let (nodes, gltf_meshes) = (
-        world.resource::<Assets<GltfNode>>(),
-        world.resource::<Assets<GltfMesh>>(),
-    );
-    let tree = |root: AssetRoot| asset_tree(gltf, &root, nodes, gltf_meshes);
+    let from = GltfAssets {
+        nodes: world.resource::<Assets<GltfNode>>(),
+        meshes: world.resource::<Assets<GltfMesh>>(),
+        materials: world.resource(),
+        lods: None,
+    };
+    let tree = |root: AssetRoot| asset_tree(gltf, &root, from);
     // The file, its only scene and its root node name the same tree.
     let parts = AssetParts::split(&tree(AssetRoot::File).unwrap());
     let scene = AssetParts::split(&tree(AssetRoot::Scene(0)).unwrap());
@@ -128,6 +130,7 @@ fn check_resolved(app: &mut App, handle: &Handle<Gltf>) {
             nodes: world.resource(),
             meshes: world.resource(),
             materials: world.resource(),
+            lods: None,
         };
         let gltf = world.resource::<Assets<Gltf>>().get(handle).unwrap();
         resolve_asset(gltf, &AssetRoot::File, from, &mut meshes).unwrap()
@@ -379,6 +382,7 @@ fn a_part_every_level_shares_is_moved_into_the_assets_frame_once() {
             nodes: world.resource(),
             meshes: world.resource(),
             materials: world.resource(),
+            lods: None,
         };
         let gltf = world.resource::<Assets<Gltf>>().get(&handle).unwrap();
         resolve_asset(gltf, &AssetRoot::File, from, &mut meshes).unwrap()
@@ -391,6 +395,78 @@ fn a_part_every_level_shares_is_moved_into_the_assets_frame_once() {
     assert_eq!(plinths.len(), 2);
     assert_eq!(plinths[0], plinths[1], "one moved plinth for both levels");
     assert_eq!(world.resource::<Assets<Mesh>>().len(), before + 1);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A rock whose levels `MSFT_lod` names (node 0 naming nodes 1 and 2, which no scene
+/// holds), its screen coverage hinted in its extras.
+fn msft_rock() -> Glb {
+    let mut file = Glb::default();
+    let grey = file.add_material(GlbMaterial::colored([0.5, 0.5, 0.5, 1.0]));
+    let mut mesh =
+        |shape: Mesh| file.add_mesh(vec![GlbPrimitive::from_mesh(&shape, grey).unwrap()]);
+    let (near, mid, far) = (
+        mesh(Cuboid::new(2.0, 2.0, 2.0).mesh().build()),
+        mesh(Sphere::new(1.0).mesh().ico(1).unwrap()),
+        mesh(Cuboid::new(1.6, 1.6, 1.6).mesh().build()),
+    );
+    let lifted = Transform::from_xyz(0.0, 1.0, 0.0);
+    let high = GlbNode::named("rock")
+        .with_mesh(near)
+        .with_transform(lifted);
+    let high = file.add_node(high.with_msft_lod(vec![1, 2], vec![0.5, 0.2, 0.01]));
+    for (name, mesh) in [("rock_mid", mid), ("rock_far", far)] {
+        file.add_node(GlbNode::named(name).with_mesh(mesh).with_transform(lifted));
+    }
+    file.add_root(high);
+    file
+}
+
+#[test]
+fn msft_lod_gives_the_levels_and_their_coverage_gives_the_switches() {
+    let (mut app, dir) = gltf_app("msft_lod", &[("rock.glb", &msft_rock().to_bytes())]);
+    let server = app.world().resource::<AssetServer>().clone();
+    let look = AssetLook::new(server.load("rock.glb"));
+    let density = LayerDensity::Constant(0.05);
+    let mut l = layer(density.clone());
+    l.classes = vec![ScatterClass::asset(density, look.clone())];
+    app.world_mut().spawn(l);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    let resolved = |app: &App| {
+        let assets = app
+            .world()
+            .resource::<bevy_rwt::instancing::ResolvedAssets>();
+        assets.ready(&look).cloned()
+    };
+    assert!(run_until(&mut app, 2_000, |app| resolved(app).is_some()));
+    let rock = resolved(&app).unwrap();
+    // Three levels of one primitive each: the nodes it names are no roots of their own.
+    let sizes: Vec<usize> = rock.levels.iter().map(Vec::len).collect();
+    assert_eq!(sizes, [1, 1, 1]);
+    assert_eq!(rock.coverage, [0.5, 0.2, 0.01]);
+    // Each level stands where the node it replaces stands, lifted 1 m: a 2 m box's bottom
+    // on the origin, a 1.6 m box's 0.2 m over it.
+    let meshes = app.world().resource::<Assets<Mesh>>();
+    let low = |level: usize| {
+        let mesh = meshes.get(&rock.levels[level][0].mesh).unwrap();
+        mesh.compute_aabb().unwrap().min().y
+    };
+    assert!(
+        low(0).abs() < 1e-3 && (low(2) - 0.2).abs() < 1e-3,
+        "{} {}",
+        low(0),
+        low(2)
+    );
+    // The far level switches where the hint says: the asset covering a fifth of the
+    // screen's height, two and a half times as far as half of it.
+    let switches = look.lods.switches(3, rock.bounds, &rock.coverage);
+    let radius = 0.5 * (rock.bounds.1 - rock.bounds.0).length();
+    let at = |cover: f32| radius / (cover * (std::f32::consts::PI / 8.0).tan());
+    assert!((switches[0] - at(0.5)).abs() < 1e-3, "{switches:?}");
+    assert!((switches[1] - at(0.2)).abs() < 1e-3, "{switches:?}");
+    // The loader's handler kept the extension by the file's path.
+    let table = app.world().resource::<MsftLodTable>();
+    assert_eq!(table.get(&"rock.glb".into()).unwrap().nodes[&0].ids, [1, 2]);
     std::fs::remove_dir_all(&dir).ok();
 }
 

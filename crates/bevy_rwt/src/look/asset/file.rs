@@ -1,7 +1,10 @@
 //! A loaded glTF file as an asset's node tree: the primitives under a node (or under every
 //! root node of the file), each as its mesh and material handles, ready for
-//! [`AssetParts::split`](super::AssetParts::split).
+//! [`AssetParts::split`](super::AssetParts::split). A node with `MSFT_lod` becomes a node
+//! over `<name>_LOD0` (its own content), `<name>_LOD1`… (the nodes it names), as levels
+//! named in the file are.
 
+use super::msft_lod::MsftLods;
 use super::parts::AssetNode;
 use bevy::gltf::{Gltf, GltfMaterial, GltfMesh, GltfNode};
 use bevy::prelude::*;
@@ -38,6 +41,27 @@ pub enum AssetTreeError {
     /// which nodes it holds (load it with `GltfLoaderSettings::include_source`).
     #[error("scene {0} of a file of several scenes needs the file loaded with its source")]
     SceneWithoutSource(usize),
+    /// A node's `MSFT_lod` names a node the loaded file does not hold.
+    #[error("the MSFT_lod of node {node:?} names node {level}, which the file does not hold")]
+    NoSuchLevel {
+        /// The node with the extension.
+        node: String,
+        /// The index it names.
+        level: usize,
+    },
+}
+
+/// The loaded assets an asset's tree is read from.
+#[derive(Clone, Copy)]
+pub struct GltfAssets<'a> {
+    /// The files' nodes.
+    pub nodes: &'a Assets<GltfNode>,
+    /// The files' meshes.
+    pub meshes: &'a Assets<GltfMesh>,
+    /// The files' materials.
+    pub materials: &'a Assets<GltfMaterial>,
+    /// The file's `MSFT_lod` nodes (see [`super::MsftLodHandler`]); `None` reads none.
+    pub lods: Option<&'a MsftLods>,
 }
 
 /// Which part of a file is the asset.
@@ -58,17 +82,17 @@ pub enum AssetRoot {
 pub fn asset_tree(
     gltf: &Gltf,
     root: &AssetRoot,
-    nodes: &Assets<GltfNode>,
-    meshes: &Assets<GltfMesh>,
+    from: GltfAssets,
 ) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
+    let reader = Reader { gltf, from };
     match root {
-        AssetRoot::File => file_tree(gltf, nodes, meshes),
+        AssetRoot::File => reader.file(),
         AssetRoot::Node(name) => {
             let node = gltf
                 .named_nodes
                 .get(name.as_str())
                 .ok_or_else(|| AssetTreeError::NoSuchNode(name.clone()))?;
-            node_tree(node, nodes, meshes)
+            reader.node(node, 0)
         }
         AssetRoot::Scene(index) => {
             if *index >= gltf.scenes.len() {
@@ -76,7 +100,7 @@ pub fn asset_tree(
             }
             let Some(source) = &gltf.source else {
                 return match gltf.scenes.len() {
-                    1 => file_tree(gltf, nodes, meshes),
+                    1 => reader.file(),
                     _ => Err(AssetTreeError::SceneWithoutSource(*index)),
                 };
             };
@@ -85,83 +109,122 @@ pub fn asset_tree(
                 .nth(*index)
                 .ok_or(AssetTreeError::NoSuchScene(*index))?;
             let roots = scene.nodes().filter_map(|n| gltf.nodes.get(n.index()));
-            roots_tree(roots, nodes, meshes)
+            reader.roots(roots)
         }
     }
 }
 
-/// The tree under `node`, read from the loaded file's node and mesh assets.
-pub fn node_tree(
-    node: &Handle<GltfNode>,
-    nodes: &Assets<GltfNode>,
-    meshes: &Assets<GltfMesh>,
-) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
-    read_node(node, nodes, meshes, 0)
+/// Reads trees of one loaded file.
+struct Reader<'a> {
+    gltf: &'a Gltf,
+    from: GltfAssets<'a>,
 }
 
-/// The whole file as one tree: a nameless root at the origin whose children are the file's
-/// root nodes (those that are no other node's child), in the file's order.
-pub fn file_tree(
-    gltf: &Gltf,
-    nodes: &Assets<GltfNode>,
-    meshes: &Assets<GltfMesh>,
-) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
-    let mut children = HashSet::new();
-    for handle in &gltf.nodes {
-        let node = nodes
+impl Reader<'_> {
+    /// The whole file as one tree: a nameless root at the origin whose children are the
+    /// file's root nodes (those that are no other node's child nor another's `MSFT_lod`
+    /// level), in the file's order.
+    fn file(&self) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
+        let mut children = HashSet::new();
+        for handle in &self.gltf.nodes {
+            let node = self.get(handle)?;
+            children.extend(node.children.iter().map(Handle::id));
+        }
+        let alternates = self.from.lods.map(MsftLods::alternates).unwrap_or_default();
+        let roots = self
+            .gltf
+            .nodes
+            .iter()
+            .enumerate()
+            .filter(|(i, h)| !children.contains(&h.id()) && !alternates.contains(i));
+        self.roots(roots.map(|(_, h)| h))
+    }
+
+    /// A nameless root at the origin over the trees of `roots`.
+    fn roots<'h>(
+        &self,
+        roots: impl Iterator<Item = &'h Handle<GltfNode>>,
+    ) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
+        let trees = roots
+            .map(|root| self.node(root, 0))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(AssetNode::new("", Transform::IDENTITY).with_children(trees))
+    }
+
+    fn get(&self, handle: &Handle<GltfNode>) -> Result<&GltfNode, AssetTreeError> {
+        self.from
+            .nodes
             .get(handle)
-            .ok_or_else(|| AssetTreeError::NotLoaded(format!("{handle:?}")))?;
-        children.extend(node.children.iter().map(Handle::id));
+            .ok_or_else(|| AssetTreeError::NotLoaded(format!("{handle:?}")))
     }
-    let roots = gltf.nodes.iter().filter(|h| !children.contains(&h.id()));
-    roots_tree(roots, nodes, meshes)
-}
 
-/// A nameless root at the origin over the trees of `roots`.
-fn roots_tree<'a>(
-    roots: impl Iterator<Item = &'a Handle<GltfNode>>,
-    nodes: &Assets<GltfNode>,
-    meshes: &Assets<GltfMesh>,
-) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
-    let trees = roots
-        .map(|root| node_tree(root, nodes, meshes))
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(AssetNode::new("", Transform::IDENTITY).with_children(trees))
-}
-
-fn read_node(
-    handle: &Handle<GltfNode>,
-    nodes: &Assets<GltfNode>,
-    meshes: &Assets<GltfMesh>,
-    depth: usize,
-) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
-    if depth >= MAX_ASSET_DEPTH {
-        return Err(AssetTreeError::TooDeep);
-    }
-    let node = nodes
-        .get(handle)
-        .ok_or_else(|| AssetTreeError::NotLoaded(format!("{handle:?}")))?;
-    let primitives = match &node.mesh {
-        Some(mesh) => {
-            let mesh = meshes
-                .get(mesh)
-                .ok_or_else(|| AssetTreeError::NotLoaded(node.name.clone()))?;
-            mesh.primitives
-                .iter()
-                .map(|p| AssetPrimitive {
-                    mesh: p.mesh.clone(),
-                    material: p.material.clone(),
-                })
-                .collect()
+    /// The tree under a node, its `MSFT_lod` levels as level nodes.
+    fn node(
+        &self,
+        handle: &Handle<GltfNode>,
+        depth: usize,
+    ) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
+        if depth >= MAX_ASSET_DEPTH {
+            return Err(AssetTreeError::TooDeep);
         }
-        None => Vec::new(),
-    };
-    let children = node
-        .children
-        .iter()
-        .map(|child| read_node(child, nodes, meshes, depth + 1))
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(AssetNode::new(node.name.clone(), node.transform)
-        .with_primitives(primitives)
-        .with_children(children))
+        let node = self.get(handle)?;
+        let own = self.plain(node, depth)?;
+        let lod = self.from.lods.and_then(|l| l.nodes.get(&node.index));
+        let Some(lod) = lod.filter(|l| !l.ids.is_empty()) else {
+            return Ok(own);
+        };
+        let level = |k: usize, mut tree: AssetNode<AssetPrimitive>, transform: Transform| {
+            tree.transform = transform;
+            AssetNode::new(format!("{}_LOD{k}", node.name), Transform::IDENTITY)
+                .with_children([tree])
+        };
+        let mut levels = vec![level(0, own, Transform::IDENTITY)];
+        let into_node = node.transform.to_matrix().inverse();
+        for (k, id) in lod.ids.iter().enumerate() {
+            let missing = || AssetTreeError::NoSuchLevel {
+                node: node.name.clone(),
+                level: *id,
+            };
+            let alternate = self.gltf.nodes.get(*id).ok_or_else(missing)?;
+            let tree = self.node(alternate, depth + 1)?;
+            let transform = Transform::from_matrix(into_node * tree.transform.to_matrix());
+            levels.push(level(k + 1, tree, transform));
+        }
+        Ok(AssetNode::new(node.name.clone(), node.transform)
+            .with_children(levels)
+            .with_coverage(lod.coverage.clone()))
+    }
+
+    /// A node as the file has it: its primitives and the trees of its children.
+    fn plain(
+        &self,
+        node: &GltfNode,
+        depth: usize,
+    ) -> Result<AssetNode<AssetPrimitive>, AssetTreeError> {
+        let primitives = match &node.mesh {
+            Some(mesh) => {
+                let mesh = self
+                    .from
+                    .meshes
+                    .get(mesh)
+                    .ok_or_else(|| AssetTreeError::NotLoaded(node.name.clone()))?;
+                mesh.primitives
+                    .iter()
+                    .map(|p| AssetPrimitive {
+                        mesh: p.mesh.clone(),
+                        material: p.material.clone(),
+                    })
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        let children = node
+            .children
+            .iter()
+            .map(|child| self.node(child, depth + 1))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(AssetNode::new(node.name.clone(), node.transform)
+            .with_primitives(primitives)
+            .with_children(children))
+    }
 }

@@ -18,6 +18,9 @@ pub struct AssetNode<P> {
     pub primitives: Vec<P>,
     /// Its children.
     pub children: Vec<AssetNode<P>>,
+    /// The fraction of the screen's height down to which each level under it is shown,
+    /// nearest first, when the file hints it (`MSFT_screencoverage`); empty otherwise.
+    pub coverage: Vec<f32>,
 }
 
 impl<P> AssetNode<P> {
@@ -28,7 +31,14 @@ impl<P> AssetNode<P> {
             transform,
             primitives: Vec::new(),
             children: Vec::new(),
+            coverage: Vec::new(),
         }
+    }
+
+    /// This node, hinting the screen coverage of the levels under it.
+    pub fn with_coverage(mut self, coverage: Vec<f32>) -> Self {
+        self.coverage = coverage;
+        self
     }
 
     /// This node, drawing `primitives`.
@@ -102,6 +112,9 @@ pub struct AssetParts<P> {
     pub levels: Vec<Vec<Placed<P>>>,
     /// The primitives of collider nodes, never drawn.
     pub colliders: Vec<Placed<P>>,
+    /// The screen coverage hint of the levels (the first node's in the tree that has one;
+    /// see [`AssetNode::coverage`]).
+    pub coverage: Vec<f32>,
 }
 
 impl<P: Clone> AssetParts<P> {
@@ -111,6 +124,7 @@ impl<P: Clone> AssetParts<P> {
             levels: BTreeMap::new(),
             shared: Vec::new(),
             colliders: Vec::new(),
+            coverage: root.coverage.clone(),
         };
         found.place(&root.primitives, Transform::IDENTITY, Bin::Shared);
         for child in &root.children {
@@ -130,6 +144,7 @@ impl<P: Clone> AssetParts<P> {
         AssetParts {
             levels,
             colliders: found.colliders,
+            coverage: found.coverage,
         }
     }
 }
@@ -152,6 +167,7 @@ struct Found<P> {
     /// Parts under no level node.
     shared: Vec<Placed<P>>,
     colliders: Vec<Placed<P>>,
+    coverage: Vec<f32>,
 }
 
 impl<P: Clone> Found<P> {
@@ -165,6 +181,9 @@ impl<P: Clone> Found<P> {
             (bin, NodeRole::Plain) => bin,
         };
         self.place(&node.primitives, transform, bin);
+        if self.coverage.is_empty() {
+            self.coverage.clone_from(&node.coverage);
+        }
         for child in &node.children {
             self.walk(child, transform, bin);
         }

@@ -3,11 +3,11 @@
 //! frame (their node transforms applied once, here) with their surfaces, the colliders'
 //! meshes, and the asset's bounds.
 
-use super::file::{AssetPrimitive, AssetRoot, AssetTreeError, asset_tree};
+use super::file::{AssetPrimitive, AssetRoot, AssetTreeError, GltfAssets, asset_tree};
 use super::parts::{AssetParts, Placed};
 use super::surface::{InstancedSurface, SurfaceError};
 use crate::look::{InstancedClassError, InstancedShading, InstancedShadows, check_instanced_mesh};
-use bevy::gltf::{Gltf, GltfMaterial, GltfMesh, GltfNode};
+use bevy::gltf::{Gltf, GltfMaterial};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 
@@ -64,8 +64,9 @@ pub enum AssetCollider {
 #[reflect(Clone, Debug, PartialEq)]
 pub struct AssetLods {
     /// The distance at which level `i + 1` takes over from level `i` (metres from the
-    /// camera to an instance's root); levels beyond the list switch where the asset
-    /// covers [`AssetLods::COVERAGE`] of the screen's height, halving at each level.
+    /// camera to an instance's root); levels beyond the list switch where the file's
+    /// screen coverage hint says (`MSFT_screencoverage`), else where the asset covers
+    /// [`AssetLods::COVERAGE`] of the screen's height, halving at each level.
     pub distances: Vec<f32>,
     /// Width of each crossfade band, as a fraction of its distance (centred on it).
     pub crossfade: f32,
@@ -86,13 +87,18 @@ impl AssetLods {
     pub const COVERAGE: f32 = 0.25;
 
     /// The switch distances of an asset of `levels` levels within `bounds`, nearest first
-    /// (one fewer than the levels, rising).
-    pub fn switches(&self, levels: usize, bounds: (Vec3, Vec3)) -> Vec<f32> {
+    /// (one fewer than the levels, rising). `coverage` is the file's hint: the fraction of
+    /// the screen's height (the bounds' sphere's diameter over it, under a 45-degree lens)
+    /// down to which each level is shown, the first level's first; its last value (where
+    /// glTF's hint draws nothing) is left to the layer's reach and impostors.
+    pub fn switches(&self, levels: usize, bounds: (Vec3, Vec3), coverage: &[f32]) -> Vec<f32> {
         let radius = 0.5 * (bounds.1 - bounds.0).length().max(1e-3);
         let mut last = 0.0f32;
         (1..levels)
             .map(|level| {
-                let covered = Self::COVERAGE / (1u64 << (level - 1).min(30)) as f32;
+                let halved = Self::COVERAGE / (1u64 << (level - 1).min(30)) as f32;
+                let hinted = coverage.get(level - 1).filter(|c| **c > 0.0 && **c <= 1.0);
+                let covered = hinted.copied().unwrap_or(halved);
                 let derived = radius / (covered * (std::f32::consts::PI / 8.0).tan());
                 let given = self.distances.get(level - 1).copied();
                 let d = given
@@ -174,6 +180,8 @@ pub struct ResolvedAsset {
     pub bounds: (Vec3, Vec3),
     /// The vertices of the nearest level (each position once), in the asset's frame.
     pub hull: Vec<Vec3>,
+    /// The file's screen coverage hint for the levels (see [`AssetLods::switches`]).
+    pub coverage: Vec<f32>,
 }
 
 impl ResolvedAsset {
@@ -210,17 +218,6 @@ pub enum AssetLookError {
     NothingDrawn,
 }
 
-/// The loaded assets an asset's tree is read from.
-#[derive(Clone, Copy)]
-pub struct GltfAssets<'a> {
-    /// The files' nodes.
-    pub nodes: &'a Assets<GltfNode>,
-    /// The files' meshes.
-    pub meshes: &'a Assets<GltfMesh>,
-    /// The files' materials.
-    pub materials: &'a Assets<GltfMaterial>,
-}
-
 /// `root` of the loaded file `gltf` made ready to draw: its primitives' meshes moved into
 /// the asset's frame (added to `meshes` once per mesh and transform, shared where a node
 /// does not move its mesh).
@@ -230,7 +227,7 @@ pub fn resolve_asset(
     from: GltfAssets,
     meshes: &mut Assets<Mesh>,
 ) -> Result<ResolvedAsset, AssetLookError> {
-    let tree = asset_tree(gltf, root, from.nodes, from.meshes)?;
+    let tree = asset_tree(gltf, root, from)?;
     let parts = AssetParts::split(&tree);
     let mut baker = Baker {
         meshes,
@@ -262,6 +259,7 @@ pub fn resolve_asset(
         colliders,
         bounds,
         hull,
+        coverage: parts.coverage,
     })
 }
 
@@ -361,7 +359,7 @@ mod tests {
     fn levels_switch_where_given_else_where_the_asset_covers_less_of_the_screen() {
         // A 2 m box: radius sqrt(3), a quarter of a 45-degree screen at about 16.7 m.
         let bounds = (Vec3::splat(-1.0), Vec3::splat(1.0));
-        let derived = AssetLods::default().switches(3, bounds);
+        let derived = AssetLods::default().switches(3, bounds, &[]);
         assert_eq!(derived.len(), 2);
         let first = 3f32.sqrt() / (0.25 * (std::f32::consts::PI / 8.0).tan());
         assert!((derived[0] - first).abs() < 1e-3, "{derived:?}");
@@ -374,13 +372,24 @@ mod tests {
             distances: vec![50.0, 20.0, f32::NAN],
             crossfade: 0.2,
         };
-        let switches = given.switches(4, bounds);
+        let switches = given.switches(4, bounds, &[]);
         assert_eq!(switches[0], 50.0);
         assert!(
             switches[1] > 50.0 && switches[2] > switches[1],
             "{switches:?}"
         );
         assert_eq!(given.band(50.0), (45.0, 55.0));
-        assert!(AssetLods::default().switches(1, bounds).is_empty());
+        assert!(AssetLods::default().switches(1, bounds, &[]).is_empty());
+        // The file's coverage hint where no distance is given: half the cover (0.125 of
+        // the screen), twice as far as a quarter.
+        let hinted = AssetLods::default().switches(3, bounds, &[0.25, 0.125, 0.01]);
+        assert!((hinted[0] - first).abs() < 1e-3 && (hinted[1] - 2.0 * first).abs() < 1e-3);
+        let near = AssetLods::default().switches(2, bounds, &[0.5, 0.01]);
+        assert!((near[0] - first / 2.0).abs() < 1e-3, "{near:?}");
+        let given_first = AssetLods {
+            distances: vec![5.0],
+            ..default()
+        };
+        assert_eq!(given_first.switches(2, bounds, &[0.5])[0], 5.0);
     }
 }
