@@ -213,7 +213,8 @@ for run in "${runs[@]}"; do
     fi
     if [ $docs = 1 ] && [ $failed = 0 ]; then
         mkdir -p docs/screenshots
-        if [ "$ex" = open_world ]; then
+        # The README's first pictures full size; the others at half.
+        if [ "$ex" = open_world ] || [ "$ex" = mesh_ground ]; then
             cp "$png" "docs/screenshots/$name.png"
         else
             python3 scripts/png_stats.py "$png" --half "docs/screenshots/$name.png" >/dev/null
