@@ -6,8 +6,8 @@ pub use plugin::RwtDiagnosticsPlugin;
 
 use crate::layers::{AssetStatus, ScatterLayerStatus};
 use bevy::diagnostic::{DiagnosticPath, Diagnostics};
+use bevy::platform::time::Instant;
 use bevy::prelude::*;
-use std::time::Instant;
 
 /// Live figures of the plugin, summed over layers (each layer's own are in its
 /// [`ScatterLayerStatus`]).

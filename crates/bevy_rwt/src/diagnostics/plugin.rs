@@ -4,8 +4,8 @@ use super::{FrameStart, RwtStats, paths, publish, start_timer, update_stats};
 use crate::settings::{RwtSystems, configure_sets, in_schedule};
 use bevy::diagnostic::{Diagnostic, RegisterDiagnostic};
 use bevy::ecs::schedule::InternedScheduleLabel;
+use bevy::platform::time::Instant;
 use bevy::prelude::*;
-use std::time::Instant;
 
 /// Keeps [`RwtStats`] and the `rwt/` diagnostics (part of [`crate::RwtPlugins`]).
 pub struct RwtDiagnosticsPlugin {

@@ -250,7 +250,7 @@ pub(in crate::instancing) fn prepare_chunks(
                 }
             }
             _ => {
-                let own = (!slab.place(entity, &chunk.buffer.instances, &device, &queue))
+                let own = (!slab.place(entity, &chunk.buffer, &device, &queue))
                     .then(|| own_buffer(&device, chunk));
                 let gpu = upload(&device, &bindings, &cache, (chunk, uniform), &texture, own);
                 commands.entity(entity).insert(gpu);

@@ -1,19 +1,21 @@
 //! One buffer holding every chunk's instances ([`InstanceSlab`]), so that culling reads all
 //! of them through one binding and tests every chunk of a view in one dispatch.
 //!
-//! Each chunk owns a range of instances, placed best-fit among the free ranges
-//! ([`Ranges`]). The buffer grows by doubling (copied on the GPU) up to what one storage
+//! Each chunk reads a range of instances, placed best-fit among the free ranges
+//! ([`Ranges`]); chunks drawing the same instances (an asset's primitives at each level, a
+//! class's meshes and its impostors) read one range, uploaded once ([`Shares`]). The buffer grows by doubling (copied on the GPU) up to what one storage
 //! binding may hold; a chunk that does not fit then gets a buffer of its own and is drawn
 //! whole. When the chunks hold a quarter of it or less (the camera left a dense area), it
 //! shrinks by halving, the chunks' ranges packed from the start.
 
-use crate::instancing::chunk::{GPU_BYTES_PER_INSTANCE, GpuInstance};
+use crate::instancing::chunk::{GPU_BYTES_PER_INSTANCE, InstanceBuffer};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use std::collections::BTreeMap;
 use std::ops::Range;
+use std::sync::Arc;
 
 /// Bytes of one instance.
 const INSTANCE_BYTES: u64 = GPU_BYTES_PER_INSTANCE as u64;
@@ -106,12 +108,76 @@ fn packed<K: Copy>(ranges: impl IntoIterator<Item = (K, Range<u32>)>) -> Vec<(K,
         .collect()
 }
 
+/// A buffer's identity while a share holds it (its address).
+type BufferKey = usize;
+
+/// One range of instances and the chunks reading it.
+#[derive(Debug)]
+struct Share {
+    range: Range<u32>,
+    readers: u32,
+    /// Held, so that no other buffer takes its address while the share stands.
+    _buffer: Arc<InstanceBuffer>,
+}
+
+/// Which chunks read which range: one per chunk buffer, however many chunks draw it.
+#[derive(Debug, Default)]
+struct Shares {
+    chunks: HashMap<Entity, BufferKey>,
+    buffers: HashMap<BufferKey, Share>,
+}
+
+impl Shares {
+    fn key(buffer: &Arc<InstanceBuffer>) -> BufferKey {
+        Arc::as_ptr(buffer) as BufferKey
+    }
+
+    fn range(&self, chunk: Entity) -> Option<Range<u32>> {
+        let key = self.chunks.get(&chunk)?;
+        self.buffers.get(key).map(|s| s.range.clone())
+    }
+
+    /// `chunk` reads `buffer`'s range, if it has one already.
+    fn join(&mut self, chunk: Entity, buffer: &Arc<InstanceBuffer>) -> bool {
+        let key = Self::key(buffer);
+        let Some(share) = self.buffers.get_mut(&key) else {
+            return false;
+        };
+        share.readers += 1;
+        self.chunks.insert(chunk, key);
+        true
+    }
+
+    /// `chunk` reads `buffer`, newly placed at `range`.
+    fn insert(&mut self, chunk: Entity, buffer: &Arc<InstanceBuffer>, range: Range<u32>) {
+        let key = Self::key(buffer);
+        let share = Share {
+            range,
+            readers: 1,
+            _buffer: buffer.clone(),
+        };
+        self.buffers.insert(key, share);
+        self.chunks.insert(chunk, key);
+    }
+
+    /// `chunk` reads nothing; returns the range no chunk reads any more, if that freed one.
+    fn leave(&mut self, chunk: Entity) -> Option<Range<u32>> {
+        let key = self.chunks.remove(&chunk)?;
+        let share = self.buffers.get_mut(&key)?;
+        share.readers -= 1;
+        if share.readers > 0 {
+            return None;
+        }
+        self.buffers.remove(&key).map(|s| s.range)
+    }
+}
+
 /// Every chunk's instances in one buffer, by chunk render entity.
 #[derive(Resource, Default)]
 pub(in crate::instancing) struct InstanceSlab {
     buffer: Option<Buffer>,
     ranges: Ranges,
-    owners: HashMap<Entity, Range<u32>>,
+    shares: Shares,
 }
 
 impl InstanceSlab {
@@ -126,28 +192,33 @@ impl InstanceSlab {
         self.buffer.as_ref().map_or(0, |_| self.ranges.capacity)
     }
 
-    /// The instances `chunk` owns.
+    /// The instances `chunk` reads.
     pub fn range(&self, chunk: Entity) -> Option<Range<u32>> {
-        self.owners.get(&chunk).cloned()
+        self.shares.range(chunk)
     }
 
     /// The bytes of `chunk`'s instances, and the buffer.
     pub fn slice(&self, chunk: Entity) -> Option<(&Buffer, Range<u64>)> {
-        let range = self.owners.get(&chunk)?;
+        let range = self.shares.range(chunk)?;
         let bytes = u64::from(range.start) * INSTANCE_BYTES..u64::from(range.end) * INSTANCE_BYTES;
         Some((self.buffer.as_ref()?, bytes))
     }
 
-    /// Places `instances` (at least one) as `chunk`'s, in place of any it owned; `false`
-    /// when the buffer cannot grow to hold them (nothing owned then).
+    /// Places `buffer`'s instances (at least one) as `chunk`'s, in place of any it read:
+    /// the range another chunk of the same buffer reads, else a new one; `false` when the
+    /// slab cannot grow to hold them (nothing read then).
     pub fn place(
         &mut self,
         chunk: Entity,
-        instances: &[GpuInstance],
+        buffer: &Arc<InstanceBuffer>,
         device: &RenderDevice,
         queue: &RenderQueue,
     ) -> bool {
         self.free(chunk);
+        if self.shares.join(chunk, buffer) {
+            return true;
+        }
+        let instances = &buffer.instances;
         let Ok(len) = u32::try_from(instances.len()) else {
             return false;
         };
@@ -160,17 +231,18 @@ impl InstanceSlab {
         let Some(range) = self.ranges.take(len) else {
             return false;
         };
-        if let Some(buffer) = &self.buffer {
+        if let Some(slab) = &self.buffer {
             let at = u64::from(range.start) * INSTANCE_BYTES;
-            queue.write_buffer(buffer, at, bytemuck::cast_slice(instances));
+            queue.write_buffer(slab, at, bytemuck::cast_slice(instances));
         }
-        self.owners.insert(chunk, range);
+        self.shares.insert(chunk, buffer, range);
         true
     }
 
     /// Frees the ranges of the chunks `live` no longer holds.
     pub fn keep_only(&mut self, live: impl Fn(Entity) -> bool) {
-        let gone: Vec<Entity> = self.owners.keys().copied().filter(|&e| !live(e)).collect();
+        let chunks = self.shares.chunks.keys();
+        let gone: Vec<Entity> = chunks.copied().filter(|&e| !live(e)).collect();
         for chunk in gone {
             self.free(chunk);
         }
@@ -185,13 +257,14 @@ impl InstanceSlab {
             return;
         };
         let buffer = slab_buffer(device, capacity);
-        let moves = packed(self.owners.iter().map(|(&e, r)| (e, r.clone())));
+        let shares = self.shares.buffers.iter();
+        let moves = packed(shares.map(|(&key, share)| (key, share.range.clone())));
         let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor {
             label: Some("rwt_instance_slab_shrink"),
         });
         let mut ranges = Ranges::default();
         ranges.grow(capacity);
-        for (chunk, from, to) in moves {
+        for (key, from, to) in moves {
             let len = from.len() as u32;
             encoder.copy_buffer_to_buffer(
                 old_buffer,
@@ -202,7 +275,9 @@ impl InstanceSlab {
             );
             let taken = ranges.take(len);
             debug_assert_eq!(taken, Some(to..to + len), "packing takes ranges in order");
-            self.owners.insert(chunk, to..to + len);
+            if let Some(share) = self.shares.buffers.get_mut(&key) {
+                share.range = to..to + len;
+            }
         }
         // Submitted now, as when growing: writes queued before land in the old buffer first.
         queue.submit([encoder.finish()]);
@@ -211,7 +286,7 @@ impl InstanceSlab {
     }
 
     fn free(&mut self, chunk: Entity) {
-        if let Some(range) = self.owners.remove(&chunk) {
+        if let Some(range) = self.shares.leave(chunk) {
             self.ranges.give(range);
         }
     }
@@ -278,7 +353,35 @@ fn most_instances(device: &RenderDevice) -> u64 {
 
 #[cfg(test)]
 mod tests {
-    use super::{Ranges, packed};
+    use super::{Arc, Entity, InstanceBuffer, Ranges, Shares, packed};
+    use crate::instancing::chunk::GpuInstance;
+
+    #[test]
+    fn chunks_of_one_buffer_share_its_range_until_the_last_leaves() {
+        let buffer = |n: usize| {
+            Arc::new(InstanceBuffer {
+                instances: vec![GpuInstance::default(); n],
+                ..Default::default()
+            })
+        };
+        let (tree, rock) = (buffer(3), buffer(2));
+        let [bark, leaves, card, stone] =
+            [1, 2, 3, 4].map(Entity::from_raw_u32).map(Option::unwrap);
+        let mut shares = Shares::default();
+        assert!(!shares.join(bark, &tree), "nothing placed yet");
+        shares.insert(bark, &tree, 0..3);
+        assert!(shares.join(leaves, &tree) && shares.join(card, &tree));
+        assert!(!shares.join(stone, &rock), "another buffer, another range");
+        shares.insert(stone, &rock, 3..5);
+        assert_eq!(shares.range(card), Some(0..3));
+        // The range stays while a chunk reads it, and is freed with the last.
+        assert_eq!((shares.leave(bark), shares.leave(card)), (None, None));
+        assert_eq!(shares.range(leaves), Some(0..3));
+        assert_eq!(shares.leave(leaves), Some(0..3));
+        assert_eq!(shares.leave(stone), Some(3..5));
+        assert!(shares.buffers.is_empty() && shares.chunks.is_empty());
+        assert_eq!(shares.leave(stone), None, "leaving twice frees nothing");
+    }
 
     fn ranges(capacity: u32) -> Ranges {
         let mut r = Ranges::default();
