@@ -1,9 +1,14 @@
-//! What the examples share: the scripted smoke session that lets CI run each example in a
-//! real renderer ([`smoke`]), a fly camera ([`fly_camera`]), a text HUD ([`hud`]) and the
-//! brush's last answer for it ([`brush_status`]), the field of grass the cost benchmarks
-//! time ([`grass_field`]) and their frame timing ([`frame_clock`]), and frames captured and
-//! compared by the examples that check themselves ([`frame_check`]), and the files they
-//! write for the asset server ([`generated`]).
+//! What the examples share:
+//! - the open world that `open_world` and `web` stream ([`world`]) and the asset pack its
+//!   vegetation is made of ([`pack`]);
+//! - the scripted smoke session that lets CI run each example in a real renderer
+//!   ([`smoke`]), and frames captured and compared by the examples that check themselves
+//!   ([`frame_check`]);
+//! - a fly camera ([`fly_camera`]), a text HUD ([`hud`]) and the brush's last answer for it
+//!   ([`brush_status`]);
+//! - the field of grass the cost benchmarks time ([`grass_field`]) and their frame timing
+//!   ([`frame_clock`]);
+//! - the files the examples write for the asset server ([`generated`]).
 //!
 //! Run an example as a user would (`cargo run --release --example open_world`), or as CI
 //! does: `RWT_SCREENSHOT=out.png cargo run --example open_world` plays the example's script,
@@ -22,6 +27,7 @@ pub mod pack;
 pub mod smoke;
 pub mod terrain;
 pub mod tuft;
+pub mod world;
 
 use bevy::prelude::*;
 use bevy::window::{PresentMode, WindowResolution};

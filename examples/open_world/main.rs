@@ -25,24 +25,20 @@
 
 mod cost;
 mod gameplay;
-mod layers;
 mod play;
 mod script;
 mod walk;
 
 use bevy::anti_alias::taa::TemporalAntiAliasing;
-use bevy::light::CascadeShadowConfigBuilder;
-use bevy::pbr::{DistanceFog, FogFalloff, ScreenSpaceAmbientOcclusion};
+use bevy::pbr::ScreenSpaceAmbientOcclusion;
 use bevy::prelude::*;
 use bevy::render::occlusion_culling::OcclusionCulling;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
 use rwt_examples::prelude::*;
-use rwt_examples::terrain::{GROUND_RECENTRE, Terrain, WATER, ground_centre, ground_mesh};
-
-/// The sky at the horizon; the fog fades into it.
-const SKY: Color = Color::srgb(0.66, 0.77, 0.88);
+use rwt_examples::terrain::Terrain;
+use rwt_examples::world::{WorldScenePlugin, WorldSystems, layers, world_fog};
 
 fn main() {
     let mut window = example_plugins("rwt open_world").build();
@@ -52,10 +48,9 @@ fn main() {
     }
     rwt_examples::pack::write_pack();
     App::new()
-        .insert_resource(ClearColor(SKY))
-        .insert_resource(Terrain::new(2006))
         .add_plugins((
             window,
+            WorldScenePlugin,
             SmokePlugin,
             HudPlugin,
             FlyCameraPlugin,
@@ -73,39 +68,18 @@ fn main() {
             script::ScriptPlugin,
             cost::CostPlugin,
         ))
-        .add_systems(Startup, (setup_scene, layers::setup_layers))
+        .add_systems(Startup, (setup_camera, layers::setup_layers))
+        .configure_sets(Update, WorldSystems.after(script::ScriptSystems))
         .add_systems(
             Update,
-            (
-                stay_above_ground,
-                follow_ground,
-                toggles,
-                toggle_taa_ssao,
-                hud,
-            )
-                .chain()
-                .after(script::ScriptSystems),
+            (toggles, toggle_taa_ssao, hud).chain().after(WorldSystems),
         )
         .run();
 }
 
-#[derive(Component)]
-struct Ground {
-    centre: Vec2,
-}
-
-#[derive(Component)]
-struct Water;
-
-/// The world around the layers: camera, sun with cascaded shadows, sky light and fog,
-/// ground and water.
-fn setup_scene(
-    mut commands: Commands,
-    terrain: Res<Terrain>,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
-    mut gizmos: ResMut<RwtGizmos>,
-) {
+/// The camera, flying over the world ([`WorldScenePlugin`] adds the sun, ground and water)
+/// with TAA, SSAO and occlusion culling.
+fn setup_camera(mut commands: Commands, terrain: Res<Terrain>, mut gizmos: ResMut<RwtGizmos>) {
     *gizmos = RwtGizmos {
         chunks: false,
         tiles: false,
@@ -125,16 +99,7 @@ fn setup_scene(
                 ..default()
             },
             RwtViewer::default(),
-            DistanceFog {
-                color: SKY,
-                directional_light_color: Color::srgba(1.0, 0.93, 0.78, 0.5),
-                directional_light_exponent: 24.0,
-                falloff: FogFalloff::from_visibility_colors(
-                    4500.0,
-                    Color::srgb(0.42, 0.52, 0.64),
-                    Color::srgb(0.72, 0.8, 0.9),
-                ),
-            },
+            world_fog(),
         ))
         .id();
     // TAA and SSAO read the depth, normal and motion-vector prepasses, which the instanced
@@ -144,85 +109,6 @@ fn setup_scene(
     // need is there anyway); `RWT_OCCLUSION=0` draws them.
     if std::env::var("RWT_OCCLUSION").map_or(true, |v| v != "0") {
         commands.entity(camera).insert(OcclusionCulling);
-    }
-    commands.spawn((
-        DirectionalLight {
-            illuminance: 11_000.0,
-            shadow_maps_enabled: true,
-            color: Color::srgb(1.0, 0.96, 0.88),
-            ..default()
-        },
-        Transform::from_xyz(0.55, 0.6, 0.35).looking_at(Vec3::ZERO, Vec3::Y),
-        CascadeShadowConfigBuilder {
-            num_cascades: 3,
-            first_cascade_far_bound: 30.0,
-            maximum_distance: 350.0,
-            ..default()
-        }
-        .build(),
-    ));
-    commands.insert_resource(GlobalAmbientLight {
-        color: Color::srgb(0.75, 0.83, 1.0),
-        brightness: 500.0,
-        ..default()
-    });
-    commands.spawn((
-        Ground {
-            centre: Vec2::splat(f32::MAX),
-        },
-        Mesh3d(meshes.add(Plane3d::default().mesh().size(1.0, 1.0))),
-        MeshMaterial3d(materials.add(StandardMaterial {
-            perceptual_roughness: 0.95,
-            reflectance: 0.2,
-            ..default()
-        })),
-    ));
-    commands.spawn((
-        Water,
-        Mesh3d(meshes.add(Plane3d::default().mesh().size(14_000.0, 14_000.0))),
-        MeshMaterial3d(materials.add(StandardMaterial {
-            base_color: Color::srgb(0.1, 0.24, 0.32),
-            perceptual_roughness: 0.12,
-            reflectance: 0.35,
-            ..default()
-        })),
-        Transform::from_xyz(0.0, WATER, 0.0),
-    ));
-}
-
-fn stay_above_ground(terrain: Res<Terrain>, mut camera: Query<&mut Transform, With<FlyCamera>>) {
-    for mut t in &mut camera {
-        let ground = terrain.height(t.translation.xz()).max(WATER) + 1.2;
-        if t.translation.y < ground {
-            t.translation.y = ground;
-        }
-    }
-}
-
-/// Rebuilds the ground mesh (and moves the water) under the camera when it strays from the
-/// mesh's centre; the near grid stays on a fixed lattice, so it does not swim.
-fn follow_ground(
-    terrain: Res<Terrain>,
-    camera: Query<&Transform, With<FlyCamera>>,
-    mut ground: Query<(&mut Ground, &Mesh3d), Without<Water>>,
-    mut water: Query<&mut Transform, (With<Water>, Without<FlyCamera>)>,
-    mut meshes: ResMut<Assets<Mesh>>,
-) {
-    let Ok(eye) = camera.single() else {
-        return;
-    };
-    let here = ground_centre(eye.translation.xz());
-    for mut w in &mut water {
-        w.translation.x = here.x;
-        w.translation.z = here.y;
-    }
-    for (mut g, mesh) in &mut ground {
-        if g.centre.distance(eye.translation.xz()) > GROUND_RECENTRE {
-            g.centre = here;
-            if let Some(mut m) = meshes.get_mut(&mesh.0) {
-                *m = ground_mesh(&terrain, here);
-            }
-        }
     }
 }
 

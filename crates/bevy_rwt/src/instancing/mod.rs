@@ -38,5 +38,5 @@ pub use plugin::RwtInstancingPlugin;
 pub use promote::PromotedInstance;
 pub(crate) use queue::{InstancedQueue, UploadSources};
 #[cfg(feature = "testing")]
-pub use render::{CullingCheck, CullingReport};
+pub use render::{CullingCheck, CullingReport, gpu_culling_supported};
 pub use settings::{CascadeCasters, InstanceCulling, RwtFadeIn, RwtWind};

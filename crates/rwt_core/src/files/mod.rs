@@ -99,12 +99,40 @@ pub enum FileError {
         /// What it is instead: "a folder", "a FIFO", "a device", "a socket".
         what: &'static str,
     },
+    /// The platform gives no file system (`wasm32-unknown-unknown`: a page in a browser):
+    /// nothing is read or written, and nothing panics.
+    #[error("{}: cannot {action} on the web: a browser's page has no file system", path.display())]
+    NoFileSystem {
+        /// The file or folder.
+        path: PathBuf,
+        /// What was asked.
+        action: FileAction,
+    },
     /// A transaction was asked to write one file twice.
     #[error("{}: written twice in one save", path.display())]
     Duplicate {
         /// The file.
         path: PathBuf,
     },
+}
+
+/// Whether this platform has files to read and write: not a browser's page.
+pub const HAS_FILE_SYSTEM: bool = !cfg!(all(target_family = "wasm", target_os = "unknown"));
+
+/// [`FileError::NoFileSystem`] for `path` where the platform has no files.
+fn file_system(path: &Path, action: FileAction) -> Result<(), FileError> {
+    require_files(HAS_FILE_SYSTEM, path, action)
+}
+
+/// [`FileError::NoFileSystem`] for `path` unless `has` files.
+fn require_files(has: bool, path: &Path, action: FileAction) -> Result<(), FileError> {
+    if has {
+        return Ok(());
+    }
+    Err(FileError::NoFileSystem {
+        path: path.to_path_buf(),
+        action,
+    })
 }
 
 impl FileError {
@@ -267,6 +295,7 @@ pub struct AtomicFile {
 impl AtomicFile {
     /// Starts replacing `path` (creating its folder when missing).
     pub fn create(path: &Path) -> Result<Self, FileError> {
+        file_system(path, FileAction::Create)?;
         let target = resolve_target(path)?;
         if std::fs::metadata(&target).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
             let file = File::options()
@@ -396,6 +425,7 @@ pub fn write_atomic_with(
 /// FIFO would block until a writer comes, a device such as `/dev/zero` never ends, a folder
 /// has no bytes. A link is followed.
 pub fn open_regular(path: &Path) -> Result<File, FileError> {
+    file_system(path, FileAction::Read)?;
     let read_err = |e: io::Error| FileError::io(path, FileAction::Read, &e);
     let regular = |metadata: std::fs::Metadata| match metadata.file_type() {
         kind if kind.is_file() => Ok(()),
@@ -486,6 +516,7 @@ impl SaveTransaction {
     /// Starts a save into `dir` (created when missing), first finishing a save a crash
     /// interrupted there (see [`recover`]).
     pub fn begin(dir: &Path) -> Result<Self, FileError> {
+        file_system(dir, FileAction::Create)?;
         std::fs::create_dir_all(dir).map_err(|e| FileError::io(dir, FileAction::Create, &e))?;
         recover(dir)?;
         Ok(Self {
@@ -578,6 +609,7 @@ fn finish_journal(dir: &Path, staged: &[Staged]) -> Result<(), FileError> {
 /// written, and removes temporary files a crash left before that. Returns whether a save was
 /// finished. Readers of a saved folder call it before reading.
 pub fn recover(dir: &Path) -> Result<bool, FileError> {
+    file_system(dir, FileAction::Read)?;
     let journal_path = dir.join(JOURNAL_FILE);
     let finished = match std::fs::read_to_string(&journal_path) {
         Ok(text) => match ron::from_str::<Vec<Staged>>(&text) {

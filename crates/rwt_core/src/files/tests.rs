@@ -269,3 +269,19 @@ fn a_save_interrupted_after_its_journal_is_finished_by_recover() {
     assert_eq!(recover(&dir), Ok(false));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn without_a_file_system_files_are_a_typed_error_naming_path_and_action() {
+    const { assert!(HAS_FILE_SYSTEM, "tests run where files exist") };
+    let path = Path::new("painted/flowers.png");
+    assert!(require_files(true, path, FileAction::Create).is_ok());
+    let err = require_files(false, path, FileAction::Create).unwrap_err();
+    assert!(
+        matches!(&err, FileError::NoFileSystem { path: p, action: FileAction::Create } if p == path),
+        "{err:?}"
+    );
+    assert_eq!(
+        err.to_string(),
+        "painted/flowers.png: cannot create on the web: a browser's page has no file system"
+    );
+}

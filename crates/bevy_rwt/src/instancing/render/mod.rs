@@ -35,7 +35,7 @@ mod uniforms;
 #[cfg(feature = "testing")]
 pub(super) use cull::{CullSnapshot, FrameCheck, check_culling, extract_culling_check};
 #[cfg(feature = "testing")]
-pub use cull::{CullingCheck, CullingReport};
+pub use cull::{CullingCheck, CullingReport, gpu_culling_supported};
 pub(super) use cull::{cull_instances, cull_late, encode_cull, init_culler};
 pub(super) use depth::{
     DrawInstancedDepth, InstancedDepthPipeline, init_depth_pipeline, queue_prepass, queue_shadows,

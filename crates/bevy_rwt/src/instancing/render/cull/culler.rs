@@ -142,7 +142,7 @@ pub(in crate::instancing) fn init_culler(
         ),
     );
     let pyramids = Pyramids::new(&device);
-    let pipeline = culls_on(&device, &adapter).then(|| {
+    let pipeline = gpu_culling_supported(&device, &adapter).then(|| {
         cache.queue_compute_pipeline(ComputePipelineDescriptor {
             label: Some("rwt_cull".into()),
             layout: vec![layout.clone(), pyramids.layout().clone()],
@@ -168,9 +168,11 @@ pub(in crate::instancing) fn init_culler(
     });
 }
 
-/// Whether the adapter runs the culling pass: compute shaders (not WebGL2-class adapters,
-/// nor limits that emulate them), indirect draws, and storage buffers enough.
-fn culls_on(device: &RenderDevice, adapter: &RenderAdapter) -> bool {
+/// Whether the adapter runs the culling pass of [`InstanceCulling`](crate::InstanceCulling)'s
+/// `Auto` and `PerInstance`: compute shaders (not WebGL2-class adapters, nor limits that
+/// emulate them), indirect draws, and storage buffers enough. Where it does not, every kept
+/// chunk is drawn whole, directly (the main world has both resources, to tell a user).
+pub fn gpu_culling_supported(device: &RenderDevice, adapter: &RenderAdapter) -> bool {
     let limits = device.limits();
     let flags = adapter.get_downlevel_capabilities().flags;
     flags.contains(DownlevelFlags::COMPUTE_SHADERS | DownlevelFlags::INDIRECT_EXECUTION)

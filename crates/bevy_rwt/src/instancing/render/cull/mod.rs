@@ -44,6 +44,7 @@ pub(in crate::instancing) use check::{
 };
 #[cfg(feature = "testing")]
 pub use check::{CullingCheck, CullingReport};
+pub use culler::gpu_culling_supported;
 pub(in crate::instancing) use culler::{InstanceCuller, init_culler};
 pub(in crate::instancing) use frame::{cull_instances, encode_cull};
 pub(in crate::instancing) use occlusion::cull_late;

@@ -1,7 +1,10 @@
-//! The vegetation: every plant and rock is placed by a `bevy_rwt` layer (none by hand).
-//! Trees, bushes, ferns, rocks and flowers are the asset pack's glTF files
-//! ([`rwt_examples::pack`]), drawn instanced as asset classes; grass is rwt's own look.
+//! The open world's vegetation: every plant and rock is placed by a `bevy_rwt` layer (none
+//! by hand). Trees, bushes, ferns, rocks and flowers are the asset pack's glTF files
+//! ([`crate::pack`]), drawn instanced as asset classes; grass is rwt's own look.
 
+use crate::forest::{ForestCover, asset_tree_layer};
+use crate::pack::{PACK, flowers};
+use crate::terrain::{Terrain, WATER};
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::layers::file::NamedAssets;
@@ -11,9 +14,6 @@ use bevy_rwt::prelude::*;
 use glam::DVec2;
 use noise::{NoiseFn, Perlin};
 use rwt_core::density::{Density, NoiseDensity, NoiseParams};
-use rwt_examples::forest::{ForestCover, asset_tree_layer};
-use rwt_examples::pack::{PACK, flowers};
-use rwt_examples::terrain::{Terrain, WATER};
 use std::sync::Arc;
 
 /// The painted maps: `MAP_TEXELS` a side over `MAP_SIZE` metres centred on the origin.

@@ -1,0 +1,93 @@
+//! open_world's world in a browser: grass, flowers, ferns, bushes, rocks and forests from
+//! the asset pack, streamed by `bevy_rwt` around a fly camera, with the density brush.
+//!
+//! `scripts/web.sh` builds it for WebGL2 and for WebGPU into `target/web` (serve that folder
+//! and open `index.html`; `?backend=webgl2` or `?backend=webgpu` chooses, else WebGPU where
+//! the browser has it). On WebGL2 each kept chunk is drawn whole, directly (no compute
+//! shaders); on WebGPU a compute pass culls each instance. The page's console gets one line
+//! once streaming has settled and 120 frames were timed:
+//! `rwt-web: backend=B instances=N frames=F frame_ms=T` (`scripts/web_test.sh` reads it).
+//!
+//! It also runs natively: `cargo run --release --example web`.
+//! - WASD / arrows fly, Q / E down and up, Shift boosts, hold the right mouse button to
+//!   look, the wheel sets the speed;
+//! - B toggles the brush: left mouse paints, right erases, 1-4 choose the map (saving, F5,
+//!   is a typed error on the web: a page has no files).
+
+mod report;
+
+use bevy::asset::AssetMetaCheck;
+use bevy::prelude::*;
+use bevy_rwt::brush::DensityBrush;
+use bevy_rwt::prelude::*;
+use rwt_examples::prelude::*;
+use rwt_examples::terrain::{Terrain, WATER};
+use rwt_examples::world::{WorldScenePlugin, layers, world_fog};
+
+fn main() {
+    // The browser's page is served the pack that `scripts/web.sh` writes natively.
+    #[cfg(not(target_arch = "wasm32"))]
+    rwt_examples::pack::write_pack();
+    let window = Window {
+        title: "rwt in the browser".into(),
+        canvas: Some("#rwt".into()),
+        fit_canvas_to_parent: true,
+        // Keys and the wheel fly the camera, not the page.
+        prevent_default_event_handling: true,
+        ..default()
+    };
+    let plugins = DefaultPlugins
+        .set(WindowPlugin {
+            primary_window: Some(window),
+            ..default()
+        })
+        // A static site has no `.meta` files: asking for them logs a 404 per asset.
+        .set(AssetPlugin {
+            meta_check: AssetMetaCheck::Never,
+            ..default()
+        });
+    App::new()
+        .add_plugins((plugins, WorldScenePlugin, FlyCameraPlugin))
+        .add_plugins((
+            RwtPlugins::default()
+                .with_max_tasks(32)
+                .build()
+                .enable::<RwtBrushPlugin>(),
+            report::ReportPlugin,
+        ))
+        .add_systems(Startup, (setup_camera, layers::setup_layers))
+        .add_systems(Update, share_mouse)
+        .run();
+}
+
+/// The camera: at the edge of a meadow, looking over grass and flowers towards the forest.
+fn setup_camera(mut commands: Commands, terrain: Res<Terrain>) {
+    let at = Vec2::new(-443.0, -1433.0);
+    let cam = FlyCamera {
+        speed: 20.0,
+        yaw: 0.6,
+        pitch: -0.12,
+        ..default()
+    };
+    let eye = Vec3::new(at.x, terrain.height(at).max(WATER) + 2.5, at.y);
+    commands.spawn((
+        Camera3d::default(),
+        Projection::Perspective(PerspectiveProjection {
+            far: 7000.0,
+            ..default()
+        }),
+        Transform::from_translation(eye).with_rotation(cam.rotation()),
+        cam,
+        RwtViewer::default(),
+        world_fog(),
+    ));
+}
+
+/// The mouse is the brush's while it is on, the camera's otherwise.
+fn share_mouse(brush: Res<DensityBrush>, mut cameras: Query<&mut FlyCamera>) {
+    for mut cam in &mut cameras {
+        if cam.mouse == brush.enabled {
+            cam.mouse = !brush.enabled;
+        }
+    }
+}
