@@ -9,7 +9,7 @@
 # wasm32-unknown-unknown`); otherwise Debian's rustc-web with the standard library's sources
 # (rust-web-src), built with `-Zbuild-std` and linked by wasm-ld (lld-22), installed here when
 # missing. wasm-bindgen-cli comes from crates.io at the lockfile's version, wasm-opt from
-# binaryen (Debian's, else skipped).
+# binaryen 116 or newer (on PATH, else npm's; without either the module is not shrunk).
 #
 #   scripts/web.sh                   # both backends
 #   scripts/web.sh webgl2            # one
@@ -52,7 +52,16 @@ if [ "$("$tools/bin/wasm-bindgen" --version 2>/dev/null | awk '{print $2}')" != 
     echo "installing wasm-bindgen-cli $bindgen_version"
     cargo install -q wasm-bindgen-cli --version "$bindgen_version" --root "$tools"
 fi
-command -v wasm-opt >/dev/null || apt_install binaryen || true
+# wasm-opt from binaryen 116 or newer: older ones (Debian 12's 108) give wasm-bindgen's
+# function table a type its JS cannot fill. npm's binaryen otherwise, else none.
+wasm_opt=""
+if [ "$(wasm-opt --version 2>/dev/null | grep -o '[0-9]\+' | head -1)" -ge 116 ] 2>/dev/null; then
+    wasm_opt=wasm-opt
+elif command -v npm >/dev/null; then
+    [ -x "$tools/node/node_modules/.bin/wasm-opt" ] ||
+        npm install -s --prefix "$tools/node" --no-audit --no-fund binaryen@132 >/dev/null
+    wasm_opt="$tools/node/node_modules/.bin/wasm-opt"
+fi
 
 # The asset pack, written natively (the page loads it over HTTP).
 cargo run -q --example pack
@@ -69,13 +78,8 @@ for backend in "${backends[@]}"; do
     "$tools/bin/wasm-bindgen" --target web --no-typescript --out-dir "$site/$backend" \
         --out-name rwt_web "$wasm"
     module="$site/$backend/rwt_web_bg.wasm"
-    if command -v wasm-opt >/dev/null; then
-        # The features rustc's wasm32 target enables, no more: with all of binaryen's
-        # (typed function references), wasm-bindgen's function table gets a type its JS
-        # cannot fill.
-        wasm-opt -Os --enable-bulk-memory --enable-multivalue --enable-mutable-globals \
-            --enable-nontrapping-float-to-int --enable-reference-types --enable-sign-ext \
-            "$module" -o "$module.opt" && mv "$module.opt" "$module"
+    if [ -n "$wasm_opt" ]; then
+        "$wasm_opt" -Os "$module" -o "$module.opt" && mv "$module.opt" "$module"
     fi
     echo "rwt-web-build: $backend $(stat -c %s "$module") bytes ($(( $(stat -c %s "$module") / 1048576 )) MiB, $(gzip -9c "$module" | wc -c) gzipped) in $(( $(date +%s) - t0 )) s"
 done

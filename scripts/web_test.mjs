@@ -14,6 +14,9 @@ import { extname, join, normalize } from "node:path";
 
 const [site, out, ...backends] = process.argv.slice(2);
 const LIMIT_S = Number(process.env.RWT_WEB_LIMIT_S ?? 900);
+// The share of the vegetation the page grows (its `?detail=`): SwiftShader pays for every
+// instance drawn, tens of microseconds each, so the whole world takes about 40 s a frame.
+const DETAIL = process.env.RWT_WEB_DETAIL ?? "0.02";
 // The page's size: RWT_WEB_SIZE=1280x720 for pictures; smaller renders faster on SwiftShader.
 const [WIDTH, HEIGHT] = (process.env.RWT_WEB_SIZE ?? "640x360").split("x").map(Number);
 const REPORT = /^rwt-web: backend=(\S+) instances=(\d+) frames=(\d+) frame_ms=([\d.]+)$/;
@@ -65,7 +68,9 @@ async function run(port, backend) {
       page.on("console", (msg) => {
         const text = msg.text();
         appendFileSync(logFile, `${((Date.now() - started) / 1000).toFixed(1)} ${msg.type()}: ${text}\n`);
-        if (text.includes("rwt-web:")) console.log(`[${backend}] ${text}`);
+        // tracing's lines carry a level, a place and CSS: keep the message.
+        const line = text.match(/rwt-web: [^%]*?(?= color:|$)/);
+        if (line) console.log(`[${backend}] ${line[0]}`);
         if (msg.type() === "error") problems.push(`console error: ${text}`);
         const m = text.match(REPORT);
         if (m) ok((report = m));
@@ -73,7 +78,7 @@ async function run(port, backend) {
     });
     page.on("pageerror", (e) => problems.push(`uncaught: ${e.message}`));
     page.on("response", (r) => r.status() >= 400 && problems.push(`HTTP ${r.status()}: ${r.url()}`));
-    await page.goto(`http://127.0.0.1:${port}/index.html?backend=${backend}&clean`);
+    await page.goto(`http://127.0.0.1:${port}/index.html?backend=${backend}&clean&detail=${DETAIL}`);
     const limit = new Promise((ok) => setTimeout(ok, LIMIT_S * 1000));
     const failed = new Promise((ok) => {
       const poll = setInterval(() => problems.length && (clearInterval(poll), ok()), 500);

@@ -8,6 +8,9 @@
 //! once streaming has settled and 120 frames were timed:
 //! `rwt-web: backend=B instances=N frames=F frame_ms=T` (`scripts/web_test.sh` reads it).
 //!
+//! `?detail=D` (0 < D <= 1) grows that share of the vegetation, in the same places: for weak
+//! devices and the browser test (SwiftShader pays for every instance drawn).
+//!
 //! It also runs natively: `cargo run --release --example web`.
 //! - WASD / arrows fly, Q / E down and up, Shift boosts, hold the right mouse button to
 //!   look, the wheel sets the speed;
@@ -22,6 +25,7 @@ use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::{Terrain, WATER};
+use rwt_examples::world::layers::Detail;
 use rwt_examples::world::{WorldScenePlugin, layers, world_fog};
 
 fn main() {
@@ -47,6 +51,7 @@ fn main() {
             ..default()
         });
     App::new()
+        .insert_resource(detail())
         .add_plugins((plugins, WorldScenePlugin, FlyCameraPlugin))
         .add_plugins((
             RwtPlugins::default()
@@ -81,6 +86,27 @@ fn setup_camera(mut commands: Commands, terrain: Res<Terrain>) {
         RwtViewer::default(),
         world_fog(),
     ));
+}
+
+/// The share of the vegetation to grow: the page's `?detail=D` (natively `RWT_DETAIL`),
+/// over 0 and at most 1, else all of it.
+fn detail() -> Detail {
+    #[cfg(target_arch = "wasm32")]
+    let setting = {
+        let get = |v: &_, key: &str| js_sys::Reflect::get(v, &key.into()).ok();
+        let search = get(&js_sys::global(), "location").and_then(|l| get(&l, "search"));
+        search.and_then(|q| q.as_string()).and_then(|q| {
+            let q = q.trim_start_matches('?').to_owned();
+            q.split('&')
+                .find_map(|kv| kv.strip_prefix("detail=").map(str::to_owned))
+        })
+    };
+    #[cfg(not(target_arch = "wasm32"))]
+    let setting = std::env::var("RWT_DETAIL").ok();
+    setting
+        .and_then(|d| d.parse::<f64>().ok())
+        .filter(|d| *d > 0.0 && *d <= 1.0)
+        .map_or(Detail::default(), Detail)
 }
 
 /// The mouse is the brush's while it is on, the camera's otherwise.

@@ -13,7 +13,7 @@ use bevy_rwt::look::{blade_mesh, far_blade_mesh};
 use bevy_rwt::prelude::*;
 use glam::DVec2;
 use noise::{NoiseFn, Perlin};
-use rwt_core::density::{Density, NoiseDensity, NoiseParams};
+use rwt_core::density::{Density, NoiseDensity, NoiseParams, Scale};
 use std::sync::Arc;
 
 /// The painted maps: `MAP_TEXELS` a side over `MAP_SIZE` metres centred on the origin.
@@ -34,6 +34,45 @@ const FLOWER_LOD: f32 = 15.0;
 /// with the file's collider (metres).
 const PROMOTION: f32 = 14.0;
 
+/// How much of the world's vegetation grows: 1 (the default) is the showcase's; less
+/// keeps that share of every layer's instances, in the same places (a lower density only
+/// takes points away). For weak devices and software renderers: SwiftShader, the browser
+/// test's, pays for every instance drawn.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct Detail(pub f64);
+
+impl Default for Detail {
+    fn default() -> Self {
+        Self(1.0)
+    }
+}
+
+impl Detail {
+    /// `layer` with every class's density scaled by the detail.
+    fn thin(self, mut layer: ScatterLayer) -> ScatterLayer {
+        if self.0 == 1.0 {
+            return layer;
+        }
+        for class in &mut layer.classes {
+            class.density = match std::mem::replace(&mut class.density, LayerDensity::Constant(0.0))
+            {
+                LayerDensity::Constant(c) => LayerDensity::Constant(c * self.0),
+                LayerDensity::Noise(n) => LayerDensity::Noise(NoiseDensity::new(NoiseParams {
+                    scale: n.params().scale * self.0,
+                    ..n.params()
+                })),
+                LayerDensity::Image(mut map) => {
+                    map.scale *= self.0;
+                    LayerDensity::Image(map)
+                }
+                LayerDensity::Custom(d) => LayerDensity::Custom(Arc::new(Scale(d, self.0))),
+                other => other,
+            };
+        }
+        layer
+    }
+}
+
 /// Spawns the layers and aims the brush at the flower and bush maps.
 #[allow(clippy::too_many_arguments)]
 pub fn setup_layers(
@@ -45,7 +84,9 @@ pub fn setup_layers(
     mut images: ResMut<Assets<Image>>,
     mut brush: ResMut<DensityBrush>,
     names: Res<NamedAssets>,
+    detail: Option<Res<Detail>>,
 ) {
+    let detail = detail.map_or(Detail::default(), |d| *d);
     let white = materials.add(StandardMaterial {
         perceptual_roughness: 0.9,
         reflectance: 0.2,
@@ -65,19 +106,22 @@ pub fn setup_layers(
     )
     .with_height_range(WATER + 1.5, 112.0)
     .with_max_slope(0.6);
-    commands.spawn((Name::new("trees"), trees));
+    commands.spawn((Name::new("trees"), detail.thin(trees)));
     let rocks = rocks(&ground, look(PACK.rock));
-    commands.spawn((Name::new("rocks"), rocks));
-    commands.spawn((Name::new("grass"), grass(&ground, &mut meshes)));
+    commands.spawn((Name::new("rocks"), detail.thin(rocks)));
+    let grass = grass(&ground, &mut meshes);
+    commands.spawn((Name::new("grass"), detail.thin(grass)));
     let ferns = ferns(&ground, look(PACK.fern));
-    commands.spawn((Name::new("ferns"), ferns));
+    commands.spawn((Name::new("ferns"), detail.thin(ferns)));
     let (flowers, flower_targets) = flowers(&ground, server.load(PACK.flowers), &mut images);
-    let flowers = commands.spawn((Name::new("flowers"), flowers)).id();
+    let flowers = commands
+        .spawn((Name::new("flowers"), detail.thin(flowers)))
+        .id();
     let bush_density = painted_map(&mut images, 9, 0.05, 120.0);
     let bushes = commands
         .spawn((
             Name::new("bushes"),
-            bushes(&ground, bush_density, look(PACK.bush)),
+            detail.thin(bushes(&ground, bush_density, look(PACK.bush))),
         ))
         .id();
     brush.targets = flower_targets
@@ -309,4 +353,50 @@ fn flowers(
         .iter()
         .map(|(n, _, _)| format!("{n} flowers"));
     (layer, maps.collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rwt_core::density::Constant;
+
+    /// Each class's density as a query reads it, at a few places.
+    fn sampled(layer: &ScatterLayer, images: &Assets<Image>) -> Vec<f64> {
+        let places = [DVec2::new(3.0, -7.0), DVec2::new(250.0, 40.0)];
+        let resolved = layer
+            .classes
+            .iter()
+            .map(|c| c.density.resolve(images).unwrap());
+        resolved
+            .flat_map(|d| places.map(|p| d.density(p)))
+            .collect()
+    }
+
+    #[test]
+    fn detail_scales_every_kind_of_density_and_one_leaves_the_layer_as_it_is() {
+        let images = Assets::<Image>::default();
+        let noise = NoiseDensity::new(NoiseParams {
+            seed: 3,
+            frequency: 1.0 / 120.0,
+            octaves: 3,
+            base: 0.45,
+            amplitude: 0.9,
+            scale: 140.0,
+        });
+        let layer = || {
+            let class = |d| ScatterClass::new(d, Handle::default(), Handle::default());
+            ScatterLayer::new(vec![
+                class(LayerDensity::Constant(2.0)),
+                class(LayerDensity::Noise(noise.clone())),
+                class(LayerDensity::Custom(Arc::new(Constant(0.5)))),
+            ])
+        };
+        let full = sampled(&layer(), &images);
+        assert!(full.iter().all(|d| *d > 0.0), "{full:?}");
+        assert_eq!(sampled(&Detail(1.0).thin(layer()), &images), full);
+        let thinned = sampled(&Detail(0.25).thin(layer()), &images);
+        for (t, f) in thinned.iter().zip(&full) {
+            assert!((t - f * 0.25).abs() <= 1e-9 * f, "{t} against {f}");
+        }
+    }
 }
