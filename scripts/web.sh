@@ -13,6 +13,7 @@
 #
 #   scripts/web.sh                   # both backends
 #   scripts/web.sh webgl2            # one
+#   RWT_WEB_OPT=0 scripts/web.sh     # without wasm-opt (faster; the module twice as large)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 backends=(webgl2 webgpu)
@@ -55,7 +56,9 @@ fi
 # wasm-opt from binaryen 116 or newer: older ones (Debian 12's 108) give wasm-bindgen's
 # function table a type its JS cannot fill. npm's binaryen otherwise, else none.
 wasm_opt=""
-if [ "$(wasm-opt --version 2>/dev/null | grep -o '[0-9]\+' | head -1)" -ge 116 ] 2>/dev/null; then
+if [ "${RWT_WEB_OPT:-1}" = 0 ]; then
+    echo "rwt-web-build: not shrinking the modules (RWT_WEB_OPT=0)"
+elif [ "$(wasm-opt --version 2>/dev/null | grep -o '[0-9]\+' | head -1)" -ge 116 ] 2>/dev/null; then
     wasm_opt=wasm-opt
 elif command -v npm >/dev/null; then
     [ -x "$tools/node/node_modules/.bin/wasm-opt" ] ||

@@ -50,7 +50,7 @@ impl Report {
 }
 
 fn report(
-    time: Res<Time>,
+    // Wall-clock time: the game's clock clamps a frame to 250 ms.
     real: Res<Time<Real>>,
     stats: Res<RwtStats>,
     info: Option<Res<RenderAdapterInfo>>,
@@ -74,7 +74,7 @@ fn report(
         }
         return;
     }
-    state.timed.push(time.delta_secs() * 1000.0);
+    state.timed.push(real.delta_secs() * 1000.0);
     if state.timed.len() <= TIMED {
         return;
     }
