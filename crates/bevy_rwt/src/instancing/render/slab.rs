@@ -295,6 +295,10 @@ impl InstanceSlab {
     /// the old one's instances copied over; `false` past one binding's limit.
     fn grow(&mut self, len: u32, device: &RenderDevice, queue: &RenderQueue) -> bool {
         let limit = most_instances(device);
+        if limit == 0 {
+            // No storage buffers (WebGL2): nothing culls, every chunk draws its own buffer.
+            return false;
+        }
         let old = self.ranges.capacity;
         // The free range at the end, if any, grows with the buffer.
         let tail = self
