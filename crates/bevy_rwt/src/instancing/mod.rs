@@ -37,6 +37,7 @@ pub(crate) use pack::{InstancedClasses, PackedClass};
 pub use plugin::RwtInstancingPlugin;
 pub use promote::PromotedInstance;
 pub(crate) use queue::{InstancedQueue, UploadSources};
+pub use render::gpu_culling_supported;
 #[cfg(feature = "testing")]
-pub use render::{CullingCheck, CullingReport, gpu_culling_supported};
+pub use render::{CullingCheck, CullingReport};
 pub use settings::{CascadeCasters, InstanceCulling, RwtFadeIn, RwtWind};

@@ -32,10 +32,11 @@ mod slab;
 mod slices;
 mod uniforms;
 
+pub use cull::gpu_culling_supported;
 #[cfg(feature = "testing")]
 pub(super) use cull::{CullSnapshot, FrameCheck, check_culling, extract_culling_check};
 #[cfg(feature = "testing")]
-pub use cull::{CullingCheck, CullingReport, gpu_culling_supported};
+pub use cull::{CullingCheck, CullingReport};
 pub(super) use cull::{cull_instances, cull_late, encode_cull, init_culler};
 pub(super) use depth::{
     DrawInstancedDepth, InstancedDepthPipeline, init_depth_pipeline, queue_prepass, queue_shadows,
