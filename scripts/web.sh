@@ -32,16 +32,17 @@ apt_install() {
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
 }
 
-# The wasm32 toolchain: `cargo_wasm ARGS...` builds for wasm32-unknown-unknown.
-export RUSTFLAGS="${RUSTFLAGS:-} --cfg getrandom_backend=\"wasm_js\""
+# The wasm32 toolchain: `cargo_wasm ARGS...` builds for wasm32-unknown-unknown (its own
+# RUSTFLAGS: set for native builds too, they would rebuild those from scratch).
+wasm_flags="${RUSTFLAGS:-} --cfg getrandom_backend=\"wasm_js\""
 if rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
-    cargo_wasm() { cargo build --target wasm32-unknown-unknown "$@"; }
+    cargo_wasm() { RUSTFLAGS="$wasm_flags" cargo build --target wasm32-unknown-unknown "$@"; }
 else
     apt_install rustc-web cargo-web rust-web-src lld-22
     # Debian's cargo and rustc (beside rustup's, which stay first on PATH) build the standard
     # library from its sources; its own dependencies come from crates.io.
     cargo_wasm() {
-        RUSTC=/usr/bin/rustc RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
+        RUSTFLAGS="$wasm_flags" RUSTC=/usr/bin/rustc RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
             CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_LINKER=wasm-ld-22 \
             /usr/bin/cargo build -Zbuild-std=std,panic_abort --target wasm32-unknown-unknown "$@"
     }

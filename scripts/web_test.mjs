@@ -14,9 +14,13 @@ import { extname, join, normalize } from "node:path";
 
 const [site, out, ...backends] = process.argv.slice(2);
 const LIMIT_S = Number(process.env.RWT_WEB_LIMIT_S ?? 900);
+const SHOT_S = Number(process.env.RWT_WEB_SHOT_S ?? 180);
 // The share of the vegetation the page grows (its `?detail=`): SwiftShader pays for every
 // instance drawn, tens of microseconds each, so the whole world takes about 40 s a frame.
 const DETAIL = process.env.RWT_WEB_DETAIL ?? "0.02";
+// Frames the page times once settled (its `?frames=`; 120 unless set): fewer for pictures
+// of a denser world, whose frames take many seconds in SwiftShader.
+const FRAMES = process.env.RWT_WEB_FRAMES ? `&frames=${process.env.RWT_WEB_FRAMES}` : "";
 // The page's size: RWT_WEB_SIZE=1280x720 for pictures; smaller renders faster on SwiftShader.
 const [WIDTH, HEIGHT] = (process.env.RWT_WEB_SIZE ?? "640x360").split("x").map(Number);
 const REPORT = /^rwt-web: backend=(\S+) instances=(\d+) frames=(\d+) frame_ms=([\d.]+)$/;
@@ -78,7 +82,7 @@ async function run(port, backend) {
     });
     page.on("pageerror", (e) => problems.push(`uncaught: ${e.message}`));
     page.on("response", (r) => r.status() >= 400 && problems.push(`HTTP ${r.status()}: ${r.url()}`));
-    await page.goto(`http://127.0.0.1:${port}/index.html?backend=${backend}&clean&detail=${DETAIL}`);
+    await page.goto(`http://127.0.0.1:${port}/index.html?backend=${backend}&clean&detail=${DETAIL}${FRAMES}`);
     const limit = new Promise((ok) => setTimeout(ok, LIMIT_S * 1000));
     const failed = new Promise((ok) => {
       const poll = setInterval(() => problems.length && (clearInterval(poll), ok()), 500);
@@ -86,9 +90,10 @@ async function run(port, backend) {
     await Promise.race([reported, limit, failed]);
     // The second report line (culling, slowest frame) follows the first.
     await page.waitForTimeout(2000);
-    // A busy page (the module compiling, SwiftShader drawing) is slow to capture.
+    // A busy page (the module compiling, SwiftShader drawing) is slow to capture: up to
+    // RWT_WEB_SHOT_S seconds (a denser world's frames take tens of seconds each).
     await page
-      .screenshot({ path: join(out, `${backend}.png`), timeout: 180_000 })
+      .screenshot({ path: join(out, `${backend}.png`), timeout: SHOT_S * 1000 })
       .catch((e) => problems.push(`no screenshot: ${e.message.split("\n")[0]}`));
   } finally {
     await browser.close();

@@ -3,6 +3,7 @@
 //! far trees drawn both ways ([`FarTrees`]).
 
 use crate::foliage;
+use crate::terrain::{Terrain, WATER};
 use bevy::prelude::*;
 use bevy_rwt::look::asset::{AssetLods, AssetLook};
 use bevy_rwt::prelude::*;
@@ -62,6 +63,31 @@ impl Density for ForestCover {
     fn min_over(&self, min: DVec2, max: DVec2) -> f64 {
         self.0.iter().map(|f| f.min_over(min, max)).sum()
     }
+}
+
+/// A place near `p` in open ground that looks at a forest about 35 m ahead (its ferns in
+/// view), and the yaw that looks there.
+pub fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
+    let cover = ForestCover::new();
+    let density = |q: Vec2| cover.density(glam::DVec2::new(q.x as f64, q.y as f64));
+    let mut best = (f64::MIN, p, 0.0);
+    for ring in 0..30 {
+        for k in 0..24 {
+            let a = k as f32 / 24.0 * std::f32::consts::TAU;
+            let at = p + Vec2::from_angle(a) * (ring as f32 * 40.0);
+            for j in 0..8 {
+                let yaw = j as f32 / 8.0 * std::f32::consts::TAU;
+                // FlyCamera looks along -z turned by yaw.
+                let ahead = at + Vec2::new(-yaw.sin(), -yaw.cos()) * 35.0;
+                let dry = terrain.height(at) > WATER + 2.0 && terrain.height(ahead) > WATER + 2.0;
+                let score = density(ahead) - 3.0 * density(at) - 1e-6 * ring as f64;
+                if dry && score > best.0 {
+                    best = (score, at, yaw);
+                }
+            }
+        }
+    }
+    (best.1, best.2)
 }
 
 /// How far trees are drawn.

@@ -10,8 +10,7 @@ use crate::play::{Play, play};
 use bevy::prelude::*;
 use bevy_rwt::brush::{BrushCommand, BrushSystems, DensityBrush, PaintDab};
 use bevy_rwt::prelude::*;
-use bevy_rwt::rwt_core::density::Density;
-use rwt_examples::forest::ForestCover;
+use rwt_examples::forest::forest_edge;
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::{Terrain, WATER};
 
@@ -196,31 +195,6 @@ fn end_pose(view: View, terrain: &Terrain, (p, yaw): (Vec2, f32)) -> (Vec3, f32,
             (Vec3::new(at.x, ground(at) + 2.0, at.y), yaw, 0.0)
         }
     }
-}
-
-/// A place near `p` in open ground that looks at a forest about 35 m ahead (its ferns in
-/// view), and the yaw that looks there.
-fn forest_edge(terrain: &Terrain, p: Vec2) -> (Vec2, f32) {
-    let cover = ForestCover::new();
-    let density = |q: Vec2| cover.density(glam::DVec2::new(q.x as f64, q.y as f64));
-    let mut best = (f64::MIN, p, 0.0);
-    for ring in 0..30 {
-        for k in 0..24 {
-            let a = k as f32 / 24.0 * std::f32::consts::TAU;
-            let at = p + Vec2::from_angle(a) * (ring as f32 * 40.0);
-            for j in 0..8 {
-                let yaw = j as f32 / 8.0 * std::f32::consts::TAU;
-                // FlyCamera looks along -z turned by yaw.
-                let ahead = at + Vec2::new(-yaw.sin(), -yaw.cos()) * 35.0;
-                let dry = terrain.height(at) > WATER + 2.0 && terrain.height(ahead) > WATER + 2.0;
-                let score = density(ahead) - 3.0 * density(at) - 1e-6 * ring as f64;
-                if dry && score > best.0 {
-                    best = (score, at, yaw);
-                }
-            }
-        }
-    }
-    (best.1, best.2)
 }
 
 /// Live instances of the layer the stroke paints, once it has settled.

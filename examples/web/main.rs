@@ -9,7 +9,8 @@
 //! `rwt-web: backend=B instances=N frames=F frame_ms=T` (`scripts/web_test.sh` reads it).
 //!
 //! `?detail=D` (0 < D <= 1) grows that share of the vegetation, in the same places: for weak
-//! devices and the browser test (SwiftShader pays for every instance drawn).
+//! devices and the browser test (SwiftShader pays for every instance drawn). `?frames=F`
+//! times F frames instead of 120 (for pictures on slow renderers).
 //!
 //! It also runs natively: `cargo run --release --example web`.
 //! - WASD / arrows fly, Q / E down and up, Shift boosts, hold the right mouse button to
@@ -23,6 +24,7 @@ use bevy::asset::AssetMetaCheck;
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
+use rwt_examples::forest::forest_edge;
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::{Terrain, WATER};
 use rwt_examples::world::layers::Detail;
@@ -58,23 +60,23 @@ fn main() {
                 .with_max_tasks(32)
                 .build()
                 .enable::<RwtBrushPlugin>(),
-            report::ReportPlugin,
+            report(),
         ))
         .add_systems(Startup, (setup_camera, layers::setup_layers))
         .add_systems(Update, share_mouse)
         .run();
 }
 
-/// The camera: at the edge of a meadow, looking over grass and flowers towards the forest.
+/// The camera: in a meadow, looking over grass and flowers at a forest's edge.
 fn setup_camera(mut commands: Commands, terrain: Res<Terrain>) {
-    let at = Vec2::new(-443.0, -1433.0);
+    let (at, yaw) = forest_edge(&terrain, Vec2::new(-443.0, -1433.0));
     let cam = FlyCamera {
         speed: 20.0,
-        yaw: 0.6,
-        pitch: -0.12,
+        yaw,
+        pitch: -0.06,
         ..default()
     };
-    let eye = Vec3::new(at.x, terrain.height(at).max(WATER) + 2.5, at.y);
+    let eye = Vec3::new(at.x, terrain.height(at).max(WATER) + 2.0, at.y);
     commands.spawn((
         Camera3d::default(),
         Projection::Perspective(PerspectiveProjection {
@@ -88,25 +90,43 @@ fn setup_camera(mut commands: Commands, terrain: Res<Terrain>) {
     ));
 }
 
-/// The share of the vegetation to grow: the page's `?detail=D` (natively `RWT_DETAIL`),
-/// over 0 and at most 1, else all of it.
-fn detail() -> Detail {
+/// The page's setting `?key=value` (natively the environment variable `env`).
+fn setting(key: &str, env: &str) -> Option<String> {
     #[cfg(target_arch = "wasm32")]
-    let setting = {
-        let get = |v: &_, key: &str| js_sys::Reflect::get(v, &key.into()).ok();
-        let search = get(&js_sys::global(), "location").and_then(|l| get(&l, "search"));
-        search.and_then(|q| q.as_string()).and_then(|q| {
-            let q = q.trim_start_matches('?').to_owned();
-            q.split('&')
-                .find_map(|kv| kv.strip_prefix("detail=").map(str::to_owned))
-        })
-    };
+    {
+        let _ = env;
+        let get = |v: &_, name: &str| js_sys::Reflect::get(v, &name.into()).ok();
+        let search = get(&js_sys::global(), "location").and_then(|l| get(&l, "search"))?;
+        let query = search.as_string()?;
+        let prefix = format!("{key}=");
+        query
+            .trim_start_matches('?')
+            .split('&')
+            .find_map(|kv| kv.strip_prefix(prefix.as_str()).map(str::to_owned))
+    }
     #[cfg(not(target_arch = "wasm32"))]
-    let setting = std::env::var("RWT_DETAIL").ok();
-    setting
+    {
+        let _ = key;
+        std::env::var(env).ok()
+    }
+}
+
+/// The share of the vegetation to grow: `?detail=D` (natively `RWT_DETAIL`), over 0 and at
+/// most 1, else all of it.
+fn detail() -> Detail {
+    setting("detail", "RWT_DETAIL")
         .and_then(|d| d.parse::<f64>().ok())
         .filter(|d| *d > 0.0 && *d <= 1.0)
         .map_or(Detail::default(), Detail)
+}
+
+/// The report, timing `?frames=F` frames (natively `RWT_FRAMES`; at least 1) once settled,
+/// else [`report::TIMED`].
+fn report() -> report::ReportPlugin {
+    let frames = setting("frames", "RWT_FRAMES").and_then(|f| f.parse::<usize>().ok());
+    report::ReportPlugin {
+        frames: frames.filter(|f| *f > 0).unwrap_or(report::TIMED),
+    }
 }
 
 /// The mouse is the brush's while it is on, the camera's otherwise.

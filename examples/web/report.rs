@@ -1,6 +1,7 @@
 //! The page's report: once streaming has settled (no generation task pending, the live
-//! instances unchanged for [`STEADY`] frames), [`TIMED`] frames are timed and one line goes
-//! to the console, `rwt-web: backend=B instances=N frames=F frame_ms=T`, then a second,
+//! instances unchanged for [`STEADY`] frames), [`TIMED`] frames (or as many as the page
+//! asks) are timed and one line goes to the console,
+//! `rwt-web: backend=B instances=N frames=F frame_ms=T`, then a second,
 //! `rwt-web: culling=C slowest_ms=S`: per instance on the GPU, or per chunk where the
 //! adapter has no compute shaders (WebGL2).
 
@@ -11,25 +12,32 @@ use bevy_rwt::instancing::gpu_culling_supported;
 
 /// Frames the live instances stay unchanged, with no task pending, to count as settled.
 const STEADY: u32 = 30;
-/// Frames timed once settled.
-const TIMED: usize = 120;
+/// Frames timed once settled, unless the page asks for another number.
+pub const TIMED: usize = 120;
 /// Frames after which the report is written even if streaming never settled (it then says
 /// so, as an error the browser test fails on).
 const GIVE_UP: u32 = 3000;
 /// Seconds between the progress lines written while streaming settles.
 const PROGRESS_S: f32 = 10.0;
 
-/// Writes the report.
-pub struct ReportPlugin;
+/// Writes the report after timing `frames` frames.
+pub struct ReportPlugin {
+    pub frames: usize,
+}
 
 impl Plugin for ReportPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<Report>().add_systems(Last, report);
+        app.insert_resource(Report {
+            frames: self.frames,
+            ..default()
+        })
+        .add_systems(Last, report);
     }
 }
 
 #[derive(Resource, Default)]
 struct Report {
+    frames: usize,
     frame: u32,
     steady: u32,
     instances: usize,
@@ -75,7 +83,7 @@ fn report(
         return;
     }
     state.timed.push(real.delta_secs() * 1000.0);
-    if state.timed.len() <= TIMED {
+    if state.timed.len() <= state.frames {
         return;
     }
     state.done = true;
