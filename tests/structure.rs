@@ -7,9 +7,10 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-const CRATES: [&str; 4] = [
+const CRATES: [&str; 5] = [
     "crates/rwt_core/src",
     "crates/bevy_rwt/src",
+    "crates/bevy_rwt_net/src",
     "crates/rwt_cli/src",
     "crates/rwt_py/src",
 ];

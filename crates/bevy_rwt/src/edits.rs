@@ -98,7 +98,37 @@ impl EditInstance {
     }
 }
 
-/// Why an [`EditInstance`] was not applied (logged).
+/// Who applies the game's [`EditInstance`]s: this app (the default), or a remote authority
+/// such as a multiplayer server (`bevy_rwt_net` makes a joined client's edits requests to
+/// its server). Under [`EditAuthority::Remote`] the plugin applies only [`ConfirmedEdit`]s
+/// and leaves the game's edits to whoever forwards them.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
+#[reflect(Resource, Clone, Debug, Default, PartialEq)]
+pub enum EditAuthority {
+    /// The plugin applies the game's edits.
+    #[default]
+    Local,
+    /// The game's edits are requests to another app; only confirmed ones apply.
+    Remote,
+}
+
+/// An edit its authority confirmed (a multiplayer server's): applied, with an
+/// [`EditOutcome`], whatever the [`EditAuthority`].
+#[derive(Message, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ConfirmedEdit(pub EditInstance);
+
+/// What became of an [`EditInstance`] or a [`ConfirmedEdit`]: the plugin writes one for each it reads, in order,
+/// in [`crate::RwtSystems::Plan`] (read it after that set). A game shows why a chop failed;
+/// a server that replicates edits sends on the applied ones.
+#[derive(Message, Clone, Debug, PartialEq)]
+pub struct EditOutcome {
+    /// The edit.
+    pub edit: EditInstance,
+    /// Whether it was applied, or why not.
+    pub result: Result<(), EditError>,
+}
+
+/// Why an [`EditInstance`] was not applied (logged, and in its [`EditOutcome`]).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum EditError {
     /// The entity has no [`crate::ScatterLayer`].

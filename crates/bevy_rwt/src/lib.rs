@@ -185,7 +185,7 @@ use rwt_core::tileset::TileSet;
 pub use settings::{RwtSettings, RwtSystems};
 use std::sync::Arc;
 pub use streaming::RwtStreamingPlugin;
-pub use streaming::{ChunkLoaded, ChunkUnloaded, DensityMapPainted};
+pub use streaming::{ChunkLoaded, ChunkUnloaded, DensityMapPainted, RwtTileSet};
 pub use viewers::{RwtViewer, RwtViewersPlugin, ViewCone};
 
 /// Everything a game needs.

@@ -2,7 +2,10 @@
 //! chunk's edits, and the entity look despawns or swaps an edited instance at once.
 
 use super::{LayerState, RwtTileSet};
-use crate::edits::{EditError, EditInstance, EditSet, InstanceEdit, ScatterEdits};
+use crate::edits::{
+    ConfirmedEdit, EditAuthority, EditError, EditInstance, EditOutcome, EditSet, InstanceEdit,
+    ScatterEdits,
+};
 use crate::entities::Spawner;
 use crate::layers::ScatterLayer;
 use crate::settings::RwtSettings;
@@ -12,9 +15,15 @@ use rwt_core::query::{Point, Sampler};
 use rwt_core::streaming::ChunkCoord;
 use std::sync::Arc;
 
-/// Indexes replaced edit sets by chunk, then applies the frame's [`EditInstance`]s.
+/// Indexes replaced edit sets by chunk, then applies the frame's [`EditInstance`]s (where
+/// this app has the [`EditAuthority`]) and [`ConfirmedEdit`]s, telling each one's
+/// [`EditOutcome`].
+#[allow(clippy::too_many_arguments)]
 pub(super) fn apply_edits(
     mut messages: MessageReader<EditInstance>,
+    mut confirmed: MessageReader<ConfirmedEdit>,
+    authority: Res<EditAuthority>,
+    mut outcomes: MessageWriter<EditOutcome>,
     mut layers: Query<(Entity, &ScatterLayer, &mut LayerState, &mut ScatterEdits)>,
     tile_set: Res<RwtTileSet>,
     settings: Res<RwtSettings>,
@@ -27,26 +36,42 @@ pub(super) fn apply_edits(
             index_edits(&mut state, layer, &sampler, edits.edits());
         }
     }
-    for message in messages.read() {
-        let Ok((entity, layer, mut state, mut edits)) = layers.get_mut(message.layer) else {
-            warn!("{}", EditError::NoLayer(message.layer));
-            continue;
+    let local = *authority == EditAuthority::Local;
+    let game = messages.read().filter(|_| local);
+    for message in game.chain(confirmed.read().map(|c| &c.0)) {
+        let result = match layers.get_mut(message.layer) {
+            Ok((entity, layer, mut state, mut edits)) => {
+                let sampler = state.sampler(layer, &tile_set.set, budget);
+                // Single edits do not count as a replaced set (see `index_edits`).
+                let edits = edits.bypass_change_detection();
+                let target = EditTarget {
+                    entity,
+                    layer,
+                    state: &mut state,
+                    sampler: &sampler,
+                    edits,
+                };
+                apply_edit(&mut commands, target, message)
+            }
+            Err(_) => Err(EditError::NoLayer(message.layer)),
         };
-        let sampler = state.sampler(layer, &tile_set.set, budget);
-        // Single edits do not count as a replaced set (see `index_edits`).
-        let edits = edits.bypass_change_detection();
-        if let Err(e) = apply_edit(
-            &mut commands,
-            entity,
-            layer,
-            &mut state,
-            &sampler,
-            edits,
-            message,
-        ) {
-            warn!("scatter layer {entity}: edit refused: {e}");
+        if let Err(e) = &result {
+            warn!("scatter layer {}: edit refused: {e}", message.layer);
         }
+        outcomes.write(EditOutcome {
+            edit: *message,
+            result,
+        });
     }
+}
+
+/// The layer an edit applies to, and what the plugin keeps of it.
+struct EditTarget<'a> {
+    entity: Entity,
+    layer: &'a ScatterLayer,
+    state: &'a mut LayerState,
+    sampler: &'a Sampler,
+    edits: &'a mut ScatterEdits,
 }
 
 /// Makes the by-chunk index of a layer's (new) edits; the chunks the old or the new edits
@@ -76,13 +101,16 @@ fn index_edits(state: &mut LayerState, layer: &ScatterLayer, sampler: &Sampler, 
 /// Applies one edit: to the layer's set, to its chunk's set, and to what the looks show.
 fn apply_edit(
     commands: &mut Commands,
-    entity: Entity,
-    layer: &ScatterLayer,
-    state: &mut LayerState,
-    sampler: &Sampler,
-    edits: &mut ScatterEdits,
+    target: EditTarget,
     message: &EditInstance,
 ) -> Result<(), EditError> {
+    let EditTarget {
+        entity,
+        layer,
+        state,
+        sampler,
+        edits,
+    } = target;
     let id = message.id;
     let position = sampler.locate(&id).ok_or(EditError::NoSuchPoint(id))?;
     let class = match message.edit {

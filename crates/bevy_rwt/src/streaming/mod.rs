@@ -74,20 +74,32 @@ pub struct DensityMapPainted {
     pub region: Rect,
 }
 
-/// The tile set every layer samples (the shipped one unless the plugin was given another).
+/// The tile set every layer samples (the shipped one unless the plugin was given another):
+/// a resource, read-only outside the plugin. Its [`RwtTileSet::fingerprint`] names it in
+/// saved edits and in what networked peers compare.
 #[derive(Resource, Clone)]
-pub(crate) struct RwtTileSet {
-    pub set: Arc<TileSet>,
+pub struct RwtTileSet {
+    pub(crate) set: Arc<TileSet>,
     /// [`TileSet::fingerprint`], which saved edits name their tile set by.
     fingerprint: u64,
 }
 
 impl RwtTileSet {
-    pub fn new(set: Arc<TileSet>) -> Self {
+    pub(crate) fn new(set: Arc<TileSet>) -> Self {
         Self {
             fingerprint: set.fingerprint(),
             set,
         }
+    }
+
+    /// The tile set.
+    pub fn tile_set(&self) -> &TileSet {
+        &self.set
+    }
+
+    /// [`TileSet::fingerprint`] of the tile set.
+    pub fn fingerprint(&self) -> u64 {
+        self.fingerprint
     }
 
     /// What the point identities of `layer` refer to (in saves).

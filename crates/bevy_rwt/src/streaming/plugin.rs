@@ -9,7 +9,7 @@ use super::repaint::{PaintedRegions, repaint};
 use super::spawn::apply_budget;
 use super::surfaces::{SurfaceMeshes, track_surfaces};
 use super::*;
-use crate::edits::{EditInstance, ScatterEdits};
+use crate::edits::{ConfirmedEdit, EditAuthority, EditInstance, EditOutcome, ScatterEdits};
 use crate::footprints::Footprint;
 use crate::instancing::InstancedMeshes;
 use crate::layers::ScatterEntity;
@@ -73,6 +73,10 @@ impl Plugin for RwtStreamingPlugin {
             .add_message::<ChunkUnloaded>()
             .add_message::<DensityMapPainted>()
             .add_message::<EditInstance>()
+            .add_message::<EditOutcome>()
+            .add_message::<ConfirmedEdit>()
+            .init_resource::<EditAuthority>()
+            .register_type::<EditAuthority>()
             .add_observer(on_layer_inserted)
             .add_observer(on_layer_removed)
             .add_systems(

@@ -5,7 +5,9 @@
 use crate::common::forest::*;
 use crate::common::*;
 use bevy::prelude::*;
-use bevy_rwt::edits::{Edit, EditInstance, ScatterEdits};
+use bevy_rwt::edits::{
+    ConfirmedEdit, Edit, EditAuthority, EditError, EditInstance, EditOutcome, ScatterEdits,
+};
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
 use std::collections::HashMap;
@@ -150,9 +152,65 @@ fn refused_edits_change_nothing() {
         EditInstance::remove(layer, nowhere),
         EditInstance::remove(not_a_layer, tree),
     ]);
+    app.update();
+    // Each is answered, in order, with why.
+    let outcomes: Vec<_> = app
+        .world_mut()
+        .resource_mut::<Messages<EditOutcome>>()
+        .drain()
+        .map(|o| o.result)
+        .collect();
+    assert_eq!(
+        outcomes,
+        [
+            Err(EditError::NoSuchClass {
+                class: 9,
+                classes: 4
+            }),
+            Err(EditError::NoSuchPoint(nowhere)),
+            Err(EditError::NoLayer(not_a_layer)),
+        ]
+    );
     tick_app(&mut app, 4_000);
     assert!(layer_edits(&app, layer).is_empty());
     assert!(placed(&mut app) == before);
+}
+
+#[test]
+fn under_a_remote_authority_only_confirmed_edits_apply() {
+    let mut app = instanced_app();
+    let (layer, _) = forest(&mut app);
+    spawn_viewer(&mut app, Vec3::ZERO);
+    tick_app(&mut app, 4_000);
+    let before = placed(&mut app);
+    let trees = nearest(&before, TREE, 2);
+    *app.world_mut().resource_mut::<EditAuthority>() = EditAuthority::Remote;
+    // The game's edit is a request for someone else: nothing changes here.
+    app.world_mut()
+        .write_message(EditInstance::remove(layer, trees[0]));
+    tick_app(&mut app, 4_000);
+    assert!(layer_edits(&app, layer).is_empty());
+    assert!(placed(&mut app) == before);
+    // The authority's confirmation applies, and is answered.
+    let chop = EditInstance::remove(layer, trees[1]);
+    app.world_mut().write_message(ConfirmedEdit(chop));
+    app.update();
+    let outcomes: Vec<_> = app
+        .world_mut()
+        .resource_mut::<Messages<EditOutcome>>()
+        .drain()
+        .collect();
+    assert_eq!(
+        outcomes,
+        [EditOutcome {
+            edit: chop,
+            result: Ok(())
+        }]
+    );
+    tick_app(&mut app, 4_000);
+    assert_eq!(layer_edits(&app, layer).len(), 1);
+    assert!(!placed(&mut app).contains_key(&trees[1]));
+    assert!(placed(&mut app).contains_key(&trees[0]));
 }
 
 #[test]
