@@ -95,14 +95,20 @@ fn some_ids(app: &mut App, layer_name: &str, n: usize) -> Vec<PointId> {
         .collect()
 }
 
-#[test]
-fn a_clients_edits_reach_the_server_and_every_client() {
+/// A server and two clients that joined it.
+fn server_and_two_clients() -> (App, App, App) {
     let mut server = peer(1, default());
     let mut a = peer(1, default());
     let mut b = peer(1, default());
     server.connect_client(&mut a);
     server.connect_client(&mut b);
     pump(&mut server, &mut [&mut a, &mut b], 4);
+    (server, a, b)
+}
+
+#[test]
+fn a_clients_edits_reach_the_server_and_every_client() {
+    let (mut server, mut a, mut b) = server_and_two_clients();
     assert_eq!(status(&a), NetClientStatus::Joined);
     assert_eq!(status(&b), NetClientStatus::Joined);
     let before = shown(&mut server);
@@ -181,12 +187,7 @@ fn a_client_of_another_world_is_refused_with_what_differs() {
 
 #[test]
 fn reconnecting_clients_end_with_the_server_world() {
-    let mut server = peer(1, default());
-    let mut a = peer(1, default());
-    let mut b = peer(1, default());
-    server.connect_client(&mut a);
-    server.connect_client(&mut b);
-    pump(&mut server, &mut [&mut a, &mut b], 4);
+    let (mut server, mut a, mut b) = server_and_two_clients();
 
     // A leaves; B chops two trees; A, meanwhile, chops one alone (never sent: offline).
     server.disconnect_client(&mut a);
