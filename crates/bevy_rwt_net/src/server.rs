@@ -352,11 +352,11 @@ fn welcome(
                 continue;
             };
             let file = edits.edits().to_bytes(&tile_set.stamp(layer));
-            let parts = file.chunks(config.join_part_bytes.max(1)).count();
-            for (k, part) in file.chunks(config.join_part_bytes.max(1)).enumerate() {
+            let parts: Vec<&[u8]> = file.chunks(config.join_part_bytes.max(1)).collect();
+            for (k, part) in parts.iter().enumerate() {
                 send(ServerNet::JoinPart {
                     layer: i as u16,
-                    last: k + 1 == parts,
+                    last: k + 1 == parts.len(),
                     bytes: part.to_vec(),
                 });
             }

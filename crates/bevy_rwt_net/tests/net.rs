@@ -253,6 +253,22 @@ fn send(client: &mut App, message: ClientNet) {
     client.world_mut().write_message(message);
 }
 
+/// Delivers `bytes` to the server as from `client`, on the channel `request` takes (learnt
+/// from the request, taken back before it is sent).
+fn send_bytes(server: &mut App, client: &mut App, request: ClientNet, bytes: &[u8]) {
+    send(client, request);
+    client.update();
+    let (channel, _) = client
+        .world_mut()
+        .resource_mut::<ClientMessages>()
+        .drain_sent()
+        .last()
+        .unwrap();
+    let entity = **client.world().resource::<TestClientEntity>();
+    let mut messages = server.world_mut().resource_mut::<ServerMessages>();
+    messages.insert_received(entity, channel, bytes.to_vec());
+}
+
 #[test]
 fn hostile_requests_are_refused_and_counted() {
     let config = NetConfig {
@@ -343,23 +359,10 @@ fn hostile_requests_are_refused_and_counted() {
     // The valid edit reached B.
     assert!(!shown(&mut b).contains(&("trees".into(), 0, valid)));
 
-    // Bytes that are no message, on the channel A's requests take (learnt from a request
-    // taken back before it is sent).
-    send(
-        &mut a,
-        ClientNet::Edit(wire(trees, valid.level, valid.index, WireKind::Remove)),
-    );
-    a.update();
-    let (channel, _) = a
-        .world_mut()
-        .resource_mut::<ClientMessages>()
-        .drain_sent()
-        .last()
-        .unwrap();
-    let client = **a.world().resource::<TestClientEntity>();
+    // Bytes that are no message, on the channel A's requests take.
+    let request = ClientNet::Edit(wire(trees, valid.level, valid.index, WireKind::Remove));
     for garbage in [&[0xff_u8, 0xff, 0xff][..], &[9], &[1, 200, 1, 2]] {
-        let mut messages = server.world_mut().resource_mut::<ServerMessages>();
-        messages.insert_received(client, channel, garbage.to_vec());
+        send_bytes(&mut server, &mut a, request.clone(), garbage);
     }
     pump(&mut server, &mut [&mut a, &mut b], 2);
     assert_eq!(refusals(&server).garbled, 3);
