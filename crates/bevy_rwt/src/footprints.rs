@@ -32,8 +32,9 @@ use rwt_core::Rect;
 
 /// The shape of a [`Footprint`], in the ground coordinates of its entity (x and z of its
 /// `Transform` on the default plane, x and y on [`GroundPlane::Xy`]); the entity's
-/// translation, turn and scale place it in the world.
-#[derive(Clone, Debug, PartialEq, Reflect)]
+/// translation, turn and scale place it in the world. Serializable, for a game that sends
+/// footprints across a network or saves them (`bevy_rwt_net` replicates them).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize, Reflect)]
 #[reflect(Clone, Debug, PartialEq)]
 pub enum FootprintShape {
     /// A disc around the entity's origin.

@@ -77,11 +77,28 @@ pub(crate) fn plugin(app: &mut App) {
         );
 }
 
+/// This client's world, as the handshake introduces it.
+#[derive(bevy::ecs::system::SystemParam)]
+struct OwnWorld<'w, 's> {
+    tile_set: Res<'w, RwtTileSet>,
+    layers: Query<'w, 's, (&'static Name, &'static ScatterLayer)>,
+    config: Res<'w, NetConfig>,
+}
+
+impl OwnWorld<'_, '_> {
+    fn hello(&self) -> ClientNet {
+        let layers = self.layers.iter();
+        ClientNet::Hello(WorldFingerprint::of(
+            &self.tile_set,
+            layers,
+            self.config.world_version,
+        ))
+    }
+}
+
 /// Introduces this client's world to the server.
 fn hello(
-    tile_set: Res<RwtTileSet>,
-    layers: Query<(&Name, &ScatterLayer)>,
-    config: Res<NetConfig>,
+    world: OwnWorld,
     mut status: ResMut<NetClientStatus>,
     mut authority: ResMut<EditAuthority>,
     mut server_layers: ResMut<ServerLayers>,
@@ -90,11 +107,7 @@ fn hello(
     *status = NetClientStatus::Joining;
     *authority = EditAuthority::Remote;
     *server_layers = ServerLayers::default();
-    out.write(ClientNet::Hello(WorldFingerprint::of(
-        &tile_set,
-        layers.iter(),
-        config.world_version,
-    )));
+    out.write(world.hello());
 }
 
 /// Offline, the game's edits apply here again (a join replaces them). A refusal stays
@@ -142,11 +155,12 @@ fn forward(
 fn receive(
     mut messages: MessageReader<ServerNet>,
     layers: Query<(Entity, &Name, &ScatterLayer)>,
-    tile_set: Res<RwtTileSet>,
+    world: OwnWorld,
     mut server_layers: ResMut<ServerLayers>,
     mut status: ResMut<NetClientStatus>,
     mut stats: ResMut<NetClientStats>,
     mut edits: MessageWriter<ConfirmedEdit>,
+    mut out: MessageWriter<ClientNet>,
     mut commands: Commands,
 ) {
     for message in messages.read() {
@@ -179,7 +193,7 @@ fn receive(
                 if let Some(entity) = server_layers.entities[i]
                     && let Ok((_, _, scatter)) = layers.get(entity)
                 {
-                    match EditSet::from_bytes(&file, &tile_set.stamp(scatter)) {
+                    match EditSet::from_bytes(&file, &world.tile_set.stamp(scatter)) {
                         Ok(set) => {
                             stats.joined_edits += set.len() as u64;
                             commands.entity(entity).insert(ScatterEdits::new(set));
@@ -193,6 +207,10 @@ fn receive(
                 if server_layers.remaining == 0 {
                     *status = NetClientStatus::Joined;
                 }
+            }
+            ServerNet::Recheck => {
+                *status = NetClientStatus::Joining;
+                out.write(world.hello());
             }
             ServerNet::Edits(batch) => {
                 for wire in batch {

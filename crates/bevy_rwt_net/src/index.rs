@@ -4,6 +4,7 @@ use bevy::prelude::*;
 
 /// The named layers in the order the network numbers them: by name, the first of equal
 /// names.
+#[derive(Default)]
 pub(crate) struct LayerIndex(Vec<(String, Entity)>);
 
 impl LayerIndex {

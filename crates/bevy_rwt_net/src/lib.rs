@@ -19,6 +19,12 @@
 //!   applied edit, its own game's too, to every joined client. Refused requests are counted
 //!   by reason ([`NetServerStats`], [`NetPeer`]); nothing a client sends can panic the
 //!   server or grow its memory past [`NetConfig`]'s limits.
+//! - **Footprints.** A [`NetFootprint`] the server spawns (a cabin, a camp) is replicated,
+//!   and clears the same ground on every peer.
+//! - **A changing server.** A server that loads a save ([`bevy_rwt::save::LoadWorld`])
+//!   sends every joined client the join again; one whose named layers, tile set or world
+//!   version change asks its clients to shake hands again, and refuses those that no longer
+//!   match.
 //!
 //! Layers are matched by their `Name` (as saves match them); unnamed layers stay local.
 //! Code that decides points (a custom density, the ground's height function) has no
@@ -30,6 +36,7 @@
 mod client;
 mod config;
 mod fingerprint;
+mod footprint;
 mod index;
 mod protocol;
 mod server;
@@ -40,6 +47,7 @@ pub use fingerprint::{
     Difference, JoinRefused, LayerField, LayerFingerprint, MAX_LAYERS, Mismatch, PROTOCOL,
     WorldFingerprint,
 };
+pub use footprint::NetFootprint;
 pub use protocol::{ClientNet, ServerNet, WireEdit, WireKind};
 pub use server::{EditPermission, EditRequest, NetPeer, NetServerStats, Refusals};
 
@@ -60,5 +68,6 @@ impl Plugin for RwtNetPlugin {
         protocol::register(app);
         server::plugin(app);
         client::plugin(app);
+        footprint::plugin(app);
     }
 }

@@ -1,7 +1,9 @@
 //! The two messages that cross the network, one each way, each on one ordered reliable
-//! channel (so a join always arrives before the live edits that follow it).
+//! channel (so a join always arrives before the live edits that follow it), and the one
+//! replicated component ([`NetFootprint`]).
 
 use crate::fingerprint::{JoinRefused, WorldFingerprint};
+use crate::footprint::NetFootprint;
 use bevy::prelude::*;
 use bevy_replicon::bytes::Bytes;
 use bevy_replicon::postcard_utils;
@@ -47,6 +49,9 @@ pub enum ServerNet {
     },
     /// Edits the server applied, in order.
     Edits(Vec<WireEdit>),
+    /// The server's world changed (its named layers, tile set or world version): the
+    /// client shakes hands again, with its world as it is now.
+    Recheck,
 }
 
 /// One instance edit on the wire: the layer by index, the point by identity.
@@ -113,10 +118,11 @@ impl WireEdit {
     }
 }
 
-/// Registers both messages (the same order on every peer: it is part of replicon's
-/// protocol hash).
+/// Registers both messages and the replicated footprint (the same order on every peer: it
+/// is part of replicon's protocol hash).
 pub(crate) fn register(app: &mut App) {
-    app.add_client_message_with(Channel::Ordered, serialize_client, deserialize_client)
+    app.replicate::<NetFootprint>()
+        .add_client_message_with(Channel::Ordered, serialize_client, deserialize_client)
         .add_server_message::<ServerNet>(Channel::Ordered)
         // The world's messages need no replicated entity first.
         .make_message_independent::<ServerNet>();

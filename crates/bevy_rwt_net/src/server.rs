@@ -1,6 +1,8 @@
 //! The server: checks each client's handshake, sends a joining client every layer's edits,
 //! screens edit requests (joined, known layer, storable level, rate, the game's permission)
 //! before the plugin applies them, and sends every applied edit on to the joined clients.
+//! When its world changes under them (a save loaded, named layers changed) it sends its
+//! clients the join again, or asks them to shake hands again.
 
 use crate::config::NetConfig;
 use crate::fingerprint::{JoinRefused, WorldFingerprint};
@@ -13,6 +15,7 @@ use bevy_rwt::RwtTileSet;
 use bevy_rwt::edits::{EditError, EditInstance, EditOutcome, ScatterEdits};
 use bevy_rwt::layers::ScatterLayer;
 use bevy_rwt::rwt_core::query::MAX_LEVEL;
+use bevy_rwt::save::WorldLoaded;
 use std::collections::VecDeque;
 
 /// A connected client as the server sees it (on replicon's client entity).
@@ -98,6 +101,11 @@ pub struct NetServerStats {
     pub join_bytes: u64,
     /// Bytes of live-edit messages sent, per client they went to.
     pub live_bytes: u64,
+    /// Times the joined clients were sent the join again (a save was loaded).
+    pub resyncs: u64,
+    /// Times the joined clients were asked to shake hands again (the named layers, the tile
+    /// set or the world version changed).
+    pub rechecks: u64,
 }
 
 /// A client's edit request after screening, handed to the game's [`EditPermission`].
@@ -125,25 +133,88 @@ struct Pending(Vec<EditRequest>);
 #[derive(Resource, Default)]
 struct InFlight(VecDeque<EditRequest>);
 
+/// The server's world as clients see it: its fingerprint and its named layers, made again
+/// only when they change.
+#[derive(Resource, Default)]
+struct ServerWorld {
+    /// `None` before the first frame.
+    fingerprint: Option<WorldFingerprint>,
+    index: LayerIndex,
+}
+
+/// A named layer that appeared, was renamed or changed.
+type LayerChanged = (
+    With<ScatterLayer>,
+    Or<(Changed<Name>, Changed<ScatterLayer>)>,
+);
+
 pub(crate) fn plugin(app: &mut App) {
     app.init_resource::<NetServerStats>()
         .init_resource::<Pending>()
         .init_resource::<InFlight>()
+        .init_resource::<ServerWorld>()
         .add_observer(on_client_connected)
         .add_systems(
             PreUpdate,
-            (receive, ask_permission)
+            (track_world, receive, ask_permission)
                 .chain()
                 .after(ServerSystems::Receive)
                 .run_if(in_state(ServerState::Running)),
         )
         .add_systems(
             PostUpdate,
-            (send_on, welcome)
+            (send_on, resync_after_load, welcome)
                 .chain()
                 .before(ServerSystems::Send)
                 .run_if(in_state(ServerState::Running)),
         );
+}
+
+/// Takes the world's fingerprint and layer index again when what they are made of changed;
+/// when the fingerprint differs, asks every joined client to shake hands again (its
+/// requests are refused as not joined until it has).
+#[allow(clippy::too_many_arguments)]
+fn track_world(
+    layers: Query<(Entity, &Name, &ScatterLayer)>,
+    changed: Query<(), LayerChanged>,
+    mut gone: RemovedComponents<ScatterLayer>,
+    mut unnamed: RemovedComponents<Name>,
+    tile_set: Res<RwtTileSet>,
+    config: Res<NetConfig>,
+    mut world: ResMut<ServerWorld>,
+    mut peers: Query<(Entity, &mut NetPeer)>,
+    mut stats: ResMut<NetServerStats>,
+    mut out: MessageWriter<ToClients<ServerNet>>,
+) {
+    let removed = gone.read().count() + unnamed.read().count() > 0;
+    let first = world.fingerprint.is_none();
+    if !(first || removed || !changed.is_empty() || tile_set.is_changed() || config.is_changed()) {
+        return;
+    }
+    let now = WorldFingerprint::of(
+        &tile_set,
+        layers.iter().map(|(_, n, l)| (n, l)),
+        config.world_version,
+    );
+    world.index = LayerIndex::new(layers.iter().map(|(e, n, _)| (e, n)));
+    let was = world.fingerprint.replace(now);
+    if first || was == world.fingerprint {
+        return;
+    }
+    let mut asked = false;
+    for (client, mut peer) in peers.iter_mut().filter(|(_, p)| p.joined || p.welcome) {
+        peer.joined = false;
+        peer.welcome = false;
+        asked = true;
+        out.write(ToClients {
+            targets: SendTargets::Single(ClientId::Client(client)),
+            message: ServerNet::Recheck,
+        });
+    }
+    if asked {
+        info!("the server's world changed: its clients shake hands again");
+        stats.rechecks += 1;
+    }
 }
 
 /// Every connected client gets a [`NetPeer`], with a full burst of requests.
@@ -163,8 +234,7 @@ fn on_client_connected(
 fn receive(
     mut messages: MessageReader<FromClient<ClientNet>>,
     mut peers: Query<&mut NetPeer>,
-    layers: Query<(Entity, &Name, &ScatterLayer)>,
-    tile_set: Res<RwtTileSet>,
+    world: Res<ServerWorld>,
     config: Res<NetConfig>,
     time: Res<Time<Real>>,
     mut pending: ResMut<Pending>,
@@ -176,7 +246,6 @@ fn receive(
     for mut peer in &mut peers {
         peer.tokens = (peer.tokens + refill).min(config.request_burst as f32);
     }
-    let index = LayerIndex::new(layers.iter().map(|(e, n, _)| (e, n)));
     for FromClient { client_id, message } in messages.read() {
         let ClientId::Client(client) = *client_id else {
             continue;
@@ -193,11 +262,9 @@ fn receive(
                 refuse(|r| &mut r.not_joined, &mut peer)
             }
             ClientNet::Hello(theirs) => {
-                let ours = WorldFingerprint::of(
-                    &tile_set,
-                    layers.iter().map(|(_, n, l)| (n, l)),
-                    config.world_version,
-                );
+                let Some(ours) = &world.fingerprint else {
+                    continue;
+                };
                 let differences = ours.differences(theirs);
                 if differences.is_empty() {
                     peer.welcome = true;
@@ -218,7 +285,7 @@ fn receive(
             }
             ClientNet::Edit(wire) => {
                 peer.tokens -= 1.0;
-                let Some(layer) = index.entity(wire.layer) else {
+                let Some(layer) = world.index.entity(wire.layer) else {
                     refuse(|r| &mut r.unknown_layer, &mut peer);
                     continue;
                 };
@@ -270,18 +337,16 @@ fn send_on(
     mut outcomes: MessageReader<EditOutcome>,
     mut in_flight: ResMut<InFlight>,
     mut peers: Query<(Entity, &mut NetPeer)>,
-    layers: Query<(Entity, &Name), With<ScatterLayer>>,
+    world: Res<ServerWorld>,
     mut stats: ResMut<NetServerStats>,
     mut out: MessageWriter<ToClients<ServerNet>>,
 ) {
-    let index = LayerIndex::new(layers.iter());
     let mut batch = Vec::new();
     for outcome in outcomes.read() {
-        let asked = in_flight.0.iter().position(|r| r.edit == outcome.edit);
-        let client = asked.and_then(|i| in_flight.0.remove(i)).map(|r| r.client);
+        let client = in_flight.requester(&outcome.edit);
         match &outcome.result {
             Ok(()) => {
-                if let Some(layer) = index.position(outcome.edit.layer) {
+                if let Some(layer) = world.index.position(outcome.edit.layer) {
                     batch.push(WireEdit::new(layer, &outcome.edit));
                 }
             }
@@ -312,6 +377,34 @@ fn send_on(
     }
 }
 
+impl InFlight {
+    /// Who asked for `edit` (`None`: the server's game), taken off the queue. Outcomes come
+    /// in the order the requests were handed on, so a client's is at the front unless the
+    /// game's own edits came between.
+    fn requester(&mut self, edit: &EditInstance) -> Option<ClientId> {
+        let at = match self.0.front() {
+            Some(first) if first.edit == *edit => Some(0),
+            _ => self.0.iter().position(|r| r.edit == *edit),
+        };
+        at.and_then(|i| self.0.remove(i)).map(|r| r.client)
+    }
+}
+
+/// A loaded save replaced the server's edits: every joined client gets the join again.
+fn resync_after_load(
+    mut loaded: MessageReader<WorldLoaded>,
+    mut peers: Query<&mut NetPeer>,
+    mut stats: ResMut<NetServerStats>,
+) {
+    if !loaded.read().any(|l| l.result.is_ok()) {
+        return;
+    }
+    stats.resyncs += 1;
+    for mut peer in peers.iter_mut().filter(|p| p.joined) {
+        peer.welcome = true;
+    }
+}
+
 fn reason(error: &EditError) -> fn(&mut Refusals) -> &mut u64 {
     match error {
         EditError::NoLayer(_) => |r| &mut r.unknown_layer,
@@ -325,17 +418,20 @@ fn reason(error: &EditError) -> fn(&mut Refusals) -> &mut u64 {
 /// this frame's edits were applied: the live edits that follow are all newer).
 fn welcome(
     mut peers: Query<(Entity, &mut NetPeer)>,
-    layers: Query<(Entity, &Name, &ScatterLayer, &ScatterEdits)>,
+    layers: Query<(&ScatterLayer, &ScatterEdits)>,
+    world: Res<ServerWorld>,
     tile_set: Res<RwtTileSet>,
     config: Res<NetConfig>,
     mut stats: ResMut<NetServerStats>,
     mut out: MessageWriter<ToClients<ServerNet>>,
 ) {
-    let index = LayerIndex::new(layers.iter().map(|(e, n, ..)| (e, n)));
+    let index = &world.index;
     for (client, mut peer) in peers.iter_mut().filter(|(_, p)| p.welcome) {
         peer.welcome = false;
+        if !peer.joined {
+            stats.joins += 1;
+        }
         peer.joined = true;
-        stats.joins += 1;
         let target = SendTargets::Single(ClientId::Client(client));
         let mut send = |message: ServerNet| {
             stats.join_bytes += postcard::to_allocvec(&message).map_or(0, |b| b.len() as u64);
@@ -348,7 +444,7 @@ fn welcome(
             layers: index.names().map(str::to_owned).collect(),
         });
         for (i, entity) in index.entities().enumerate() {
-            let Ok((_, _, layer, edits)) = layers.get(entity) else {
+            let Ok((layer, edits)) = layers.get(entity) else {
                 continue;
             };
             let file = edits.edits().to_bytes(&tile_set.stamp(layer));

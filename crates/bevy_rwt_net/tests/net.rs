@@ -1,21 +1,29 @@
 //! Edits across the network, headless, with replicon's in-process connection (no transport):
-//! a client's chops reach the server and every other client, late joiners and reconnecting
-//! clients end with the server's world, a mismatched client is refused with what differs,
-//! and hostile requests are refused and counted.
+//! a client's chops and the server's cabins reach every client, late joiners, reconnecting
+//! clients and the clients of a server restarted from its save end with the server's world,
+//! a mismatched client is refused with what differs (also when the server's world changes
+//! under it), and hostile requests are refused and counted.
 
 use bevy::prelude::*;
 use bevy::state::app::StatesPlugin;
 use bevy_replicon::prelude::*;
 use bevy_replicon::test_app::{ServerTestAppExt, TestClientEntity};
 use bevy_rwt::edits::{EditInstance, ScatterEdits};
+use bevy_rwt::footprints::Footprint;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
 use bevy_rwt::testing::{headless_app_with, settle, spawn_viewer};
 use bevy_rwt_net::*;
 use std::collections::BTreeSet;
 
-/// A world's layers: trees and stones, named; `seed` is the trees'.
-fn peer(seed: u64, config: NetConfig) -> App {
+/// A layer of one class per density, entities drawn with default handles.
+fn layer_of(densities: &[f64]) -> ScatterLayer {
+    let class = |d: &f64| ScatterClass::new(LayerDensity::Constant(*d), default(), default());
+    ScatterLayer::new(densities.iter().map(class).collect())
+}
+
+/// A peer whose world `spawn_layers` makes, with a viewer at the origin, settled.
+fn peer_of(config: NetConfig, spawn_layers: impl FnOnce(&mut World)) -> App {
     let mut app = headless_app_with(RwtPlugins::default(), |app| {
         app.add_plugins((
             StatesPlugin,
@@ -23,19 +31,18 @@ fn peer(seed: u64, config: NetConfig) -> App {
             RwtNetPlugin { config },
         ));
     });
-    let class = |density| ScatterClass::new(LayerDensity::Constant(density), default(), default());
-    let world = app.world_mut();
-    world.spawn((
-        Name::new("trees"),
-        ScatterLayer::new(vec![class(0.05), class(0.0)]).with_seed(seed),
-    ));
-    world.spawn((
-        Name::new("stones"),
-        ScatterLayer::new(vec![class(0.02)]).with_seed(9),
-    ));
+    spawn_layers(app.world_mut());
     spawn_viewer(&mut app, Vec3::ZERO);
     assert!(settle(&mut app, 10_000));
     app
+}
+
+/// A world's layers: trees (and their stump class) and stones, named; `seed` is the trees'.
+fn peer(seed: u64, config: NetConfig) -> App {
+    peer_of(config, |world| {
+        world.spawn((Name::new("trees"), layer_of(&[0.05, 0.0]).with_seed(seed)));
+        world.spawn((Name::new("stones"), layer_of(&[0.02]).with_seed(9)));
+    })
 }
 
 fn layer(app: &mut App, name: &str) -> Entity {
@@ -182,7 +189,28 @@ fn a_client_of_another_world_is_refused_with_what_differs() {
         panic!("not refused");
     };
     assert_eq!(refused.differences[0].what, Mismatch::WorldVersion);
-    assert_eq!(server.world().resource::<NetServerStats>().refused_joins, 2);
+
+    // Another layer file: denser stones, and a layer of flowers the server lacks.
+    let mut other_layers = peer_of(default(), |world| {
+        world.spawn((Name::new("trees"), layer_of(&[0.05, 0.0]).with_seed(1)));
+        world.spawn((Name::new("stones"), layer_of(&[0.03]).with_seed(9)));
+        world.spawn((Name::new("flowers"), layer_of(&[0.5]).with_seed(5)));
+    });
+    server.connect_client(&mut other_layers);
+    pump(&mut server, &mut [&mut other_layers], 3);
+    let NetClientStatus::Refused(refused) = status(&other_layers) else {
+        panic!("not refused: {:?}", status(&other_layers));
+    };
+    let what: Vec<Mismatch> = refused.differences.iter().map(|d| d.what.clone()).collect();
+    assert_eq!(
+        what,
+        [
+            Mismatch::Layer("stones".into(), LayerField::Description),
+            Mismatch::ExtraLayer("flowers".into()),
+        ],
+        "{refused}"
+    );
+    assert_eq!(server.world().resource::<NetServerStats>().refused_joins, 3);
 }
 
 #[test]
@@ -211,8 +239,25 @@ fn reconnecting_clients_end_with_the_server_world() {
     assert_eq!(a.world().get::<ScatterEdits>(trees_a).unwrap().len(), 2);
 }
 
+/// Saves `app`'s world to `dir` (the save module, as a game's server does); the edits saved.
+fn save(app: &mut App, dir: &std::path::Path) -> usize {
+    app.world_mut().write_message(SaveWorld::to(dir));
+    app.update();
+    let mut saved = app.world_mut().resource_mut::<Messages<WorldSaved>>();
+    saved.drain().last().unwrap().result.unwrap().edits
+}
+
+/// Loads the save in `dir` into `app`; the edits loaded.
+fn load(app: &mut App, dir: &std::path::Path) -> usize {
+    app.world_mut().write_message(LoadWorld::from(dir));
+    app.update();
+    let mut loaded = app.world_mut().resource_mut::<Messages<WorldLoaded>>();
+    loaded.drain().last().unwrap().result.unwrap().edits
+}
+
 #[test]
 fn a_restarted_server_resyncs_its_clients() {
+    let dir = std::env::temp_dir().join(format!("rwt-net-restart-{}", std::process::id()));
     let mut server = peer(1, default());
     let mut a = peer(1, default());
     server.connect_client(&mut a);
@@ -222,20 +267,15 @@ fn a_restarted_server_resyncs_its_clients() {
         a.world_mut().write_message(EditInstance::remove(trees, id));
     }
     pump(&mut server, &mut [&mut a], 6);
-    let trees_server = layer(&mut server, "trees");
-    let saved = server
-        .world()
-        .get::<ScatterEdits>(trees_server)
-        .unwrap()
-        .clone();
-    assert_eq!(saved.len(), 3);
+    assert_eq!(save(&mut server, &dir), 3);
 
-    // The server restarts from its saved edits (the save module's job in a game: the
-    // same edits set), with one more chop made while it was down.
+    // The server stops, and a new one starts from the save, its game chopping one more
+    // tree before the client is back.
     server.disconnect_client(&mut a);
+    drop(server);
     let mut restarted = peer(1, default());
+    assert_eq!(load(&mut restarted, &dir), 3);
     let trees_s = layer(&mut restarted, "trees");
-    restarted.world_mut().entity_mut(trees_s).insert(saved);
     let more = some_ids(&mut restarted, "trees", 20)[19];
     restarted
         .world_mut()
@@ -246,6 +286,121 @@ fn a_restarted_server_resyncs_its_clients() {
     assert_eq!(status(&a), NetClientStatus::Joined);
     assert_eq!(shown(&mut a), shown(&mut restarted));
     assert_eq!(a.world().get::<ScatterEdits>(trees).unwrap().len(), 4);
+
+    // The running server loads its save again (the fourth chop undone): the client follows.
+    assert_eq!(load(&mut restarted, &dir), 3);
+    pump(&mut restarted, &mut [&mut a], 4);
+    assert_eq!(a.world().get::<ScatterEdits>(trees).unwrap().len(), 3);
+    assert_eq!(shown(&mut a), shown(&mut restarted));
+    // One resync: the first load came before the server listened, with no one to send to.
+    let stats = restarted.world().resource::<NetServerStats>();
+    assert_eq!((stats.resyncs, stats.joins), (1, 1), "{stats:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The first shown tree's ground position on `app`.
+fn a_tree(app: &mut App) -> Vec3 {
+    let trees = layer(app, "trees");
+    let mut q = app.world_mut().query::<(&ScatterEntity, &Transform)>();
+    let mut places: Vec<Vec3> = q
+        .iter(app.world())
+        .filter(|(s, _)| s.layer == trees)
+        .map(|(_, t)| t.translation)
+        .collect();
+    places.sort_by(|a, b| a.length().total_cmp(&b.length()));
+    places[0]
+}
+
+/// Footprints on `app`.
+fn footprints(app: &mut App) -> usize {
+    let mut q = app.world_mut().query::<(&NetFootprint, &Footprint)>();
+    q.iter(app.world()).count()
+}
+
+#[test]
+fn a_cabin_the_server_places_clears_the_same_ground_for_every_player() {
+    let (mut server, mut a, mut b) = server_and_two_clients();
+    let before = shown(&mut server);
+    let at = a_tree(&mut server);
+    let cabin = server
+        .world_mut()
+        .spawn((
+            NetFootprint::new(Transform::from_translation(at), Footprint::circle(6.0))
+                .on_layers(["trees"]),
+            Replicated,
+        ))
+        .id();
+    pump(&mut server, &mut [&mut a, &mut b], 4);
+
+    // Every tree within 6 m of the cabin is gone on the server, and nothing else.
+    let world = shown(&mut server);
+    let cleared: Vec<_> = before.difference(&world).collect();
+    assert!(!cleared.is_empty());
+    assert!(
+        cleared.iter().all(|(layer, ..)| layer == "trees"),
+        "{cleared:?}"
+    );
+    let trees = layer(&mut server, "trees");
+    let mut q = server.world_mut().query::<(&ScatterEntity, &Transform)>();
+    let near = |t: &Transform| t.translation.xz().distance(at.xz()) <= 6.0;
+    assert!(
+        !q.iter(server.world())
+            .any(|(s, t)| s.layer == trees && near(t))
+    );
+    assert_eq!(shown(&mut a), world, "A shows the server's clearing");
+    assert_eq!(shown(&mut b), world, "B shows the server's clearing");
+
+    // A late player, and one that reconnects, have the cabin once.
+    let mut c = peer(1, default());
+    server.connect_client(&mut c);
+    server.disconnect_client(&mut b);
+    pump(&mut server, &mut [&mut a, &mut c], 2);
+    server.connect_client(&mut b);
+    pump(&mut server, &mut [&mut a, &mut b, &mut c], 4);
+    for (name, app) in [("B", &mut b), ("C", &mut c)] {
+        assert_eq!(shown(app), world, "{name} shows the server's clearing");
+        assert_eq!(footprints(app), 1, "{name}");
+    }
+
+    // The cabin goes: the trees stand again for everyone.
+    server.world_mut().entity_mut(cabin).despawn();
+    pump(&mut server, &mut [&mut a, &mut b, &mut c], 4);
+    assert_eq!(shown(&mut server), before);
+    for app in [&mut a, &mut b, &mut c] {
+        assert_eq!(shown(app), before);
+    }
+}
+
+#[test]
+fn a_changed_server_world_rechecks_its_clients() {
+    let (mut server, mut a, mut b) = server_and_two_clients();
+    // The server and A (updated alike) get a layer of apples; B does not. "apples" sorts
+    // first, so the trees' index on the wire moves.
+    for app in [&mut server, &mut a] {
+        app.world_mut()
+            .spawn((Name::new("apples"), layer_of(&[0.01]).with_seed(3)));
+    }
+    pump(&mut server, &mut [&mut a, &mut b], 4);
+    assert_eq!(status(&a), NetClientStatus::Joined);
+    let NetClientStatus::Refused(refused) = status(&b) else {
+        panic!("not refused: {:?}", status(&b));
+    };
+    let what: Vec<Mismatch> = refused.differences.iter().map(|d| d.what.clone()).collect();
+    assert_eq!(what, [Mismatch::MissingLayer("apples".into())]);
+    assert_eq!(server.world().resource::<NetServerStats>().rechecks, 1);
+
+    // A's chop lands on the server's trees.
+    let trees = layer(&mut a, "trees");
+    let id = some_ids(&mut a, "trees", 1)[0];
+    a.world_mut().write_message(EditInstance::remove(trees, id));
+    pump(&mut server, &mut [&mut a], 6);
+    let trees_s = layer(&mut server, "trees");
+    assert_eq!(
+        server.world().get::<ScatterEdits>(trees_s).unwrap().len(),
+        1
+    );
+    assert_eq!(shown(&mut a), shown(&mut server));
+    assert_eq!(refusals(&server).total(), 0);
 }
 
 /// Sends `message` from `client` as it is, bypassing the client plugin.
