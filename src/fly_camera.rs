@@ -37,6 +37,15 @@ impl FlyCamera {
     pub fn rotation(&self) -> Quat {
         Quat::from_euler(EulerRot::YXZ, self.yaw, self.pitch, 0.0)
     }
+
+    /// Puts the camera at `from`, looking at `target` (its yaw and pitch, and `transform`).
+    pub fn place(&mut self, transform: &mut Transform, from: Vec3, target: Vec3) {
+        let look = (target - from).normalize_or(Vec3::NEG_Z);
+        self.yaw = (-look.x).atan2(-look.z);
+        self.pitch = look.y.asin();
+        transform.translation = from;
+        transform.rotation = self.rotation();
+    }
 }
 
 /// Moves [`FlyCamera`]s from keyboard and mouse input.

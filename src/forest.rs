@@ -203,3 +203,39 @@ pub fn asset_tree_layer(
     classes.push(stump(meshes, material));
     forest_layer(classes, ground)
 }
+
+/// The tree layer's entity: the layer named "trees".
+pub fn named_tree_layer(layers: &Query<(Entity, &Name), With<ScatterLayer>>) -> Option<Entity> {
+    layers
+        .iter()
+        .find(|(_, n)| n.as_str() == "trees")
+        .map(|(e, _)| e)
+}
+
+/// The trees (not stumps) a pick considers, up to 300 m away.
+pub fn trees_only(layer: Entity) -> PickFilter {
+    PickFilter::default()
+        .layers([layer])
+        .classes(TREE_SPECIES)
+        .max_distance(300.0)
+}
+
+/// The tree under the mouse cursor of the one camera and window.
+#[derive(bevy::ecs::system::SystemParam)]
+pub struct TreeUnderCursor<'w, 's> {
+    cameras: Query<'w, 's, (&'static Camera, &'static GlobalTransform)>,
+    windows: Query<'w, 's, &'static Window>,
+    layers: Query<'w, 's, (Entity, &'static Name), With<ScatterLayer>>,
+    picking: ScatterPicking<'w, 's>,
+}
+
+impl TreeUnderCursor<'_, '_> {
+    /// The tree the cursor points at, if any.
+    pub fn tree(&self) -> Option<ScatterHit> {
+        let (camera, at) = self.cameras.single().ok()?;
+        let layer = named_tree_layer(&self.layers)?;
+        let cursor = self.windows.single().ok()?.cursor_position()?;
+        let ray = camera.viewport_to_world(at, cursor).ok()?;
+        self.picking.cast_ray(ray, &trees_only(layer))
+    }
+}

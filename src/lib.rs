@@ -1,6 +1,7 @@
 //! What the examples share:
-//! - the open world that `open_world` and `web` stream ([`world`]) and the asset pack its
-//!   vegetation is made of ([`pack`]);
+//! - the open world that `open_world` and `web` stream ([`world`]), the
+//!   asset pack its vegetation is made of ([`pack`]), its forests ([`forest`]) and the
+//!   cabin players place ([`cabin`]);
 //! - the scripted smoke session that lets CI run each example in a real renderer
 //!   ([`smoke`]), and frames captured and compared by the examples that check themselves
 //!   ([`frame_check`]);
@@ -15,6 +16,7 @@
 //! saves a screenshot, prints `rwt-smoke: ... instances N` and exits with status 0.
 
 pub mod brush_status;
+pub mod cabin;
 pub mod fly_camera;
 pub mod foliage;
 pub mod forest;

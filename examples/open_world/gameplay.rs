@@ -6,8 +6,8 @@
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
-use rwt_examples::foliage;
-use rwt_examples::forest::{STUMP, TREE_SPECIES};
+use rwt_examples::cabin::{CabinPlugin, Cabins, cabin_footprint, cabin_transform};
+use rwt_examples::forest::{STUMP, TreeUnderCursor};
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::Terrain;
 
@@ -16,72 +16,22 @@ pub struct GameplayPlugin;
 
 impl Plugin for GameplayPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<Cabins>()
-            .add_systems(Startup, cabin_assets)
+        app.add_plugins(CabinPlugin)
             .add_systems(Update, (chop_on_click, place_cabin_on_key));
     }
-}
-
-/// The cabin's mesh and material, made once.
-#[derive(Resource, Default)]
-pub struct Cabins {
-    mesh: Handle<Mesh>,
-    material: Handle<StandardMaterial>,
-}
-
-fn cabin_assets(
-    mut cabins: ResMut<Cabins>,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
-) {
-    cabins.mesh = meshes.add(foliage::cabin());
-    cabins.material = materials.add(StandardMaterial {
-        perceptual_roughness: 0.85,
-        ..default()
-    });
-}
-
-/// The tree layer's entity, by its name.
-pub fn tree_layer(layers: &Query<(Entity, &Name), With<ScatterLayer>>) -> Option<Entity> {
-    layers
-        .iter()
-        .find(|(_, n)| n.as_str() == "trees")
-        .map(|(e, _)| e)
-}
-
-/// The trees (not stumps) a pick considers, up to 300 m away.
-pub fn trees_only(layer: Entity) -> PickFilter {
-    PickFilter::default()
-        .layers([layer])
-        .classes(TREE_SPECIES)
-        .max_distance(300.0)
 }
 
 /// Left click with the brush off: the tree under the cursor becomes a stump.
 fn chop_on_click(
     buttons: Res<ButtonInput<MouseButton>>,
     brush: Res<DensityBrush>,
-    cameras: Query<(&Camera, &GlobalTransform)>,
-    windows: Query<&Window>,
-    layers: Query<(Entity, &Name), With<ScatterLayer>>,
-    picking: ScatterPicking,
+    cursor: TreeUnderCursor,
     mut edits: MessageWriter<EditInstance>,
 ) {
     if brush.enabled || !buttons.just_pressed(MouseButton::Left) {
         return;
     }
-    let (Ok((camera, at)), Ok(window), Some(layer)) =
-        (cameras.single(), windows.single(), tree_layer(&layers))
-    else {
-        return;
-    };
-    let Some(ray) = window
-        .cursor_position()
-        .and_then(|c| camera.viewport_to_world(at, c).ok())
-    else {
-        return;
-    };
-    if let Some(hit) = picking.cast_ray(ray, &trees_only(layer)) {
+    if let Some(hit) = cursor.tree() {
         edits.write(EditInstance::reclass(hit.layer, hit.id, STUMP));
     }
 }
@@ -104,25 +54,14 @@ fn place_cabin_on_key(
 }
 
 /// A cabin at ground position `at` whose door looks along `facing`, clearing the ground
-/// under it and 1.5 m around; returns its footprint.
+/// under it and 1.5 m around.
 pub fn spawn_cabin(
     commands: &mut Commands,
     cabins: &Cabins,
     terrain: &Terrain,
     at: Vec2,
     facing: Vec2,
-) -> (Transform, Footprint) {
-    // The door is on the cabin's +x side.
-    let yaw = (-facing.y).atan2(-facing.x);
-    let transform = Transform::from_xyz(at.x, terrain.height(at) - 0.2, at.y)
-        .with_rotation(Quat::from_rotation_y(yaw));
-    let footprint = Footprint::rectangle(Vec2::new(3.0, 2.0)).with_margin(1.5);
-    commands.spawn((
-        Mesh3d(cabins.mesh.clone()),
-        MeshMaterial3d(cabins.material.clone()),
-        transform,
-        footprint.clone(),
-        CountedInstance,
-    ));
-    (transform, footprint)
+) {
+    let transform = cabin_transform(terrain, at, facing);
+    commands.spawn((cabins.look(), transform, cabin_footprint(), CountedInstance));
 }

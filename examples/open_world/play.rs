@@ -7,13 +7,13 @@
 //! ([`crate::walk`]) heads straight for a tree's trunk and must stop at it:
 //! `rwt-smoke: walked into a trunk: closest D m from its axis, collision at R m`.
 
-use crate::gameplay::{Cabins, spawn_cabin, tree_layer, trees_only};
+use crate::gameplay::spawn_cabin;
 use crate::walk::{RADIUS as WALKER_RADIUS, Walker, spawn_walker};
 use bevy::prelude::*;
 use bevy_rwt::prelude::*;
 use bevy_rwt::rwt_core::query::PointId;
-use glam::DVec2;
-use rwt_examples::forest::STUMP;
+use rwt_examples::cabin::{CabinPlan, Cabins};
+use rwt_examples::forest::{STUMP, named_tree_layer, trees_only};
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::Terrain;
 use std::collections::{HashMap, HashSet};
@@ -158,38 +158,28 @@ fn start(
     edits: &mut MessageWriter<EditInstance>,
     commands: &mut Commands,
 ) {
-    let (Ok(eye), Some(layer)) = (world.camera.single(), tree_layer(&world.layers)) else {
+    let Ok(eye) = world.camera.single() else {
         return;
     };
-    let forward = eye.forward().xz().normalize_or(Vec2::Y);
-    let here = eye.translation.xz();
-    // Trees around, nearest first.
-    let trees = world.picking.near(here, 300.0, &trees_only(layer));
-    let in_view = |h: &&ScatterHit| {
-        let d = h.transform.translation.xz() - here;
-        (12.0..40.0).contains(&d.length()) && d.normalize_or_zero().dot(forward) > 0.9
+    let Some(plan) = CabinPlan::at_eye(eye, &world.layers, &world.picking, &world.terrain) else {
+        return;
     };
-    let cabin = trees
-        .iter()
-        .find(in_view)
-        .map(|h| h.transform.translation.xz())
-        .unwrap_or(here + forward * 15.0);
-    let (transform, footprint) =
-        spawn_cabin(commands, &world.cabins, &world.terrain, cabin, -forward);
-    play.cabin = cabin;
-    let ground = footprint.on_ground(&GlobalTransform::from(transform), GroundPlane::Xz);
-    let clears = |h: &ScatterHit| {
-        let p = h.transform.translation;
-        ground.clears(DVec2::new(p.x as f64, p.z as f64), h.class)
-    };
+    spawn_cabin(
+        commands,
+        &world.cabins,
+        &world.terrain,
+        plan.at,
+        plan.facing,
+    );
+    play.cabin = plan.at;
     play.cleared = world
         .picking
-        .near(cabin, CABIN_REACH, &PickFilter::default())
+        .near(plan.at, CABIN_REACH, &PickFilter::default())
         .iter()
-        .filter(|h| clears(h))
+        .filter(|h| plan.clears(h))
         .map(|h| (h.layer, h.id))
         .collect();
-    for hit in trees.iter().filter(|h| !clears(h)).take(3) {
+    for hit in &plan.chops {
         edits.write(EditInstance::reclass(hit.layer, hit.id, STUMP));
         play.chopped.push(hit.id);
     }
@@ -202,7 +192,7 @@ fn persisted(play: &Play, world: &Stage) -> usize {
         .iter()
         .map(|i| ((i.layer, i.id), i.class))
         .collect();
-    let layer = tree_layer(&world.layers);
+    let layer = named_tree_layer(&world.layers);
     let stumps = play
         .chopped
         .iter()
@@ -242,7 +232,7 @@ struct Walk {
 /// A walker 3 m from the nearest tree, heading for its axis.
 fn start_walk(world: &Stage, commands: &mut Commands) -> Option<Walk> {
     let eye = world.camera.single().ok()?;
-    let layer = tree_layer(&world.layers)?;
+    let layer = named_tree_layer(&world.layers)?;
     let trees = world
         .picking
         .near(eye.translation.xz(), 200.0, &trees_only(layer));

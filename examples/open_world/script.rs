@@ -173,12 +173,9 @@ fn overlook(
     let at = cabin + back * OVERLOOK.0;
     let ground = terrain.height(cabin);
     let from = Vec3::new(at.x, ground.max(WATER) + OVERLOOK.1, at.y);
-    let look = (Vec3::new(cabin.x, ground + 1.5, cabin.y) - from).normalize();
+    let target = Vec3::new(cabin.x, ground + 1.5, cabin.y);
     for (mut cam, mut transform) in &mut camera {
-        cam.yaw = (-look.x).atan2(-look.z);
-        cam.pitch = look.y.asin();
-        transform.translation = from;
-        transform.rotation = cam.rotation();
+        cam.place(&mut transform, from, target);
     }
     report.hold |= gameplay.frames_done(smoke.frame) < OVERLOOK_FRAMES;
 }

@@ -24,11 +24,10 @@ use bevy::asset::AssetMetaCheck;
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
-use rwt_examples::forest::forest_edge;
 use rwt_examples::prelude::*;
-use rwt_examples::terrain::{Terrain, WATER};
+use rwt_examples::terrain::Terrain;
 use rwt_examples::world::layers::Detail;
-use rwt_examples::world::{WorldScenePlugin, layers, world_fog};
+use rwt_examples::world::{WorldScenePlugin, forest_edge_camera, layers};
 
 fn main() {
     // The browser's page is served the pack that `scripts/web.sh` writes natively.
@@ -69,25 +68,7 @@ fn main() {
 
 /// The camera: in a meadow, looking over grass and flowers at a forest's edge.
 fn setup_camera(mut commands: Commands, terrain: Res<Terrain>) {
-    let (at, yaw) = forest_edge(&terrain, Vec2::new(-443.0, -1433.0));
-    let cam = FlyCamera {
-        speed: 20.0,
-        yaw,
-        pitch: -0.06,
-        ..default()
-    };
-    let eye = Vec3::new(at.x, terrain.height(at).max(WATER) + 2.0, at.y);
-    commands.spawn((
-        Camera3d::default(),
-        Projection::Perspective(PerspectiveProjection {
-            far: 7000.0,
-            ..default()
-        }),
-        Transform::from_translation(eye).with_rotation(cam.rotation()),
-        cam,
-        RwtViewer::default(),
-        world_fog(),
-    ));
+    commands.spawn(forest_edge_camera(&terrain, Vec2::new(-443.0, -1433.0)));
 }
 
 /// The page's setting `?key=value` (natively the environment variable `env`).

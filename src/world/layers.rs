@@ -73,6 +73,87 @@ impl Detail {
     }
 }
 
+/// The world's layers, by name, and the names of the flower maps (one per class of
+/// `"flowers"`, the brush's targets with `"bushes"`).
+pub struct WorldLayers {
+    /// Trees, rocks, grass, ferns, flowers and bushes, with their names.
+    pub layers: Vec<(&'static str, ScatterLayer)>,
+    /// The flower maps' names.
+    pub flower_maps: Vec<String>,
+}
+
+/// What the world's layers are made of: the ground, the pack's files (`load` gives the
+/// handle of a pack path; a server that draws nothing passes `|_| Handle::default()`),
+/// the assets the grass and painted maps are made into, and the share that grows.
+pub struct LayerParts<'a> {
+    /// The terrain.
+    pub terrain: &'a Terrain,
+    /// A pack file's handle, by path.
+    pub load: &'a dyn Fn(&str) -> Handle<Gltf>,
+    /// Where meshes go.
+    pub meshes: &'a mut Assets<Mesh>,
+    /// Where materials go.
+    pub materials: &'a mut Assets<StandardMaterial>,
+    /// Where the painted maps go.
+    pub images: &'a mut Assets<Image>,
+    /// The share that grows.
+    pub detail: Detail,
+}
+
+impl LayerParts<'_> {
+    /// The layers; the names `names` holds for layer files ("terrain", "white") added.
+    pub fn build(self, names: &NamedAssets) -> WorldLayers {
+        let detail = self.detail;
+        let white = self.materials.add(StandardMaterial {
+            perceptual_roughness: 0.9,
+            reflectance: 0.2,
+            ..default()
+        });
+        // Named, so that the brush writes the painted layers as layer files (F5).
+        let ground = self.terrain.source();
+        names.insert_height("terrain", &ground);
+        names.insert_material("white", white.clone());
+        let look = |path: &str| AssetLook::new((self.load)(path));
+        let trees = asset_tree_layer(
+            &ground,
+            PACK.trees.map(look),
+            self.meshes,
+            &white,
+            PROMOTION,
+        )
+        .with_height_range(WATER + 1.5, 112.0)
+        .with_max_slope(0.6);
+        let (flowers, flower_maps) = flowers(&ground, (self.load)(PACK.flowers), self.images);
+        let bush_density = painted_map(self.images, 9, 0.05, 120.0);
+        let layers = vec![
+            ("trees", trees),
+            ("rocks", rocks(&ground, look(PACK.rock))),
+            ("grass", grass(&ground, self.meshes)),
+            ("ferns", ferns(&ground, look(PACK.fern))),
+            ("flowers", flowers),
+            ("bushes", bushes(&ground, bush_density, look(PACK.bush))),
+        ];
+        let layers = layers
+            .into_iter()
+            .map(|(name, layer)| (name, detail.thin(layer)))
+            .collect();
+        WorldLayers {
+            layers,
+            flower_maps,
+        }
+    }
+}
+
+impl WorldLayers {
+    /// Spawns the layers, each with its `Name`; the entities by name.
+    pub fn spawn(self, commands: &mut Commands) -> Vec<(&'static str, Entity)> {
+        let layers = self.layers.into_iter();
+        layers
+            .map(|(name, layer)| (name, commands.spawn((Name::new(name), layer)).id()))
+            .collect()
+    }
+}
+
 /// Spawns the layers and aims the brush at the flower and bush maps.
 #[allow(clippy::too_many_arguments)]
 pub fn setup_layers(
@@ -86,45 +167,22 @@ pub fn setup_layers(
     names: Res<NamedAssets>,
     detail: Option<Res<Detail>>,
 ) {
-    let detail = detail.map_or(Detail::default(), |d| *d);
-    let white = materials.add(StandardMaterial {
-        perceptual_roughness: 0.9,
-        reflectance: 0.2,
-        ..default()
-    });
-    // Named, so that the brush writes the painted layers as layer files (F5).
-    let ground = terrain.source();
-    names.insert_height("terrain", &ground);
-    names.insert_material("white", white.clone());
-    let look = |path: &str| AssetLook::new(server.load(path.to_string()));
-    let trees = asset_tree_layer(
-        &ground,
-        PACK.trees.map(look),
-        &mut meshes,
-        &white,
-        PROMOTION,
-    )
-    .with_height_range(WATER + 1.5, 112.0)
-    .with_max_slope(0.6);
-    commands.spawn((Name::new("trees"), detail.thin(trees)));
-    let rocks = rocks(&ground, look(PACK.rock));
-    commands.spawn((Name::new("rocks"), detail.thin(rocks)));
-    let grass = grass(&ground, &mut meshes);
-    commands.spawn((Name::new("grass"), detail.thin(grass)));
-    let ferns = ferns(&ground, look(PACK.fern));
-    commands.spawn((Name::new("ferns"), detail.thin(ferns)));
-    let (flowers, flower_targets) = flowers(&ground, server.load(PACK.flowers), &mut images);
-    let flowers = commands
-        .spawn((Name::new("flowers"), detail.thin(flowers)))
-        .id();
-    let bush_density = painted_map(&mut images, 9, 0.05, 120.0);
-    let bushes = commands
-        .spawn((
-            Name::new("bushes"),
-            detail.thin(bushes(&ground, bush_density, look(PACK.bush))),
-        ))
-        .id();
-    brush.targets = flower_targets
+    let parts = LayerParts {
+        terrain: &terrain,
+        load: &|path| server.load(path.to_string()),
+        meshes: &mut meshes,
+        materials: &mut materials,
+        images: &mut images,
+        detail: detail.map_or(Detail::default(), |d| *d),
+    };
+    let world = parts.build(&names);
+    let flower_maps = world.flower_maps.clone();
+    let spawned = world.spawn(&mut commands);
+    let entity = |name: &str| spawned.iter().find(|(n, _)| *n == name).map(|(_, e)| *e);
+    let (Some(flowers), Some(bushes)) = (entity("flowers"), entity("bushes")) else {
+        return;
+    };
+    brush.targets = flower_maps
         .into_iter()
         .enumerate()
         .map(|(class, name)| NamedMap::new(flowers, class, name))

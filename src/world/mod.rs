@@ -4,22 +4,27 @@
 pub mod layers;
 
 use crate::fly_camera::FlyCamera;
+use crate::forest::forest_edge;
 use crate::terrain::{GROUND_RECENTRE, Terrain, WATER, ground_centre, ground_mesh};
 use bevy::light::{CascadeShadowConfig, CascadeShadowConfigBuilder};
 use bevy::pbr::MAX_CASCADES_PER_LIGHT;
 use bevy::prelude::*;
+use bevy_rwt::prelude::RwtViewer;
+
+/// The terrain's seed.
+pub const TERRAIN_SEED: u32 = 2006;
 
 /// The sky at the horizon; the fog fades into it.
 pub const SKY: Color = Color::srgb(0.66, 0.77, 0.88);
 
-/// The terrain (seed 2006), the sky, the sun with cascaded shadows, sky light, and the
+/// The terrain ([`TERRAIN_SEED`]), the sky, the sun with cascaded shadows, sky light, and the
 /// ground and water that follow the [`FlyCamera`].
 pub struct WorldScenePlugin;
 
 impl Plugin for WorldScenePlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(ClearColor(SKY))
-            .insert_resource(Terrain::new(2006))
+            .insert_resource(Terrain::new(TERRAIN_SEED))
             .add_systems(Startup, setup_scene)
             .add_systems(
                 Update,
@@ -33,6 +38,30 @@ impl Plugin for WorldScenePlugin {
 /// Where the ground follows the camera: after whatever moves the camera.
 #[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
 pub struct WorldSystems;
+
+/// A fly camera in a meadow near `near`, 2 m above the ground, looking over grass and
+/// flowers at a forest's edge, streaming around it, with the world's fog.
+pub fn forest_edge_camera(terrain: &Terrain, near: Vec2) -> impl Bundle {
+    let (at, yaw) = forest_edge(terrain, near);
+    let cam = FlyCamera {
+        speed: 20.0,
+        yaw,
+        pitch: -0.06,
+        ..default()
+    };
+    let eye = Vec3::new(at.x, terrain.height(at).max(WATER) + 2.0, at.y);
+    (
+        Camera3d::default(),
+        Projection::Perspective(PerspectiveProjection {
+            far: 7000.0,
+            ..default()
+        }),
+        Transform::from_translation(eye).with_rotation(cam.rotation()),
+        cam,
+        RwtViewer::default(),
+        world_fog(),
+    )
+}
 
 /// The fog of the world's cameras: the far hills fade into the sky.
 pub fn world_fog() -> DistanceFog {
