@@ -20,9 +20,11 @@
 # scene entities of it cover (silhouette IoU >= 0.98, each primitive's colour in its place),
 # asset_shadows, which fails unless an asset's cut-out leaves cast their shadows where Bevy's
 # own scene entities of it cast theirs (shadow IoU >= 0.85) and its moss receives them,
-# and asset_lods, which fails unless an asset's levels of detail, chosen per instance on the
+# asset_lods, which fails unless an asset's levels of detail, chosen per instance on the
 # GPU, draw fewer vertices as the camera moves away, each instance the level its distance
-# calls for.
+# calls for, and multiplayer, which fails unless a server and three players (processes on
+# 127.0.0.1, a server restart from its save between them) end with the same edits and
+# cabins.
 #
 #   scripts/smoke.sh                 # debug build (reuses `cargo test`'s), screenshots in target/smoke
 #   scripts/smoke.sh --docs          # release build, and refresh docs/screenshots/*.png, with
@@ -34,10 +36,10 @@ cd "$(dirname "$0")/.."
 docs=0
 [ "${1:-}" = "--docs" ] && docs=1 && shift
 scripts/render_deps.sh
-examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_shadows asset_lods)
+examples=(quickstart open_world paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_shadows asset_lods multiplayer)
 runs=("${examples[@]}")
 if [ $docs = 1 ]; then
-    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_shadows asset_lods)
+    runs=(quickstart open_world:eye open_world:forest open_world:aerial open_world:brush open_world:clearing paint_density stipple_zoom mesh_ground instanced_passes gpu_culling gpu_occlusion impostor_match asset_match asset_shadows asset_lods multiplayer)
 fi
 [ $# -gt 0 ] && runs=("$@")
 # The examples the runs need, once each.
@@ -122,6 +124,19 @@ for run in "${runs[@]}"; do
     if [ "$ex" = asset_shadows ]; then
         # Shadows of an asset: rwt's cut-out card casts where Bevy's own scene casts.
         self_checked RWT_ASSET_SHADOWS_DIR=$out/asset_shadows rwt-asset-shadows 'instances'
+        continue
+    fi
+    if [ "$ex" = multiplayer ]; then
+        # Multiplayer: the server and three players as processes on 127.0.0.1 (A chops and
+        # asks for a cabin, B joins late, the server restarts from its save, B reconnects, C
+        # joins late and takes the screenshot); every world must hold the same edits and
+        # cabins. 15 % of the vegetation grows: three debug windows render at once.
+        RWT_DETAIL=${RWT_DETAIL:-0.15} self_checked RWT_SCREENSHOT=$png rwt-multiplayer 'agree'
+        [ -s "$png" ] || { echo "FAIL $name: no screenshot"; failed=1; }
+        if [ $docs = 1 ] && [ $failed = 0 ]; then
+            mkdir -p docs/screenshots
+            python3 scripts/png_stats.py "$png" --half docs/screenshots/multiplayer_late_player.png >/dev/null
+        fi
         continue
     fi
     if [ "$ex" = asset_lods ]; then

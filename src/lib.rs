@@ -1,5 +1,5 @@
 //! What the examples share:
-//! - the open world that `open_world` and `web` stream ([`world`]), the
+//! - the open world that `open_world`, `web` and `multiplayer` stream ([`world`]), the
 //!   asset pack its vegetation is made of ([`pack`]), its forests ([`forest`]) and the
 //!   cabin players place ([`cabin`]);
 //! - the scripted smoke session that lets CI run each example in a real renderer
@@ -100,6 +100,8 @@ pub mod guide {
     pub struct Instanced;
     #[doc = include_str!("../docs/guide/library.md")]
     pub struct Library;
+    #[doc = include_str!("../docs/guide/multiplayer.md")]
+    pub struct Multiplayer;
     #[doc = include_str!("../docs/guide/plugin.md")]
     pub struct Plugin;
     #[doc = include_str!("../docs/guide/python.md")]
