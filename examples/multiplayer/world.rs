@@ -9,6 +9,7 @@ use bevy_replicon_renet::{RenetChannelsExt, RepliconRenetPlugins};
 use bevy_rwt::edits::{EditOutcome, ScatterEdits};
 use bevy_rwt::layers::file::NamedAssets;
 use bevy_rwt::prelude::*;
+use bevy_rwt::rwt_core::rng::fnv1a;
 use bevy_rwt::{ClassLook, RwtTileSet};
 use bevy_rwt_net::{NetConfig, NetFootprint, RwtNetPlugin};
 use rwt_examples::cabin::{cabin_footprint, cabin_transform};
@@ -218,11 +219,4 @@ impl WorldState<'_, '_> {
             digest: fnv1a(&bytes),
         }
     }
-}
-
-/// 64-bit FNV-1a.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ *b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
 }

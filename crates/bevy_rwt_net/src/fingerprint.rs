@@ -5,6 +5,7 @@
 use bevy::prelude::*;
 use bevy_rwt::RwtTileSet;
 use bevy_rwt::layers::{LayerDensity, ScatterLayer};
+use bevy_rwt::rwt_core::rng::fnv1a;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -282,11 +283,4 @@ fn density(d: &LayerDensity) -> String {
         }
         other => format!("{other:?}"),
     }
-}
-
-/// 64-bit FNV-1a: the same on every platform and build.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ *b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
 }

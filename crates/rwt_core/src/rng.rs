@@ -22,6 +22,19 @@ pub fn hash_words(seed: u64, words: &[u64]) -> u64 {
     h
 }
 
+/// 64-bit FNV-1a of `bytes`: the same on every platform and build, for names and
+/// fingerprints of data (not for hashing points: see [`hash_words`]).
+///
+/// ```
+/// assert_eq!(rwt_core::rng::fnv1a(b""), 0xcbf2_9ce4_8422_2325);
+/// assert_eq!(rwt_core::rng::fnv1a(b"a"), 0xaf63_dc4c_8601_ec8c);
+/// ```
+pub fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
 /// Maps a hash to a float uniformly distributed in `[0, 1)` (53 random bits).
 #[inline]
 pub fn unit_f64(h: u64) -> f64 {

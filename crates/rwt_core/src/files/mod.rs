@@ -191,12 +191,7 @@ fn temp_prefix(target: &Path) -> std::ffi::OsString {
         while !text.is_char_boundary(cut.min(text.len())) {
             cut -= 1;
         }
-        let hash = name
-            .as_encoded_bytes()
-            .iter()
-            .fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-                (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
-            });
+        let hash = crate::rng::fnv1a(name.as_encoded_bytes());
         prefix.push(format!("{}~{hash:016x}", &text[..cut.min(text.len())]));
     }
     prefix.push(".");
