@@ -146,7 +146,7 @@ fn run_check(
                 || (chunks.is_empty() && spawned.iter().count() >= 3 * check.instances)
         }
     };
-    let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && drawn;
+    let settled = stats.settled() && drawn;
     let Some(since) = check.settled_at else {
         if settled {
             check.settled_at = Some(check.frame);

@@ -176,7 +176,7 @@ fn run_check(
     }
     let shown = drawn(&check, &captures, chunks.iter().len(), spawned.iter().len());
     // Settled for WAIT frames in a row.
-    if !(stats.pending_tasks == 0 && stats.queued_spawns == 0 && shown) {
+    if !(stats.settled() && shown) {
         check.settled_at = None;
         return;
     }

@@ -198,8 +198,7 @@ fn run_check(
         (Some(field), None) => live <= field,
         (None, _) => true,
     };
-    let settled =
-        stats.pending_tasks == 0 && stats.queued_spawns == 0 && live > 0 && layers_as_meant;
+    let settled = stats.settled() && live > 0 && layers_as_meant;
     let Some(since) = check.settled_at else {
         if settled {
             check.settled_at = Some(check.frame);

@@ -148,7 +148,7 @@ fn run_check(
     if out_of_patience(&mut check.frame, PATIENCE, "rwt-occlusion", &mut exit) {
         return;
     }
-    let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && stats.live_instanced > 0;
+    let settled = stats.settled() && stats.live_instanced > 0;
     let Some(since) = check.settled_at else {
         if settled {
             check.settled_at = Some(check.frame);

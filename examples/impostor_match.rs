@@ -167,7 +167,7 @@ fn run_check(
     } else {
         stats.live_entities
     };
-    let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && shown > 0;
+    let settled = stats.settled() && shown > 0;
     let Some(since) = check.settled_at else {
         if settled {
             check.settled_at = Some(check.frame);

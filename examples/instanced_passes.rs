@@ -296,7 +296,7 @@ struct Scene<'w, 's> {
 }
 
 fn run_check(mut check: ResMut<Check>, mut scene: Scene, mut commands: Commands) {
-    let settled = scene.stats.pending_tasks == 0 && scene.stats.queued_spawns == 0;
+    let settled = scene.stats.settled();
     check.waited += 1;
     check.frames += 1;
     if let Some(pending) = check.pending.clone() {

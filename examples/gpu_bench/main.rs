@@ -475,10 +475,8 @@ fn step(
             stable,
             live: streamed,
         } => {
-            let settled_now = stats.pending_tasks == 0
-                && stats.queued_spawns == 0
-                && grass.live_instanced > 0
-                && grass.live_instanced == streamed;
+            let settled_now =
+                stats.settled() && grass.live_instanced > 0 && grass.live_instanced == streamed;
             let stable = if settled_now { stable + 1 } else { 0 };
             bench.phase = Phase::Streaming {
                 since,

@@ -136,7 +136,7 @@ pub fn report(
         return;
     }
     hold.hold = true;
-    let settled = stats.pending_tasks == 0 && stats.queued_spawns == 0 && stats.live_instanced > 0;
+    let settled = stats.settled() && stats.live_instanced > 0;
     if !settled || smoke.frame < 30 {
         return;
     }

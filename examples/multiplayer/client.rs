@@ -225,8 +225,3 @@ fn hud(player: Res<Player>, status: Res<NetClientStatus>, world: WorldState, mut
         "click: chop   H: cabin   right mouse: look   F1: hide".into(),
     ];
 }
-
-/// Whether streaming has settled (nothing pending, nothing waiting to spawn).
-pub fn settled(stats: &RwtStats) -> bool {
-    stats.pending_tasks == 0 && stats.queued_spawns == 0
-}

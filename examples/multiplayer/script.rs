@@ -4,7 +4,7 @@
 //! `RWT_SCREENSHOT`, once joined, looks down at the cabin and holds its screenshot until its
 //! world there has settled.
 
-use crate::client::{Player, report_line, settled};
+use crate::client::{Player, report_line};
 use crate::options::ScriptRole;
 use crate::world::CabinRequest;
 use bevy::prelude::*;
@@ -62,7 +62,7 @@ fn act(
     mut edits: MessageWriter<EditInstance>,
     mut cabins: MessageWriter<CabinRequest>,
 ) {
-    let ready = *status == NetClientStatus::Joined && settled(&stats);
+    let ready = *status == NetClientStatus::Joined && stats.settled();
     if script.role != ScriptRole::Chop || script.acted || !ready {
         return;
     }
@@ -98,7 +98,7 @@ fn hold_screenshot(
     if !smoke.active() {
         return;
     }
-    let ready = *status == NetClientStatus::Joined && settled(&stats);
+    let ready = *status == NetClientStatus::Joined && stats.settled();
     script.ready_frames = if ready { script.ready_frames + 1 } else { 0 };
     report.hold = script.ready_frames < SETTLE_FRAMES || !script.overlooks;
 }

@@ -116,7 +116,7 @@ pub fn play(
     mut edits: MessageWriter<EditInstance>,
     mut commands: Commands,
 ) {
-    let settled = world.stats.pending_tasks == 0 && world.stats.queued_spawns == 0;
+    let settled = world.stats.settled();
     let frame = world.smoke.frame;
     let waited = frame.saturating_sub(play.since);
     let phase = play.phase;

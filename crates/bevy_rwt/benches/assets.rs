@@ -187,7 +187,7 @@ fn fill(app: &mut App, path: Path) -> usize {
         app.update();
         frames += 1;
         let s = app.world().resource::<RwtStats>();
-        let settled = s.pending_tasks == 0 && s.queued_spawns == 0 && live(app) > 0;
+        let settled = s.settled() && live(app) > 0;
         if settled && (path == Path::Instanced || promoted(app) >= live(app)) {
             break;
         }

@@ -56,7 +56,7 @@ fn fill(app: &mut App) {
         app.update();
         frames += 1;
         let s = app.world().resource::<RwtStats>();
-        if s.pending_tasks == 0 && s.queued_spawns == 0 && s.live_entities > 0 {
+        if s.settled() && s.live_entities > 0 {
             break;
         }
         if frames > 100_000 {

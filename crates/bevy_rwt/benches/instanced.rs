@@ -118,7 +118,7 @@ fn fill(app: &mut App, expected: f64) {
         app.update();
         frames += 1;
         let s = app.world().resource::<RwtStats>();
-        if s.pending_tasks == 0 && s.queued_spawns == 0 && live(app) > 0 {
+        if s.settled() && live(app) > 0 {
             break;
         }
         assert!(frames < 1_000_000, "the world did not fill");

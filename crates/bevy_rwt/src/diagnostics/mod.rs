@@ -34,6 +34,13 @@ pub struct RwtStats {
     pub streaming_ms: f64,
 }
 
+impl RwtStats {
+    /// Whether streaming has settled: no chunk pending, nothing waiting for a budget.
+    pub fn settled(&self) -> bool {
+        self.pending_tasks == 0 && self.queued_spawns == 0
+    }
+}
+
 /// Diagnostic paths published by the plugin.
 pub mod paths {
     use super::DiagnosticPath;

@@ -82,7 +82,7 @@ pub fn run_until(app: &mut App, max: usize, done: impl Fn(&App) -> bool) -> bool
 pub fn settle(app: &mut App, max: usize) -> bool {
     let idle = |app: &App| {
         let s = app.world().resource::<RwtStats>();
-        s.pending_tasks == 0 && s.queued_spawns == 0
+        s.settled()
     };
     for _ in 0..max {
         app.update();

@@ -89,7 +89,7 @@ fn a_painted_region_message_limits_what_re_scatters() {
             let mut reader = app.world_mut().resource_mut::<Messages<ChunkLoaded>>();
             regenerated += reader.drain().count();
             let s = app.world().resource::<RwtStats>();
-            if s.pending_tasks == 0 && s.queued_spawns == 0 && regenerated > 0 {
+            if s.settled() && regenerated > 0 {
                 break;
             }
         }
