@@ -58,6 +58,16 @@ pub fn cabin_transform(terrain: &Terrain, at: Vec2, facing: Vec2) -> Transform {
         .with_rotation(Quat::from_rotation_y(yaw))
 }
 
+/// How far ahead of the camera a player's cabin goes (metres).
+pub const CABIN_AHEAD: f32 = 14.0;
+
+/// Where a cabin placed from `eye` stands on the ground, [`CABIN_AHEAD`] ahead, and where
+/// its door looks: back at the eye.
+pub fn cabin_ahead(eye: &Transform) -> (Vec2, Vec2) {
+    let ahead = eye.forward().xz().normalize_or(Vec2::Y);
+    (eye.translation.xz() + ahead * CABIN_AHEAD, -ahead)
+}
+
 /// The ground a cabin clears: under it and 1.5 m around.
 pub fn cabin_footprint() -> Footprint {
     Footprint::rectangle(Vec2::new(3.0, 2.0)).with_margin(1.5)

@@ -16,7 +16,7 @@ use bevy_replicon_renet::RenetClient;
 use bevy_replicon_renet::netcode::{ClientAuthentication, NetcodeClientTransport};
 use bevy_rwt::prelude::*;
 use bevy_rwt_net::{NetClientStatus, NetFootprint};
-use rwt_examples::cabin::{CabinPlugin, Cabins};
+use rwt_examples::cabin::{CabinPlugin, Cabins, cabin_ahead};
 use rwt_examples::forest::{STUMP, TreeUnderCursor};
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::Terrain;
@@ -30,8 +30,6 @@ use std::time::SystemTime;
 const RETRY: f32 = 2.0;
 /// Where the players start: a meadow by a forest's edge near here.
 const START: Vec2 = Vec2::new(-443.0, -1433.0);
-/// How far ahead of the camera H places a cabin (metres).
-const CABIN_AHEAD: f32 = 14.0;
 
 /// Runs a player until its window closes; `script` adds what it does by itself.
 pub fn run(options: ClientOptions, script: impl FnOnce(&mut App)) -> AppExit {
@@ -150,16 +148,8 @@ fn cabin_on_key(
         return;
     }
     if let Ok(eye) = camera.single() {
-        requests.write(cabin_ahead(eye, CABIN_AHEAD));
-    }
-}
-
-/// A cabin `distance` ahead of `eye` on the ground, its door towards the eye.
-pub fn cabin_ahead(eye: &Transform, distance: f32) -> CabinRequest {
-    let ahead = eye.forward().xz().normalize_or(Vec2::Y);
-    CabinRequest {
-        at: eye.translation.xz() + ahead * distance,
-        facing: -ahead,
+        let (at, facing) = cabin_ahead(eye);
+        requests.write(CabinRequest { at, facing });
     }
 }
 

@@ -6,7 +6,7 @@
 use bevy::prelude::*;
 use bevy_rwt::brush::DensityBrush;
 use bevy_rwt::prelude::*;
-use rwt_examples::cabin::{CabinPlugin, Cabins, cabin_footprint, cabin_transform};
+use rwt_examples::cabin::{CabinPlugin, Cabins, cabin_ahead, cabin_footprint, cabin_transform};
 use rwt_examples::forest::{STUMP, TreeUnderCursor};
 use rwt_examples::prelude::*;
 use rwt_examples::terrain::Terrain;
@@ -36,7 +36,7 @@ fn chop_on_click(
     }
 }
 
-/// H: a cabin 14 m ahead of the camera, facing it (C is the fly camera's down key).
+/// H: a cabin ahead of the camera, facing it (C is the fly camera's down key).
 fn place_cabin_on_key(
     keys: Res<ButtonInput<KeyCode>>,
     camera: Query<&Transform, With<FlyCamera>>,
@@ -48,9 +48,8 @@ fn place_cabin_on_key(
         return;
     }
     let Ok(eye) = camera.single() else { return };
-    let ahead = eye.forward().xz().normalize_or(Vec2::Y);
-    let at = eye.translation.xz() + ahead * 14.0;
-    spawn_cabin(&mut commands, &cabins, &terrain, at, -ahead);
+    let (at, facing) = cabin_ahead(eye);
+    spawn_cabin(&mut commands, &cabins, &terrain, at, facing);
 }
 
 /// A cabin at ground position `at` whose door looks along `facing`, clearing the ground
